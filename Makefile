@@ -1,0 +1,41 @@
+# flipkit: `make test` and `make figures` set everything up themselves on a fresh machine.
+SHELL := /bin/bash
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.flipkit-installed
+APT_PACKAGES :=
+export MPLBACKEND := Agg
+export OMP_NUM_THREADS := 1
+
+.PHONY: test figures figures-quick paper bench venv lock clean
+
+venv: $(STAMP)
+
+$(STAMP): environment.lock pyproject.toml
+	@if [ -n "$(APT_PACKAGES)" ]; then \
+	  missing=$$(for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	  if [ -n "$$missing" ]; then apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; fi; fi
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --disable-pip-version-check --require-hashes -r environment.lock
+	$(PY) -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+	@touch $(STAMP)
+
+test: $(STAMP)
+	$(PY) -m pytest -n 2 -q
+
+figures: $(STAMP)
+	$(VENV)/bin/flipkit figures $(FIGURES_ARGS)
+
+figures-quick: $(STAMP)
+	$(VENV)/bin/flipkit figures --quick
+
+bench: $(STAMP)
+	$(PY) -m flipkit.bench translate
+
+# Regenerate the lock from requirements.in (needs uv: pip install uv).
+lock:
+	uv pip compile requirements.in --python-version 3.11 --generate-hashes -o environment.lock
+
+clean:
+	rm -rf build figures/*.pdf figures/*.png figures/manifest.json

@@ -1,0 +1,1 @@
+"""Sub-commands of the ``flipkit`` command line, one module each."""

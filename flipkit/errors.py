@@ -1,0 +1,63 @@
+"""Exception hierarchy: every error flipkit raises derives from :class:`FlipkitError`.
+
+Messages are one line and, where the error is a bad choice, list the valid choices, so the
+command line can print them as they are (``flipkit: error: <message>``) and exit non-zero.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+
+class FlipkitError(Exception):
+    """Root of every flipkit error."""
+
+
+class ConfigError(FlipkitError, ValueError):
+    """An invalid configuration value (wrong shape, non-finite, out of range)."""
+
+
+class InvalidChoiceError(ConfigError):
+    """A name that is not one of the allowed choices.
+
+    Args:
+        what: What is being chosen (e.g. ``"cone form"``).
+        value: The rejected value.
+        choices: The valid values, listed in the message.
+    """
+
+    def __init__(self, what: str, value: Any, choices: Iterable[Any]):
+        self.what, self.value, self.choices = what, value, tuple(choices)
+        valid = ", ".join(repr(c) for c in self.choices)
+        super().__init__(f"unknown {what} {value!r}; valid choices: {valid}")
+
+
+class UnreachableError(FlipkitError):
+    """A requested spatula pose that the robot cannot reach (IK failed or outside the area)."""
+
+
+class PlanFileError(FlipkitError):
+    """A plan file that is missing, not JSON, or not in the ``flipkit-plan/1`` format."""
+
+
+class NoSolutionFound(FlipkitError):
+    """A trajectory optimisation that did not converge to a feasible point.
+
+    Attributes:
+        problem: The NLP that was being solved.
+        status: Solver status string.
+        group: Name of the most violated constraint group (or ``None``).
+        amount: Its maximum scaled violation.
+        result: The solver result (iterate, log), for inspection.
+    """
+
+    def __init__(self, problem: Any, status: str, group: str | None, amount: float,
+                 result: Any = None):
+        self.problem, self.status, self.group, self.amount, self.result = (
+            problem, status, group, amount, result)
+        where = f"; worst constraint group {group!r} violated by {amount:.3g}" if group else ""
+        super().__init__(f"no solution found ({status}){where}")
+
+
+class VerificationError(FlipkitError):
+    """A plan that fails the independent residual check."""

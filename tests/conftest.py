@@ -1,0 +1,37 @@
+import os
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import numpy as np
+import pytest
+
+from flipkit.config import CellConfig
+from flipkit.robot import Robot
+
+
+@pytest.fixture(scope="session")
+def cell():
+    return CellConfig()
+
+
+@pytest.fixture(scope="session")
+def robot(cell):
+    return Robot(cell, with_burger=True)
+
+
+def central_fd(fun, x, h=1e-6):
+    """Central finite-difference Jacobian of fun at x (columns: ∂/∂x_k)."""
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for k in range(x.size):
+        e = np.zeros_like(x)
+        e[k] = h
+        cols.append((np.asarray(fun(x + e)) - np.asarray(fun(x - e))) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+def random_states(robot, seed, n=5):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        q = robot.q_home + rng.uniform(-0.6, 0.6, robot.nq)
+        yield q, rng.uniform(-1.5, 1.5, robot.nq), rng.uniform(-5, 5, robot.nq)

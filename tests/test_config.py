@@ -1,0 +1,54 @@
+import numpy as np
+import pytest
+
+from flipkit.config import (TABLE1_LOCATIONS, BurgerConfig, CellConfig, GrillConfig, RobotConfig,
+                            SpatulaConfig, TaskLimits)
+from flipkit.errors import ConfigError, FlipkitError
+from flipkit.ik import solve_pose
+from flipkit.orientation import rpy
+from flipkit.robot import Robot
+
+
+def test_q_home_puts_the_spatula_flat_above_the_grill():
+    r = Robot()
+    np.testing.assert_allclose(r.position(r.q_home), [0.62, -0.20, 0.30], atol=1e-4)
+    np.testing.assert_allclose(rpy(r.rotation(r.q_home)), 0, atol=1e-4)
+    assert np.all(r.q_home > r.q_min) and np.all(r.q_home < r.q_max)
+
+
+def test_grill_contains_table1_and_csv_matches():
+    g = GrillConfig()
+    assert all(g.contains(p) for p in TABLE1_LOCATIONS)
+    assert all(abs(p[2] - g.height) <= 0.0011 for p in TABLE1_LOCATIONS)
+
+
+def test_table1_locations_are_reachable_scoop_ready():
+    r = Robot()
+    for p in TABLE1_LOCATIONS:
+        solve_pose(r, p, (0.0, 0.314, 0.0))
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: BurgerConfig(mu=-0.1), "mu"),
+    (lambda: BurgerConfig(diameter=float("nan")), "diameter"),
+    (lambda: SpatulaConfig(length=0), "length"),
+    (lambda: GrillConfig(x_range=(0.9, 0.6)), "lower bound"),
+    (lambda: TaskLimits(p_min=(0, 0)), "shape"),
+    (lambda: RobotConfig(urdf="/nonexistent.urdf"), "not found"),
+    (lambda: RobotConfig(base_in_world=np.eye(4) * 2), "rigid"),
+    (lambda: CellConfig(gravity=(0, 0, float("inf"))), "finite"),
+])
+def test_validation(make, match):
+    with pytest.raises(ConfigError, match=match):
+        make()
+    assert issubclass(ConfigError, FlipkitError)
+
+
+def test_configs_are_frozen():
+    with pytest.raises(AttributeError):
+        BurgerConfig().mu = 1.0
+
+
+def test_tool_frame_must_exist():
+    with pytest.raises(ConfigError, match="tool0"):
+        Robot(CellConfig(robot=RobotConfig(tool_frame="flange")))

@@ -1,0 +1,88 @@
+"""Every analytic Jacobian against central finite differences on the UR10 + spatula.
+
+Tolerances: 1e-6 absolute (plus 1e-6 relative) for kinematic quantities, central differences
+with h = 1e-6 have truncation error O(h²) ≈ 1e-12 and round-off ≈ 1e-10/h ≈ 1e-4·ε-scaled, so
+1e-6 leaves margin while catching any missing term (those are O(1)).
+"""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import central_fd, random_states
+
+from flipkit.contact import make_cone
+from flipkit.orientation import axis_jacobian, rpy_jacobian
+
+TOL = dict(atol=1e-6, rtol=1e-6)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_position_and_angular_jacobian(robot, seed):
+    for q, _, _ in random_states(robot, seed):
+        p, R, dp_dq, Jw = robot.pose_jacobians(q)
+        np.testing.assert_allclose(dp_dq, central_fd(robot.position, q), **TOL)
+        # dR = [Jw dq]x R  <=>  Jw[:, k] = log(R(q+h e_k) R(q-h e_k)^T) / 2h
+        cols = []
+        for k in range(robot.nq):
+            e = np.zeros(robot.nq)
+            e[k] = 1e-6
+            cols.append(pin.log3(robot.rotation(q + e) @ robot.rotation(q - e).T) / 2e-6)
+        np.testing.assert_allclose(Jw, np.stack(cols, 1), **TOL)
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_velocity_and_acceleration_jacobians(robot, seed):
+    for q, qd, qdd in random_states(robot, seed):
+        st = robot.state(q, qd, qdd)
+        np.testing.assert_allclose(st.v, central_fd(robot.position, q) @ qd, **TOL)
+        fv = lambda x: robot.state(x[:6], x[6:12], x[12:]).v
+        fa = lambda x: robot.state(x[:6], x[6:12], x[12:]).a
+        x = np.concatenate([q, qd, qdd])
+        Jv, Ja = central_fd(fv, x), central_fd(fa, x)
+        np.testing.assert_allclose(st.dv_dq, Jv[:, :6], **TOL)
+        np.testing.assert_allclose(st.dv_dqd, Jv[:, 6:12], **TOL)
+        np.testing.assert_allclose(st.da_dq, Ja[:, :6], atol=1e-5, rtol=1e-6)
+        np.testing.assert_allclose(st.da_dqd, Ja[:, 6:12], **TOL)
+        np.testing.assert_allclose(st.da_dqdd, Ja[:, 12:], **TOL)
+
+
+def test_classical_acceleration_is_second_time_derivative(robot):
+    """a = d²p/dt² along q(t) = q0 + qd t + qdd t²/2 (checks a is *classical*, not spatial)."""
+    for q, qd, qdd in random_states(robot, 5):
+        path = lambda t: robot.position(q + qd * t + 0.5 * qdd * t * t)
+        h = 1e-4
+        a_fd = (path(h) - 2 * path(0.0) + path(-h)) / h**2
+        np.testing.assert_allclose(robot.state(q, qd, qdd).a, a_fd, atol=1e-5)
+
+
+@pytest.mark.parametrize("seed", [6, 7])
+def test_orientation_jacobians(robot, seed):
+    for q, _, _ in random_states(robot, seed):
+        _, R, _, Jw = robot.pose_jacobians(q)
+        o, do_dq = rpy_jacobian(R, Jw)
+        np.testing.assert_allclose(do_dq, central_fd(lambda x: rpy_jacobian(
+            robot.rotation(x), np.zeros((3, 6)))[0], q), **TOL)
+        for k in (0, 2):
+            _, da = axis_jacobian(R, Jw, k)
+            np.testing.assert_allclose(da, central_fd(lambda x: robot.rotation(x)[:, k], q), **TOL)
+
+
+@pytest.mark.parametrize("form", ["physical", "paper"])
+def test_cone_jacobians(robot, cell, form):
+    cone = make_cone(form, cell.burger.mu, cell.gravity)
+    for q, qd, qdd in random_states(robot, 8):
+        h, dq, dqd, dqdd = cone.jacobians(robot.state(q, qd, qdd))
+        f = lambda x: cone.values(robot.state(x[:6], x[6:12], x[12:]))
+        J = central_fd(f, np.concatenate([q, qd, qdd]))
+        np.testing.assert_allclose(np.hstack([dq, dqd, dqdd]), J, atol=1e-5, rtol=1e-6)
+
+
+@pytest.mark.parametrize("seed", [9, 10])
+def test_dynamics_residual_jacobians(robot, seed):
+    for q, qd, qdd in random_states(robot, seed):
+        tau, dq, dqd, dqdd, du = robot.dynamics_residual_jacobians(q, qd, qdd)
+        u = np.ones(6)
+        f = lambda x: robot.dynamics_residual(x[:6], x[6:12], x[12:18], x[18:])
+        J = central_fd(f, np.concatenate([q, qd, qdd, u]))
+        np.testing.assert_allclose(np.hstack([dq, dqd, dqdd, du]), J, atol=1e-5, rtol=1e-6)
+        np.testing.assert_allclose(tau, robot.inverse_dynamics(q, qd, qdd))
