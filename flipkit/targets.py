@@ -1,0 +1,68 @@
+"""Task-space targets of the subbehaviours (paper Sec. IV.C, eqs. 22–27), shared by the
+joint-space collocation and the end-effector-space baseline.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .config import CellConfig
+from .errors import UnreachableError
+
+SCOOP_PITCH = 0.314  # o_y* (rad), eq. (22)
+PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, eq. (25)
+PICKUP_PITCH = -0.05  # rad, eq. (25)
+FLIP_CONE_FRACTION = 0.6  # cone on nodes i <= 0.6 N, eq. (26)
+FLIP_NORMAL_BOUNDS = ((-0.5, -0.5, -1.0), (0.0, 0.5, -0.8))  # F_n(q_N), eq. (26)
+FLIP_XAXIS_BOUNDS = ((0.6, -1.0, -1.0), (1.0, 1.0, 1.0))  # R(q_i) x̂, eq. (26)
+FLIP_HEIGHT_BAND = (0.1, 0.4)  # h_g + band on p_z(q_N) (m), eq. (26)
+SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Spatula pose target: blade-centre position (m) and rpy o (rad)."""
+
+    p: tuple
+    o: tuple
+
+
+def check_location(cell: CellConfig, location) -> np.ndarray:
+    """The burger location as an array, or :class:`UnreachableError` if not on the grill."""
+    loc = np.asarray(location, dtype=float)
+    if loc.shape != (3,) or not np.all(np.isfinite(loc)):
+        raise UnreachableError(f"burger location must be three finite numbers (m), got {location!r}")
+    g = cell.grill
+    if not g.contains(loc[:2]):
+        raise UnreachableError(
+            f"burger location ({loc[0]:.3f}, {loc[1]:.3f}) is outside the grill area "
+            f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
+    if abs(loc[2] - g.height) > 0.01:
+        raise UnreachableError(
+            f"burger height {loc[2]:.3f} m is not on the grill surface (h_g = {g.height} m)")
+    return loc
+
+
+def scoop_ready(cell: CellConfig, pb) -> Pose:
+    """End of go-to-burger / start of scoop (eqs. 22–23): tip at the burger's near edge."""
+    d, l, oy = cell.burger.diameter, cell.spatula.length, SCOOP_PITCH
+    return Pose((pb[0] - d / 2 - l / 2 * math.cos(oy), pb[1], pb[2] + l / 2 * math.sin(oy)),
+                (0.0, oy, 0.0))
+
+
+def scoop_end(cell: CellConfig, pb) -> Pose:
+    """End of scoop (eq. 23): blade flat, centred under the burger."""
+    return Pose(tuple(float(x) for x in pb), (0.0, 0.0, 0.0))
+
+
+def pickup_end(cell: CellConfig, pb) -> Pose:
+    """End of pickup (eq. 25): 2 cm forward, 5 cm up, slightly tipped back."""
+    return Pose(tuple(float(pb[k] + PICKUP_OFFSET[k]) for k in range(3)), (0.0, PICKUP_PITCH, 0.0))
+
+
+def landing_spot(cell: CellConfig, pb) -> np.ndarray:
+    """Designated landing spot of the flipped burger (x, y) (m): where it was picked up."""
+    return np.asarray(pb[:2], dtype=float)
