@@ -19,7 +19,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="flipkit", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:
-        importlib.import_module(f"flipkit.commands.{name.replace('-', '_')}").register(sub)
+        module_name = f"flipkit.commands.{name.replace('-', '_')}"
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            # TEMPORARY until every sub-command exists: skip one whose module is not written
+            # yet; any other missing module is still an error.
+            if exc.name != module_name:
+                raise
+            continue
+        module.register(sub)
     return parser
 
 

@@ -1,0 +1,173 @@
+"""Constraint sets of the behaviours (paper Sec. IV.C): translate (9), go to burger (22),
+scoop (23–24), pickup (25), flip (26), turn back (27), each chained by (29).
+
+:func:`build_segment` turns a behaviour name, a start state and the task (locations) into an
+:class:`~flipkit.nlp.NLP`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import targets as tg
+from .collocation import Layout, bezier_guess
+from .config import CellConfig
+from .constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
+from .constraints.kinematic import Cone
+from .contact import make_cone
+from .errors import ConfigError, InvalidChoiceError
+from .ik import solve_pose
+from .nlp import NLP
+from .robot import Robot
+
+BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
+# Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md); the upper
+# bounds of the five subbehaviours add up to 2.9 s (< 3 s, paper Fig. 7).
+T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.5),
+            "pickup": (0.2, 0.4), "flip": (0.2, 0.5), "turn_back": (0.3, 0.7)}
+CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
+                  "flip": True, "turn_back": False}
+
+
+@dataclass(frozen=True)
+class SegmentOptions:
+    """Transcription options.
+
+    Attributes:
+        N: Intervals per segment (paper: 20, i.e. 21 nodes).
+        epsilon: Output convergence rate ε of eq. (18) (1/s).
+        cone: Friction-cone form, ``physical`` (eq. 5) or ``paper`` (eq. 20).
+    """
+
+    N: int = 20
+    epsilon: float = 10.0
+    cone: str = "physical"
+
+    def __post_init__(self):
+        if self.epsilon <= 0 or not np.isfinite(self.epsilon):
+            raise ConfigError(f"epsilon must be positive, got {self.epsilon!r}")
+        make_cone(self.cone, 0.5)  # validates the name
+
+
+class Models:
+    """The two dynamics models of a cell: bare spatula, and spatula carrying the burger."""
+
+    def __init__(self, cell: CellConfig):
+        self.cell = cell
+        self.bare = Robot(cell, with_burger=False)
+        self.loaded = Robot(cell, with_burger=True)
+
+    def for_segment(self, name: str) -> Robot:
+        return self.loaded if CARRIES_BURGER[name] else self.bare
+
+
+def _flip_guess_pose(cell: CellConfig, pb) -> tg.Pose:
+    """A pose inside the flip end set, used only to seed the initial guess."""
+    p = tg.pickup_end(cell, pb).p
+    return tg.Pose((p[0] + 0.02, p[1], cell.grill.height + 0.22), (-2.6, 0.0, 0.0))
+
+
+def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
+                  goal: tg.Pose | None = None, options: SegmentOptions = SegmentOptions()) -> NLP:
+    """The NLP of one behaviour segment.
+
+    Args:
+        name: One of :data:`BEHAVIORS`.
+        models: Robot models of the cell.
+        q_start, qd_start: Start state (rad, rad/s); q̇ defaults to rest.
+        location: Burger location p^b (m) for the subbehaviours of pickup-and-flip.
+        goal: End pose for ``translate``.
+        options: Transcription options.
+    """
+    if name not in BEHAVIORS:
+        raise InvalidChoiceError("behaviour", name, BEHAVIORS)
+    cell, robot = models.cell, models.for_segment(name)
+    L = Layout(robot.nq, options.N)
+    q_start = np.asarray(q_start, float)
+    qd_start = np.zeros(robot.nq) if qd_start is None else np.asarray(qd_start, float)
+    last, all_nodes = L.N, range(L.n_nodes)
+    ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
+    lim, hg = cell.limits, cell.grill.height
+    blocks = [
+        Dynamics(L, robot.u_max / 10), HermiteSimpson(L), BezierOutput(L, options.epsilon),
+        FixedValues("start_state", L, np.concatenate([L.iq(0), L.iqd(0)]),
+                    np.concatenate([q_start, qd_start])),
+        KinematicBlock("task_position", L, "position", all_nodes, lim.p_min, lim.p_max),
+        KinematicBlock("task_velocity", L, "velocity", all_nodes, -lim.v_max, lim.v_max),
+        KinematicBlock("task_acceleration", L, "acceleration", all_nodes, -lim.a_max, lim.a_max,
+                       scale=0.1),
+        KinematicBlock("grill_clearance", L, "blade_heights", all_nodes, hg, np.inf, ctx=ctx),
+    ]
+    cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity))
+    cone_nodes: list[int] = []
+    rest_at_end = name in ("translate", "go_to_burger", "turn_back")
+    pose = None
+    if name == "translate":
+        if goal is None:
+            raise ConfigError("translate needs a goal pose")
+        pose, cone_nodes = goal, list(all_nodes)
+    else:
+        if location is None:
+            raise ConfigError(f"{name} needs the burger location")
+        pb = tg.check_location(cell, location)
+        if name == "go_to_burger":
+            pose = tg.scoop_ready(cell, pb)
+        elif name == "scoop":
+            pose = tg.scoop_end(cell, pb)
+            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", all_nodes, hg, hg, ctx=ctx))
+        elif name == "pickup":
+            pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
+        elif name == "flip":
+            cone_nodes = [i for i in all_nodes if i <= tg.FLIP_CONE_FRACTION * L.N]
+            lo_n, hi_n = tg.FLIP_NORMAL_BOUNDS
+            lo_x, hi_x = tg.FLIP_XAXIS_BOUNDS
+            band = tg.FLIP_HEIGHT_BAND
+            blocks += [
+                KinematicBlock("flip_normal", L, "normal", [last], lo_n, hi_n),
+                KinematicBlock("flip_xaxis", L, "xaxis", all_nodes, lo_x, hi_x),
+                KinematicBlock("flip_height", L, "height", [last], hg + band[0], hg + band[1]),
+            ]
+    if pose is not None:
+        blocks.append(KinematicBlock("end_pose", L, "position", [last], pose.p, pose.p))
+        blocks.append(KinematicBlock("end_orientation", L, "rpy", [last], pose.o, pose.o))
+    if name == "turn_back":
+        blocks.append(FixedValues("end_state", L, np.concatenate([L.iq(last), L.iqd(last)]),
+                                  np.concatenate([robot.q_home, np.zeros(robot.nq)])))
+    elif rest_at_end:
+        blocks.append(FixedValues("end_rest", L, L.iqd(last), np.zeros(robot.nq)))
+    if cone_nodes:
+        blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
+
+    # Initial guess: Bezier path to an IK solution of the end pose, at T = T_max.
+    T_lo, T_hi = T_BOUNDS[name]
+    if name == "turn_back":
+        q_end = robot.q_home
+    else:
+        seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)
+        guess = q_start.copy()
+        if name == "flip":
+            guess[-1] -= 2.6  # roll the blade over about its own axis (wrist 3)
+        q_end = solve_pose(robot, seed_pose.p, seed_pose.o, guess)
+    x0 = bezier_guess(L, robot, q_start, q_end, T_hi, qd_start)
+
+    lb, ub, scale = (np.empty(L.n) for _ in range(3))
+    per_node = [(robot.q_min, robot.q_max, 1.0), (-robot.qd_max, robot.qd_max, 1.0),
+                (-robot.qdd_max, robot.qdd_max, 10.0), (-robot.u_max, robot.u_max, robot.u_max / 10)]
+    for i in all_nodes:
+        for f, (lo, hi, s) in zip((L.iq, L.iqd, L.iqdd, L.iu), per_node):
+            lb[f(i)], ub[f(i)], scale[f(i)] = lo, hi, s
+    for j in range(robot.nq):
+        ia = L.ialpha(j)
+        lb[ia], ub[ia], scale[ia] = robot.q_min[j] - 1.0, robot.q_max[j] + 1.0, 1.0
+    lb[L.T_index], ub[L.T_index], scale[L.T_index] = T_lo, T_hi, 1.0
+    return NLP(name, L, robot, blocks, lb, ub, scale, x0, cone_nodes)
+
+
+def flat_pose(position, yaw: float = 0.0) -> tg.Pose:
+    """Spatula flat and level at ``position`` (m) with heading ``yaw`` (rad)."""
+    return tg.Pose(tuple(float(v) for v in position), (0.0, 0.0, float(yaw)))
+
+
+__all__ = ["BEHAVIORS", "T_BOUNDS", "SegmentOptions", "Models", "build_segment", "flat_pose"]

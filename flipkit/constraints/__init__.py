@@ -1,0 +1,13 @@
+"""Constraint blocks of the collocation NLP, one family per module.
+
+Every block has a fixed sparsity pattern (``rows``, ``cols``) decided at construction, bounds
+``lo ≤ c ≤ hi`` (equal for equalities) and a row scale; :meth:`Block.evaluate` returns the
+values and the Jacobian entries in pattern order.
+"""
+
+from .base import Block, FixedValues
+from .dynamics import BezierOutput, Dynamics, HermiteSimpson
+from .kinematic import QUANTITIES, KinematicBlock
+
+__all__ = ["Block", "FixedValues", "Dynamics", "HermiteSimpson", "BezierOutput",
+           "KinematicBlock", "QUANTITIES"]

@@ -1,0 +1,95 @@
+"""The collocation NLP: layout, defects on known trajectories, whole-NLP Jacobian vs FD."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from flipkit import targets as tg
+from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.collocation import Evaluation, Layout
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.constraints import BezierOutput, HermiteSimpson
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.ik import solve_pose
+
+
+@pytest.fixture(scope="module")
+def models():
+    return Models(CellConfig())
+
+
+def test_layout_counts_547_variables():
+    L = Layout()
+    assert L.n == 547 and L.n_nodes == 21
+    idx = np.concatenate([f(i) for i in range(21) for f in (L.iq, L.iqd, L.iqdd, L.iu)]
+                         + [L.ialpha(j) for j in range(6)] + [[L.T_index]])
+    assert sorted(idx) == list(range(547))
+    with pytest.raises(ConfigError, match="even"):
+        Layout(N=7)
+
+
+def _poly_point(L, models, coeffs, T=0.8):
+    """Z whose q follows sum_k coeffs[k] t^k on every joint (q̇, q̈ exact)."""
+    t = L.s * T
+    q = sum(c * t**k for k, c in enumerate(coeffs))[:, None] * np.ones(6)
+    qd = sum(k * c * t ** (k - 1) for k, c in enumerate(coeffs) if k)[:, None] * np.ones(6)
+    qdd = sum(k * (k - 1) * c * t ** (k - 2) for k, c in enumerate(coeffs) if k > 1)[:, None] * np.ones(6)
+    return L.pack(q, qd, qdd, np.zeros((21, 6)), np.zeros((6, 7)), T)
+
+
+def test_hermite_simpson_exact_on_cubics_not_on_quartics(models):
+    L = Layout()
+    hs = HermiteSimpson(L)
+    cubic = _poly_point(L, models, [0.1, -0.3, 0.7, 0.5])
+    ev = Evaluation(L, models.bare, cubic)
+    assert np.abs(hs.evaluate(ev)[0]).max() < 1e-12
+    quartic = _poly_point(L, models, [0.1, -0.3, 0.7, 0.5, 2.0])
+    assert np.abs(hs.evaluate(Evaluation(L, models.bare, quartic))[0]).max() > 1e-6
+
+
+def test_bezier_output_zero_on_its_own_polynomial(models):
+    L = Layout()
+    alpha = np.random.default_rng(1).normal(size=(6, 7))
+    T = 0.7
+    t = L.s * T
+    q, qd, qdd = (L.bezier.evaluate(alpha, t, T, r) for r in range(3))
+    x = L.pack(q, qd, qdd, np.zeros((21, 6)), alpha, T)
+    vals, _ = BezierOutput(L, 10.0).evaluate(Evaluation(L, models.bare, x))
+    assert np.abs(vals).max() < 1e-9
+    x[L.iq(5)] += 0.01  # off the polynomial at one node: the output constraint sees it
+    assert np.abs(BezierOutput(L, 10.0).evaluate(Evaluation(L, models.bare, x))[0]).max() > 1e-3
+
+
+def _nlp_cases(models):
+    cell = models.cell
+    qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
+    yield build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    pb = TABLE1_LOCATIONS[5]
+    p = tg.pickup_end(cell, pb)
+    yield build_segment("flip", models, solve_pose(models.loaded, p.p, p.o), np.full(6, 0.1),
+                        location=pb)
+    r = tg.scoop_ready(cell, pb)
+    yield build_segment("scoop", models, solve_pose(models.bare, r.p, r.o), location=pb)
+
+
+def test_nlp_jacobian_matches_finite_differences(models):
+    rng = np.random.default_rng(2)
+    for nlp in _nlp_cases(models):
+        x = nlp.x0 + 0.01 * rng.normal(size=nlp.n)
+        _, jac = nlp.evaluate(x)
+        J = sp.coo_matrix((jac, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n)).toarray()
+        h, Jfd = 1e-6, np.zeros_like(J)
+        for k in range(nlp.n):
+            e = np.zeros(nlp.n)
+            e[k] = h
+            Jfd[:, k] = (nlp.constraints(x + e) - nlp.constraints(x - e)) / (2 * h)
+        np.testing.assert_allclose(J, Jfd, atol=2e-6 * max(1.0, np.abs(J).max()), err_msg=nlp.name)
+        # the pattern is the structure: entries off the pattern are zero
+        assert np.abs(Jfd[J == 0]).max() < 1e-6
+
+
+def test_segment_validation(models):
+    with pytest.raises(InvalidChoiceError, match="'translate'"):
+        build_segment("jump", models, models.bare.q_home)
+    with pytest.raises(ConfigError, match="burger location"):
+        build_segment("scoop", models, models.bare.q_home)

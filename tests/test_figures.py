@@ -1,0 +1,125 @@
+"""The figure pipeline: saving, the notebook runner, the ``flipkit figures`` command and the
+notebooks themselves (parameters cell, no outputs)."""
+
+import json
+import os
+
+import matplotlib.pyplot as plt
+import nbformat
+import pytest
+
+from flipkit import cli, figures
+from flipkit.errors import InvalidChoiceError
+
+NOTEBOOKS = sorted(figures.NOTEBOOKS_DIR.glob("*.ipynb"))
+
+
+def run_cli(argv, cwd):
+    """``flipkit <argv>`` with ``cwd`` as the current directory (build/ goes there)."""
+    here = os.getcwd()
+    os.chdir(cwd)
+    try:
+        return cli.main(argv)
+    finally:
+        os.chdir(here)
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    work = tmp_path_factory.mktemp("figures")
+    out = work / "figures"
+    code = run_cli(["figures", "--quick", "--only", "cell", "--out", str(out)], work)
+    return code, work, out
+
+
+@pytest.mark.slow
+def test_cell_figure_and_manifest(made):
+    code, work, out = made
+    assert code == 0
+    for name in ("cell.pdf", "cell.png"):
+        assert (out / name).stat().st_size > 1000
+    assert (out / "cell.pdf").read_bytes().startswith(b"%PDF")
+    assert (work / "build" / "notebooks" / "cell.ipynb").is_file()
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["flipkit"] and "git" in manifest
+    entry = manifest["figures"]["cell"]
+    assert entry["files"] == ["cell.pdf", "cell.png"]
+    assert entry["notebook"] == "notebooks/cell.ipynb"
+    assert entry["parameters"]["quick"] is True
+    assert len(entry["caption"]) > 40
+    assert entry["numbers"]["n_locations"] == 10
+    assert entry["numbers"]["spatula_home_clearance_m"] > 0.05  # spatula above the grill
+
+
+@pytest.mark.slow
+def test_second_run_is_reproducible(made):
+    _, work, out = made
+    first = json.loads((out / "manifest.json").read_text())
+    pdf = (out / "cell.pdf").read_bytes()
+    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out)], work) == 0
+    second = json.loads((out / "manifest.json").read_text())
+    assert second == first
+    assert (out / "cell.pdf").read_bytes() == pdf  # no dates: byte-identical PDF
+
+
+def test_unknown_id_is_a_one_line_error(capsys):
+    assert cli.main(["figures", "--only", "cell", "nope"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "'nope'" in err
+    assert all(repr(fig_id) in err for fig_id in figures.FIGURE_IDS)
+
+
+def test_missing_notebook_is_skipped_and_reported(tmp_path, monkeypatch):
+    monkeypatch.setitem(figures.FIGURES, "forces", "not_written_yet.ipynb")
+    report = figures.run_notebooks(only=["forces"], out_dir=tmp_path / "f",
+                                   build_dir=tmp_path / "b")
+    assert report.made == [] and report.missing == ["forces"]
+    assert json.loads(report.manifest.read_text())["figures"] == {}
+
+
+def test_save_is_deterministic_and_writes_a_sidecar(tmp_path):
+    with figures.style():
+        fig, ax = plt.subplots(figsize=(figures.COLUMN_WIDTH, 2.0))
+        ax.plot([0, 1, 2], [0, 1, 4])
+        for sub in ("a", "b"):
+            figures.save(fig, "forces", "Caption  with\n spaces.", {"x": float("nan"), "n": 3},
+                         out_dir=tmp_path / sub)
+        plt.close(fig)
+    assert (tmp_path / "a/forces.pdf").read_bytes() == (tmp_path / "b/forces.pdf").read_bytes()
+    assert (tmp_path / "a/forces.png").read_bytes() == (tmp_path / "b/forces.png").read_bytes()
+    sidecar = json.loads((tmp_path / "a/forces.json").read_text())
+    assert sidecar == {"files": ["forces.pdf", "forces.png"], "caption": "Caption with spaces.",
+                       "numbers": {"x": None, "n": 3}}
+    with pytest.raises(InvalidChoiceError):
+        figures.save(fig, "nope", "c", {}, out_dir=tmp_path)
+
+
+@pytest.mark.slow
+def test_failing_notebook_names_notebook_and_error(tmp_path):
+    notebook = tmp_path / "broken.ipynb"
+    nbformat.write(nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell("quick = False", metadata={"tags": ["parameters"]}),
+        nbformat.v4.new_code_cell("raise ValueError('burnt\\nbadly')")]), notebook)
+    with pytest.raises(figures.NotebookError) as info:
+        figures._execute(notebook, tmp_path / "executed.ipynb", {"quick": True},
+                         figures.kernel_name())
+    message = str(info.value)
+    assert "\n" not in message
+    assert "broken.ipynb" in message and "ValueError: burnt badly" in message
+
+
+def test_every_figure_id_has_a_notebook_name():
+    assert len(figures.FIGURE_IDS) == 10 and figures.FIGURE_IDS[0] == "cell"
+    assert {path.name for path in NOTEBOOKS} <= set(figures.FIGURES.values())
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
+def test_notebook_has_parameters_cell_and_no_outputs(path):
+    nb = nbformat.read(path, as_version=4)
+    tagged = [c for c in nb.cells if "parameters" in c.metadata.get("tags", [])]
+    assert len(tagged) == 1 and tagged[0].cell_type == "code"
+    for name in ("quick", "out_dir", "scheduler"):
+        assert f"{name} =" in tagged[0].source
+    for c in nb.cells:
+        if c.cell_type == "code":
+            assert c.outputs == [] and c.execution_count is None
