@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import targets as tg
-from .collocation import Layout, bezier_guess
+from .collocation import Layout, bezier_guess, fit_guess
 from .config import CellConfig
 from .constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
 from .constraints.kinematic import Cone
@@ -20,13 +20,15 @@ from .contact import make_cone
 from .errors import ConfigError, InvalidChoiceError
 from .ik import solve_pose
 from .nlp import NLP
+from .orientation import rpy
 from .robot import Robot
 
 BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
 # Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md); the upper
-# bounds of the five subbehaviours add up to 2.9 s (< 3 s, paper Fig. 7).
-T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.5),
-            "pickup": (0.2, 0.4), "flip": (0.2, 0.5), "turn_back": (0.3, 0.7)}
+# bounds of the five subbehaviours add up to 2.95 s (< 3 s, paper Fig. 7). Turn back needs
+# the most: the wrist unrolls ~2.6 rad at ≤ 3.2 rad/s.
+T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.55), "scoop": (0.2, 0.5),
+            "pickup": (0.2, 0.4), "flip": (0.2, 0.5), "turn_back": (0.4, 1.0)}
 CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
                   "flip": True, "turn_back": False}
 
@@ -69,6 +71,38 @@ def _flip_guess_pose(cell: CellConfig, pb) -> tg.Pose:
     return tg.Pose((p[0] + 0.02, p[1], cell.grill.height + 0.22), (-2.6, 0.0, 0.0))
 
 
+def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at_end):
+    """Initial guess at T = T_max.
+
+    Where the segment has a task-space path (go to burger, scoop, pickup) the spatula pose
+    is interpolated from start to end (smoothstep in time, the tip kept on the grill for
+    the scoop), solved by IK node by node and fitted by the Bezier polynomial; otherwise a
+    joint-space Bezier path to an IK solution of the end pose (flip: a pose in its end set;
+    turn back: q_home).
+    """
+    if name == "turn_back":
+        return bezier_guess(L, robot, q_start, robot.q_home, T, qd_start)
+    if name in ("go_to_burger", "scoop", "pickup"):
+        p0, R0 = robot.position(q_start), robot.rotation(q_start)
+        o0, o1 = rpy(R0), np.asarray(pose.o)
+        waypoints, q = [], q_start
+        for s in L.s:
+            w = s * s * (3 - 2 * s)
+            o = (1 - w) * o0 + w * o1
+            p = (1 - w) * p0 + w * np.asarray(pose.p)
+            if name == "scoop":  # keep the tip on the grill: p_z = h_g + (l/2) sin o_y
+                p[2] = cell.grill.height + cell.spatula.length / 2 * np.sin(o[1])
+            q = solve_pose(robot, p, o, q)
+            waypoints.append(q)
+        return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end)
+    seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)
+    guess = q_start.copy()
+    if name == "flip":
+        guess[-1] -= 2.6  # roll the blade over about its own axis (wrist 3)
+    q_end = solve_pose(robot, seed_pose.p, seed_pose.o, guess)
+    return bezier_guess(L, robot, q_start, q_end, T, qd_start)
+
+
 def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
                   goal: tg.Pose | None = None, options: SegmentOptions = SegmentOptions()) -> NLP:
     """The NLP of one behaviour segment.
@@ -88,18 +122,25 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     q_start = np.asarray(q_start, float)
     qd_start = np.zeros(robot.nq) if qd_start is None else np.asarray(qd_start, float)
     last, all_nodes = L.N, range(L.n_nodes)
+    # q_0 and q̇_0 are fixed by the start state, so constraints on them alone at node 0
+    # would only repeat it (and break constraint qualification); they start at node 1.
+    moving = range(1, L.n_nodes)
     ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
     lim, hg = cell.limits, cell.grill.height
     blocks = [
         Dynamics(L, robot.u_max / 10), HermiteSimpson(L), BezierOutput(L, options.epsilon),
         FixedValues("start_state", L, np.concatenate([L.iq(0), L.iqd(0)]),
                     np.concatenate([q_start, qd_start])),
-        KinematicBlock("task_position", L, "position", all_nodes, lim.p_min, lim.p_max),
-        KinematicBlock("task_velocity", L, "velocity", all_nodes, -lim.v_max, lim.v_max),
+        KinematicBlock("task_position", L, "position", moving, lim.p_min, lim.p_max),
+        KinematicBlock("task_velocity", L, "velocity", moving, -lim.v_max, lim.v_max),
         KinematicBlock("task_acceleration", L, "acceleration", all_nodes, -lim.a_max, lim.a_max,
                        scale=0.1),
-        KinematicBlock("grill_clearance", L, "blade_heights", all_nodes, hg, np.inf, ctx=ctx),
     ]
+    # Blade above the grill; on the scoop the tip equality (and at its end the flat pose)
+    # already holds the blade on the grill, so the clearance rows stop before the end.
+    clear_nodes = range(1, L.N) if name == "scoop" else moving
+    blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", clear_nodes, hg, np.inf,
+                                 ctx=ctx))
     cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity))
     cone_nodes: list[int] = []
     rest_at_end = name in ("translate", "go_to_burger", "turn_back")
@@ -116,7 +157,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             pose = tg.scoop_ready(cell, pb)
         elif name == "scoop":
             pose = tg.scoop_end(cell, pb)
-            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", all_nodes, hg, hg, ctx=ctx))
+            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", moving, hg, hg, ctx=ctx))
         elif name == "pickup":
             pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
         elif name == "flip":
@@ -126,7 +167,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             band = tg.FLIP_HEIGHT_BAND
             blocks += [
                 KinematicBlock("flip_normal", L, "normal", [last], lo_n, hi_n),
-                KinematicBlock("flip_xaxis", L, "xaxis", all_nodes, lo_x, hi_x),
+                KinematicBlock("flip_xaxis", L, "xaxis", moving, lo_x, hi_x),
                 KinematicBlock("flip_height", L, "height", [last], hg + band[0], hg + band[1]),
             ]
     if pose is not None:
@@ -140,17 +181,9 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     if cone_nodes:
         blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
 
-    # Initial guess: Bezier path to an IK solution of the end pose, at T = T_max.
     T_lo, T_hi = T_BOUNDS[name]
-    if name == "turn_back":
-        q_end = robot.q_home
-    else:
-        seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)
-        guess = q_start.copy()
-        if name == "flip":
-            guess[-1] -= 2.6  # roll the blade over about its own axis (wrist 3)
-        q_end = solve_pose(robot, seed_pose.p, seed_pose.o, guess)
-    x0 = bezier_guess(L, robot, q_start, q_end, T_hi, qd_start)
+    x0 = _initial_guess(name, L, robot, q_start, qd_start, T_hi, pose,
+                        None if name == "translate" else pb, cell, rest_at_end)
 
     lb, ub, scale = (np.empty(L.n) for _ in range(3))
     per_node = [(robot.q_min, robot.q_max, 1.0), (-robot.qd_max, robot.qd_max, 1.0),

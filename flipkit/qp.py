@@ -31,7 +31,7 @@ from .nlp import NLP
 
 # Deterministic OSQP: a fixed adaptive-rho interval (interval 0 would time the setup and
 # adapt rho after a fraction of it, which varies run to run; OSQP 1.x rejects fraction 0).
-OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
+OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=4000, adaptive_rho_interval=25,
                      polishing=True, polish_refine_iter=5,
                      check_termination=25, verbose=False)
 
@@ -76,6 +76,19 @@ class QPSubproblem:
         self.rho = cp.Parameter(nonneg=True, name="penalty")
         self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
         self.hess_sqrt = cp.Parameter(n, nonneg=True, name="hessian_sqrt")
+        # Curvature of the Lagrangian on per-node blocks: ½‖F d‖², F stacked factors
+        # F_i (b x b, on the block's variables) with H_i = F_iᵀF_i ⪰ 0, as a parameter on
+        # a fixed pattern (the same selection trick as the Jacobian).
+        self.blocks = [np.asarray(b, int) for b in nlp.curvature_blocks]
+        f_rows = np.concatenate([np.repeat(np.arange(len(b)) + sum(map(len, self.blocks[:k])), len(b))
+                                 for k, b in enumerate(self.blocks)]) if self.blocks else np.zeros(0, int)
+        f_cols = np.concatenate([np.tile(b, len(b)) for b in self.blocks]) if self.blocks else np.zeros(0, int)
+        nf = len(f_cols)
+        self.factor = cp.Parameter(nf, name="curvature_factor")
+        F_c = sp.csr_matrix((np.ones(nf), (np.arange(nf), f_cols)), shape=(nf, n))
+        F_r = sp.csr_matrix((np.ones(nf), (f_rows, np.arange(nf))),
+                            shape=(int(f_rows.max(initial=-1)) + 1, nf))
+        Fd = F_r @ cp.multiply(self.factor, F_c @ self.d)
         Jd = cp.multiply(self.jac, S_c @ self.d)
         cons = [self.d >= self.d_lo, self.d <= self.d_hi]
         slacks = []
@@ -97,6 +110,8 @@ class QPSubproblem:
         if len(self.hi_rows):
             cons.append(self.r_hi - S_r[self.hi_rows] @ Jd + slack(len(self.hi_rows), "s_hi") >= 0)
         obj = self.grad @ self.d + 0.5 * cp.sum_squares(cp.multiply(self.hess_sqrt, self.d))
+        if nf:
+            obj = obj + 0.5 * cp.sum_squares(Fd)
         if elastic:
             obj = obj + self.rho * sum(cp.sum(s) for s in slacks) \
                 + 0.5 * self.slack_reg * sum(cp.sum_squares(s) for s in slacks)
@@ -106,8 +121,21 @@ class QPSubproblem:
             raise RuntimeError("the SQP subproblem must be DPP")
 
     def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
-               d_lo: np.ndarray, d_hi: np.ndarray, rho: float, slack_reg: float = 1e-2) -> None:
-        """Set the parameter values for a linearisation (all in scaled units)."""
+               d_lo: np.ndarray, d_hi: np.ndarray, rho: float, slack_reg: float = 1e-2,
+               curvature: list[np.ndarray] | None = None) -> None:
+        """Set the parameter values for a linearisation (all in scaled units).
+
+        ``curvature``: per block of ``nlp.curvature_blocks`` a PSD matrix (scaled units);
+        None means zero.
+        """
+        if curvature is None:
+            self.factor.value = np.zeros(self.factor.shape)
+        else:
+            parts = []
+            for H in curvature:
+                w, V = np.linalg.eigh(0.5 * (H + H.T))
+                parts.append((np.sqrt(np.maximum(w, 0.0))[:, None] * V.T).ravel())
+            self.factor.value = np.concatenate(parts)
         self.jac.value = jac
         self.r_eq.value = (c - nlp.c_scale * nlp.c_lo)[self.eq_rows]
         self.r_lo.value = (c - nlp.c_scale * nlp.c_lo)[self.lo_rows]

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .errors import NoSolutionFound
 from .nlp import NLP
@@ -44,7 +45,7 @@ class SQPOptions:
     """
 
     tol: float = 1e-6
-    ftol: float = 1e-6
+    ftol: float = 1e-7
     rho0: float = 10.0
     step_cap: float = 1.0
     prox0: float = 1e-3
@@ -54,6 +55,8 @@ class SQPOptions:
     armijo: float = 1e-4
     min_step: float = 1e-2
     max_iter: int = 300
+    accept_ratio: float = 0.1
+    curvature: bool = True
 
 
 @dataclass
@@ -73,6 +76,23 @@ class SolveResult:
     @property
     def success(self) -> bool:
         return self.status == "solved"
+
+
+def _min_norm_correction(J: sp.csr_matrix, c: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Δ = −J_Eᵀ (J_E J_Eᵀ)⁻¹ c_E: the least-norm step zeroing the linearised equalities."""
+    JE = J[rows]
+    try:
+        y = spla.spsolve((JE @ JE.T).tocsc(), c[rows])
+    except RuntimeError:  # singular: skip the correction
+        return np.zeros(J.shape[1])
+    delta = -(JE.T @ y)
+    return np.where(np.isfinite(delta), delta, 0.0)
+
+
+def _psd_quad(H: np.ndarray, d: np.ndarray) -> float:
+    """dᵀ H₊ d with H₊ the PSD part of H (what the subproblem uses)."""
+    w, V = np.linalg.eigh(0.5 * (H + H.T))
+    return float(np.maximum(w, 0.0) @ (V.T @ d) ** 2)
 
 
 def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_failure=True
@@ -97,6 +117,9 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
 
     c, jac, f, v = point(x)
     rho, mu = options.rho0, options.prox0
+    lam = np.zeros(nlp.m)  # multipliers, raw row units
+    eq_rows = np.flatnonzero(nlp.c_lo == nlp.c_hi)
+    curvature = None
     log, qp_iters, status, it = [], 0, "max_iter", 0
     while it < options.max_iter:
         it += 1
@@ -107,32 +130,55 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         for elastic in (False, True):
             qp = subproblem_for(nlp, elastic)
             qp.update(nlp, nlp.c_scale * c, jac * Jscale, grad, hess + mu, d_lo, d_hi, rho,
-                      options.slack_reg)
+                      options.slack_reg, curvature)
             sol = qp.solve()
             qp_iters += sol.iterations
             if sol.status == "optimal":
                 break
-        if sol.eq_duals is not None:
+        if sol.eq_duals is not None and sol.status == "optimal":
             rho = max(rho, 2.0 * float(np.abs(sol.eq_duals).max(initial=0.0)))
+            lam_new = np.zeros(nlp.m)  # cvxpy: L = f + yᵀ(expr) for `expr == 0`
+            lam_new[eq_rows] = sol.eq_duals * nlp.c_scale[eq_rows] / nlp.obj_scale
+        else:
+            lam_new = lam
         d = sol.d
         c_lin = nlp.c_scale * c + J_of(jac) @ d
         lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin, c_lin - nlp.c_scale * nlp.c_hi), 0)
         merit = f + rho * v.sum()
-        pred = merit - (f + grad @ d + 0.5 * d @ (hess * d) + rho * lin_v.sum())
+        curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
+        pred = merit - (f + grad @ d + 0.5 * d @ (hess * d) + 0.5 * curv + rho * lin_v.sum())
         step, accepted, ratio = 1.0, False, 0.0
         if v.max(initial=0.0) <= options.tol and pred <= options.ftol * max(1.0, abs(f)):
             status = "solved"
         elif pred > 0:
-            while step >= options.min_step:
+            # Second-order correction (Maratos effect): pull the full step back onto the
+            # equality constraints by a minimum-norm Newton step, J_E Δ = −c_E(Z + d).
+            x_full = np.clip(x + D * d, nlp.x_lb, nlp.x_ub)
+            c_full, jac_full, f_full, v_full = point(x_full)
+            ratio = (merit - (f_full + rho * v_full.sum())) / pred
+            if ratio < options.accept_ratio:
+                delta = _min_norm_correction(J_of(jac), nlp.c_scale * (c_full - nlp.c_lo), eq_rows)
+                x_soc = np.clip(x + D * (d + delta), nlp.x_lb, nlp.x_ub)
+                c_s, jac_s, f_s, v_s = point(x_soc)
+                ratio_soc = (merit - (f_s + rho * v_s.sum())) / pred
+                if ratio_soc >= options.accept_ratio:
+                    x, c, jac, f, v, accepted = x_soc, c_s, jac_s, f_s, v_s, True
+                    ratio = ratio_soc
+            else:
+                x, c, jac, f, v, accepted = x_full, c_full, jac_full, f_full, v_full, True
+            step = 1.0 if accepted else 0.25
+            while not accepted and step >= options.min_step:
                 x_new = np.clip(x + step * D * d, nlp.x_lb, nlp.x_ub)
                 c_n, jac_n, f_n, v_n = point(x_new)
                 actual = merit - (f_n + rho * v_n.sum())
-                if step == 1.0:
-                    ratio = actual / pred
                 if actual >= options.armijo * step * pred:
                     x, c, jac, f, v, accepted = x_new, c_n, jac_n, f_n, v_n, True
                     break
                 step *= 0.25
+        if accepted and options.curvature:
+            lam = lam_new
+            curvature = [nlp.obj_scale * np.outer(D[b], D[b]) * H
+                         for b, H in zip(nlp.curvature_blocks, nlp.lagrangian_curvature(x, lam))]
         # Levenberg–Marquardt update from the full step's agreement with the model.
         if status != "solved":
             if ratio < 0.1:

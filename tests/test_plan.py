@@ -1,0 +1,209 @@
+"""The plan file: synthetic plans, JSON round trip, validation on load, cell rebuild.
+
+The synthetic plans here (also used by test_verify and test_export) need no optimiser: each
+joint follows a rest-to-rest cubic in time, which Hermite–Simpson collocation represents
+exactly, and u = RNEA(q, q̇, q̈) with the segment's payload.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from flipkit import targets as tg
+from flipkit.behaviors import CARRIES_BURGER, T_BOUNDS, Models, build_segment, flat_pose
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, PlanFileError
+from flipkit.ik import solve_pose
+from flipkit.orientation import rpy
+from flipkit.plan import FORMAT, Plan, Segment, SolverInfo
+from flipkit.sqp import SolveResult
+
+LOCATION = (0.68, -0.31, 0.072)  # Table I, location 5
+BASE_TURN = np.array([0.3, 0, 0, 0, 0, 0])  # rad: a pure base rotation keeps the blade flat
+
+
+def cubic_segment(name, q0, q1, T, robot, N=20, goal=True):
+    """Rest-to-rest cubic q(t) = q0 + (q1 − q0)(3s² − 2s³), s = t/T, with u = RNEA."""
+    t = np.linspace(0.0, T, N + 1)
+    s, d = t / T, np.asarray(q1, float) - np.asarray(q0, float)
+    q = np.asarray(q0, float) + np.outer(3 * s**2 - 2 * s**3, d)
+    qd, qdd = np.outer(6 * s - 6 * s**2, d) / T, np.outer(6 - 12 * s, d) / T**2
+    u = np.array([robot.inverse_dynamics(*z) for z in zip(q, qd, qdd)])
+    pose = None
+    if name == "translate" and goal:
+        M = robot.placement(q[-1])
+        pose = tg.Pose(tuple(M.translation), tuple(rpy(M.rotation)))
+    cone = list(range(N + 1)) if name in ("translate", "pickup") else []
+    return Segment(name, T, t, q, qd, qdd, u, np.tile(q[:1].T, (1, 7)), cone,
+                   SolverInfo("synthetic", "solved", 0, 0.0, float((u**2).sum()), 0.0), pose)
+
+
+@pytest.fixture(scope="session")
+def models():
+    return Models(CellConfig())
+
+
+def translate_plan(models, turns=(BASE_TURN, -BASE_TURN), durations=(1.0, 0.8)):
+    """Translate plan: base rotations from q_home, chained, blade flat and level throughout."""
+    q, segments = models.bare.q_home, []
+    for dq, T in zip(turns, durations):
+        segments.append(cubic_segment("translate", q, q + dq, T, models.loaded))
+        q = q + dq
+    return Plan.from_segments("translate", models.cell, segments)
+
+
+def chain_plan(models, approach=False):
+    """A flip plan without the flip: scoop (held still: blade flat on the grill under the
+    burger), pickup, turn back home — or, with ``approach``, only go to burger from home.
+    End configurations by tight IK; each segment lasts its behaviour's longest duration."""
+    cell, r = models.cell, models.bare
+    ready, scoop, pick = (f(cell, LOCATION) for f in (tg.scoop_ready, tg.scoop_end, tg.pickup_end))
+    if approach:
+        q_ready = solve_pose(r, ready.p, ready.o, r.q_home, tol=1e-22)
+        segments = [cubic_segment("go_to_burger", r.q_home, q_ready, T_BOUNDS["go_to_burger"][1],
+                                  models.bare)]
+    else:
+        q_scoop = solve_pose(r, scoop.p, scoop.o, r.q_home, tol=1e-22)
+        q_pick = solve_pose(r, pick.p, pick.o, q_scoop, tol=1e-22)
+        legs = (("scoop", q_scoop, q_scoop), ("pickup", q_scoop, q_pick),
+                ("turn_back", q_pick, r.q_home))
+        segments = [cubic_segment(name, qa, qb, T_BOUNDS[name][1], models.for_segment(name))
+                    for name, qa, qb in legs]
+    return Plan.from_segments("flip", cell, segments, location=LOCATION)
+
+
+@pytest.fixture
+def plan_file(models, tmp_path):
+    return translate_plan(models).to_json(tmp_path / "plan.json")
+
+
+def test_round_trip_is_exact_and_keys_follow_the_format(models, tmp_path):
+    plan = translate_plan(models)
+    path = plan.to_json(tmp_path / "p.json")
+    doc = json.loads(path.read_text())
+    assert list(doc) == ["format", "behavior", "status", "created_by", "robot", "gravity",
+                         "grill_height", "spatula", "burger", "cone", "segments"]
+    assert doc["format"] == FORMAT and doc["status"] == "solved"
+    assert list(doc["robot"]) == ["urdf", "base_in_world", "tool_parent_frame",
+                                  "spatula_in_parent", "payload", "q_home"]
+    seg = doc["segments"][0]
+    assert list(seg) == ["name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes",
+                         "solver", "goal"]
+    assert np.array(seg["q"]).shape == (21, 6) and np.array(seg["alpha"]).shape == (6, 7)
+    assert set(doc["created_by"]) == {"flipkit", "git"}
+    back = Plan.load(path)
+    for a, b in zip(plan.segments, back.segments):
+        for key in ("t", "q", "qd", "qdd", "u", "alpha"):
+            np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+        assert a.goal == b.goal and a.cone_nodes == b.cone_nodes and a.solver == b.solver
+    assert back.to_json(tmp_path / "again.json").read_text() == path.read_text()
+
+
+def test_cell_is_rebuilt_from_the_file(models, plan_file):
+    cell, ref = Plan.load(plan_file).cell(), models.cell
+    assert cell.spatula.thickness == pytest.approx(ref.spatula.thickness, rel=1e-9)
+    assert (cell.spatula.length, cell.spatula.width, cell.spatula.handle, cell.spatula.mass) == (
+        ref.spatula.length, ref.spatula.width, ref.spatula.handle, ref.spatula.mass)
+    assert cell.burger == ref.burger and cell.grill.height == ref.grill.height
+    assert cell.robot.urdf_path == ref.robot.urdf_path and cell.gravity == ref.gravity
+    robot = Plan.load(plan_file).robot_for("pickup", cell)
+    assert len(robot.payload) == 2 and CARRIES_BURGER["pickup"]
+
+
+def test_payload_that_does_not_match_the_cell_is_rejected(models):
+    plan = translate_plan(models)
+    plan.robot["payload"][1]["mass"] = 0.2
+    with pytest.raises(PlanFileError, match=r"robot.payload\[1\]"):
+        plan.robot_for("translate")
+
+
+def test_segment_from_a_collocation_solution(models):
+    goal = flat_pose((0.70, -0.10, 0.25))
+    nlp = build_segment("translate", models, models.bare.q_home, goal=goal)
+    result = SolveResult(x=nlp.x0, status="max_iter", iterations=3, wall_time_s=0.5,
+                         objective=nlp.objective(nlp.x0), max_violation=0.1)
+    seg = Segment.from_solution(nlp, result)
+    L = nlp.layout
+    assert seg.q.shape == seg.u.shape == (21, 6) and seg.alpha.shape == (6, 7)
+    assert seg.T == nlp.x0[L.T_index] and seg.t[-1] == pytest.approx(seg.T)
+    np.testing.assert_array_equal(seg.qdd, L.nodes(nlp.x0)[:, 2])
+    assert seg.cone_nodes == list(range(21)) and seg.goal == goal
+    assert seg.solver.status == "max_iter" and seg.solver.name == "sqp"
+    assert Plan.from_segments("translate", models.cell, [seg]).status == "failed"
+
+
+def test_constructors_validate(models):
+    seg = translate_plan(models).segments[0]
+    base = dict(vars(seg), cone_nodes=[], goal=None)
+    with pytest.raises(ConfigError, match="T: expected a positive"):
+        Segment(**{**base, "T": -1.0})
+    with pytest.raises(ConfigError, match=r"qd: expected shape \(21, 6\), got \(21, 5\)"):
+        Segment(**{**base, "qd": seg.qd[:, :5]})
+    with pytest.raises(ConfigError, match="u: expected an array of numbers"):
+        Segment(**{**base, "u": [["1"] * 6] * 21})
+    with pytest.raises(ConfigError, match="goal: only translate"):
+        Segment(**{**base, "name": "scoop", "goal": seg.goal})
+    with pytest.raises(ConfigError, match="cone_nodes"):
+        Segment(**{**base, "name": "pickup", "cone_nodes": [21]})
+    with pytest.raises(ConfigError, match="iterations"):
+        SolverInfo("sqp", "solved", 2.5, 0.1, 1.0, 0.0)
+
+
+def _edit(doc, path, value):
+    *head, last = path
+    for key in head:
+        doc = doc[key]
+    if value is KeyError:
+        del doc[last]
+    else:
+        doc[last] = value
+
+
+@pytest.mark.parametrize("path, value, message", [
+    (("format",), "flipkit-plan/2", "format: expected 'flipkit-plan/1'"),
+    (("status",), "done", "status: 'done' is not one of"),
+    (("cone",), "round", "cone: 'round' is not one of"),
+    (("segments", 0, "qdd"), KeyError, r"segments\[0\].qdd: missing key"),
+    (("robot", "q_home"), KeyError, "robot.q_home: missing key"),
+    (("segments", 1, "u", 3, 2), float("nan"), r"segments\[1\].u: contains a non-finite"),
+    (("segments", 0, "q"), [[0.0] * 6] * 20,
+     r"segments\[0\].q: expected shape \(21, n\), got \(20, 6\)"),
+    (("segments", 0, "alpha"), [[0.0] * 7] * 5, r"segments\[0\].alpha: expected shape \(6, n\)"),
+    (("segments", 1, "name"), "juggle", r"segments\[1\].name: 'juggle' is not one of"),
+    (("segments", 0, "solver", "iterations"), -2, r"segments\[0\].solver.iterations"),
+    (("segments", 0, "t"), "fast", r"segments\[0\].t: expected an array"),
+    (("robot", "base_in_world"), [[1, 0, 0]], r"robot.base_in_world: expected shape \(4, 4\)"),
+    (("burger", "mu"), 0.0, "burger.mu: expected a positive"),
+    (("behavior",), "flip", "do not fit behavior 'flip'"),
+    (("segments",), [], "segments: expected a non-empty list"),
+])
+def test_malformed_files_raise_one_line_plan_file_errors(plan_file, path, value, message):
+    doc = json.loads(plan_file.read_text())
+    _edit(doc, path, value)
+    plan_file.write_text(json.dumps(doc))
+    with pytest.raises(PlanFileError, match=message) as err:
+        Plan.load(plan_file)
+    assert "\n" not in str(err.value) and str(plan_file) in str(err.value)
+
+
+@pytest.mark.parametrize("text, message", [
+    (None, "cannot read plan file"), ("{not json", "not a JSON file"),
+    ("[1, 2]", "top level: expected a JSON object"), ('{"format": 1}', "format: expected"),
+])
+def test_unreadable_files(tmp_path, text, message):
+    path = tmp_path / "plan.json"
+    if text is not None:
+        path.write_text(text)
+    with pytest.raises(PlanFileError, match=message) as err:
+        Plan.load(path)
+    assert "\n" not in str(err.value)
+
+
+def test_flip_segments_must_come_in_order(models, tmp_path):
+    plan = chain_plan(models)
+    doc = json.loads(plan.to_json(tmp_path / "p.json").read_text())
+    doc["segments"].reverse()
+    (tmp_path / "p.json").write_text(json.dumps(doc))
+    with pytest.raises(PlanFileError, match="in this order"):
+        Plan.load(tmp_path / "p.json")

@@ -1,0 +1,182 @@
+"""Independent plan check: consistent synthetic plans pass; each corruption fails its group."""
+
+import json
+
+import numpy as np
+import pytest
+from test_plan import models  # noqa: F401  (fixture)
+from test_plan import chain_plan, cubic_segment, translate_plan
+
+from flipkit import targets as tg
+from flipkit.behaviors import T_BOUNDS
+from flipkit.cli import main
+from flipkit.errors import ConfigError, VerificationError
+from flipkit.plan import Plan
+from flipkit.verify import GROUPS, verify_plan
+
+
+@pytest.fixture(scope="module")
+def chain(models):
+    return chain_plan(models)
+
+
+def _fails(plan, group):
+    """The report of ``plan``; asserts that ``group`` fails."""
+    report = verify_plan(plan)
+    assert not report.ok and not report.groups[group].ok, report.table()
+    return report
+
+
+def _redo_u(seg, robot, i):
+    seg.u[i] = robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
+
+
+@pytest.mark.parametrize("which", ["translate", "chain", "approach"])
+def test_consistent_plans_pass(models, chain, which):
+    plan = {"translate": lambda: translate_plan(models), "chain": lambda: chain,
+            "approach": lambda: chain_plan(models, approach=True)}[which]()
+    report = verify_plan(plan)
+    assert report.ok, report.table()
+    assert set(report.groups) == set(GROUPS)
+    group, segment, amount = report.worst()
+    assert amount <= report.groups[group].tolerance
+    report.raise_if_failed()  # no exception
+
+
+def test_torque_corrupted_at_one_node_fails_dynamics(models):
+    plan = translate_plan(models)
+    plan.segments[1].u[7, 2] += 0.01  # N·m
+    report = _fails(plan, "dynamics")
+    assert report.worst() == ("dynamics", 1, pytest.approx(0.01))
+    assert report.groups["dynamics"].node == 7
+    with pytest.raises(VerificationError, match="'dynamics' in segment 1"):
+        report.raise_if_failed()
+
+
+def test_midpoint_position_off_the_interpolant_fails_defects_only(models):
+    plan = translate_plan(models)
+    seg = plan.segments[0]
+    seg.q[5, 0] += 1e-3  # rad, base joint: the blade stays flat, u recomputed
+    _redo_u(seg, models.loaded, 5)
+    report = _fails(plan, "defects")
+    assert report.worst()[:2] == ("defects", 0)
+    assert report.groups["defects"].violation == pytest.approx(1e-3)
+    assert report.groups["dynamics"].ok and report.groups["cone"].ok
+
+
+def test_joint_position_limit(models):
+    plan = translate_plan(models, turns=(np.array([-2.2, 0, 0, 0, 0, 0]),), durations=(2.0,))
+    report = _fails(plan, "q_limits")  # q_home[0] - 2.2 < -pi
+    assert report.worst()[0] == "q_limits"
+    assert report.groups["q_limits"].violation == pytest.approx(0.988933 + 2.2 - np.pi)
+
+
+def test_joint_velocity_limit(models):
+    plan = translate_plan(models, turns=(np.array([1.1, 0, 0, 0, 0, 0]),), durations=(0.6,))
+    report = _fails(plan, "qd_limits")  # peak 1.5 * 1.1 / 0.6 = 2.75 rad/s > 2.16
+    assert report.groups["qd_limits"].violation == pytest.approx(2.75 - 2.16)
+    assert report.groups["dynamics"].ok and report.groups["defects"].ok
+
+
+def test_discontinuity_between_segments(models):
+    plan = translate_plan(models)
+    seg, shift = plan.segments[1], np.array([2e-4, 0, 0, 0, 0, 0])  # rad about the base axis
+    plan.segments[1] = cubic_segment("translate", seg.q[0] + shift, seg.q[-1] + shift, seg.T,
+                                     models.loaded)
+    report = _fails(plan, "continuity")
+    assert report.worst() == ("continuity", 1, pytest.approx(2e-4))
+    assert report.groups["endpoints"].ok and report.groups["dynamics"].ok
+
+
+def test_cone_with_violent_base_acceleration(models):
+    plan = translate_plan(models, turns=(np.array([0.8, 0, 0, 0, 0, 0]),), durations=(0.6,))
+    report = _fails(plan, "cone")  # ~0.65 m × 13 rad/s² ≫ μ g
+    assert report.worst()[0] == "cone" and report.groups["cone"].node in (0, 20)
+    for group in ("dynamics", "defects", "qd_limits", "qdd_limits", "endpoints"):
+        assert report.groups[group].ok, group
+
+
+def test_cone_with_little_friction(models):
+    plan = translate_plan(models)
+    plan.burger["mu"] = 0.01  # the gentle base turn now slides the burger
+    assert _fails(plan, "cone").worst()[0] == "cone"
+
+
+def test_paper_cone_form_is_used_when_recorded(models):
+    plan = translate_plan(models)
+    plan.cone = "paper"
+    report = verify_plan(plan)
+    assert report.ok and report.groups["cone"].unit == "1"
+
+
+def test_grill_above_the_blade_fails_clearance(models):
+    plan = translate_plan(models)
+    plan.grill_height = 0.35  # m, the blade rides at 0.30 m
+    assert _fails(plan, "grill_clearance").groups["grill_clearance"].violation == pytest.approx(
+        0.05, abs=0.01)
+
+
+def test_uneven_time_grid(models):
+    plan = translate_plan(models)
+    plan.segments[0].t[3] += 1e-6
+    assert _fails(plan, "time_grid").worst()[0] == "time_grid"
+
+
+def test_translate_goal_and_rest(models):
+    plan = translate_plan(models)
+    g = plan.segments[1].goal
+    plan.segments[1].goal = tg.Pose((g.p[0] + 1e-3, g.p[1], g.p[2]), g.o)
+    assert _fails(plan, "endpoints").groups["endpoints"].violation == pytest.approx(1e-3)
+    plan = translate_plan(models)
+    plan.segments[1].goal = None  # without a goal: rest and flatness are still checked
+    assert verify_plan(plan).ok
+    plan.segments[1].qd[-1, 4] = 1e-3
+    assert _fails(plan, "endpoints").groups["endpoints"].node == 20
+
+
+def test_subbehaviour_endpoints_follow_the_burger_location(models, chain):
+    plan = chain_plan(models)
+    plan.burger["location"] = plan.burger["location"] + np.array([0.01, 0.0, 0.0])
+    report = _fails(plan, "endpoints")
+    assert report.groups["endpoints"].violation == pytest.approx(0.01, rel=1e-6)
+    plan = chain_plan(models)
+    last = plan.segments[-1]
+    plan.segments[-1] = cubic_segment("turn_back", last.q[0], last.q[-1] + 0.01, last.T,
+                                      models.bare)
+    assert _fails(plan, "endpoints").worst()[:2] == ("endpoints", 2)
+
+
+def test_a_flip_that_does_not_flip_fails_its_path_constraints(models, chain):
+    q = chain.segments[1].q[-1]  # pickup end, blade up: normal and height outside eq. (26)
+    seg = cubic_segment("flip", q, q, T_BOUNDS["flip"][1], models.loaded)
+    plan = Plan.from_segments("flip", models.cell, [seg], location=chain.burger["location"])
+    report = _fails(plan, "behavior_path")
+    assert report.worst()[0] == "behavior_path"
+    assert report.groups["behavior_path"].violation == pytest.approx(1.8, abs=0.01)  # n_z 1 vs -0.8
+
+
+def test_bad_tolerance():
+    with pytest.raises(ConfigError, match="tol must be"):
+        verify_plan(None, tol=0.0)
+
+
+def test_cli_exit_codes(models, tmp_path, capsys):
+    good = translate_plan(models).to_json(tmp_path / "good.json")
+    assert main(["verify", str(good), "--json", str(tmp_path / "r.json")]) == 0
+    out = capsys.readouterr().out
+    assert "dynamics" in out and "plan verified" in out
+    doc = json.loads((tmp_path / "r.json").read_text())
+    assert doc["ok"] is True and {g["name"] for g in doc["groups"]} == set(GROUPS)
+
+    plan = translate_plan(models)
+    plan.segments[0].u[3, 1] += 1.0
+    bad = plan.to_json(tmp_path / "bad.json")
+    assert main(["verify", str(bad)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "'dynamics' in segment 0" in err and "1 N·m" in err
+
+    (tmp_path / "broken.json").write_text('{"format": "flipkit-plan/1"')
+    assert main(["verify", str(tmp_path / "broken.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("flipkit: error:") and "not a JSON file" in err and "\n" not in err
+    assert main(["verify", str(tmp_path / "missing.json")]) == 2
