@@ -15,6 +15,7 @@ from . import targets as tg
 from .collocation import Layout, bezier_guess, fit_guess
 from .config import CellConfig
 from .constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
+from .constraints.braking import BrakingMargin
 from .constraints.kinematic import Cone
 from .contact import make_cone
 from .errors import ConfigError, InvalidChoiceError
@@ -24,11 +25,13 @@ from .orientation import rpy
 from .robot import Robot
 
 BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
-# Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md); the upper
-# bounds of the five subbehaviours add up to 2.95 s (< 3 s, paper Fig. 7). Turn back needs
-# the most: the wrist unrolls ~2.6 rad at ≤ 3.2 rad/s.
-T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.55), "scoop": (0.2, 0.5),
-            "pickup": (0.2, 0.4), "flip": (0.2, 0.5), "turn_back": (0.4, 1.0)}
+# Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md). The paper's
+# whole pickup-and-flip runs in < 3 s (Fig. 7); ours adds up to at most 3.2 s because turn
+# back must first stop the flip's end velocity (wrists at their 3.16 rad/s limit) and then
+# unroll ~2.6 rad: with |q̈| ≤ 20 rad/s² that needs ≥ 1.1 s (1.0 s is infeasible).
+T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.6),
+            "pickup": (0.2, 0.4), "flip": (0.2, 0.6), "turn_back": (0.4, 1.6)}
+SCOOP_TIP_BAND = 0.002  # m: the blade tip may ride up to 2 mm above the grill while scooping
 CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
                   "flip": True, "turn_back": False}
 
@@ -143,7 +146,9 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
                                  ctx=ctx))
     cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity))
     cone_nodes: list[int] = []
-    rest_at_end = name in ("translate", "go_to_burger", "turn_back")
+    # The scoop ends at rest too (our addition): the blade lies flat on the grill at its end,
+    # so any downward or pitching velocity there would push it through the grill on pickup.
+    rest_at_end = name in ("translate", "go_to_burger", "scoop", "turn_back")
     pose = None
     if name == "translate":
         if goal is None:
@@ -157,7 +162,12 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             pose = tg.scoop_ready(cell, pb)
         elif name == "scoop":
             pose = tg.scoop_end(cell, pb)
-            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", moving, hg, hg, ctx=ctx))
+            # The tip stays on the grill (eq. 24), relaxed to a band [h_g, h_g + SCOOP_TIP_BAND]:
+            # with q held to a degree-6 polynomial by the outputs (18), 19 tip equalities plus
+            # the end pose and rest leave a square, generically infeasible system. At node N
+            # the flat end pose already puts the tip on the grill.
+            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", range(1, L.N), hg,
+                                         hg + SCOOP_TIP_BAND, ctx=ctx))
         elif name == "pickup":
             pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
         elif name == "flip":
@@ -178,6 +188,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
                                   np.concatenate([robot.q_home, np.zeros(robot.nq)])))
     elif rest_at_end:
         blocks.append(FixedValues("end_rest", L, L.iqd(last), np.zeros(robot.nq)))
+    if not rest_at_end and name != "turn_back":
+        blocks.append(BrakingMargin(L, last, robot.q_min, robot.q_max, robot.qdd_max))
     if cone_nodes:
         blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
 

@@ -6,8 +6,9 @@ values and the Jacobian entries in pattern order.
 """
 
 from .base import Block, FixedValues
+from .braking import BrakingMargin
 from .dynamics import BezierOutput, Dynamics, HermiteSimpson
 from .kinematic import QUANTITIES, KinematicBlock
 
-__all__ = ["Block", "FixedValues", "Dynamics", "HermiteSimpson", "BezierOutput",
+__all__ = ["Block", "FixedValues", "BrakingMargin", "Dynamics", "HermiteSimpson", "BezierOutput",
            "KinematicBlock", "QUANTITIES"]

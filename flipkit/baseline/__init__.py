@@ -1,0 +1,103 @@
+"""End-effector-space + inverse-kinematics baseline (the paper's reference [8] approach,
+Sec. I): optimise the spatula trajectory of each subbehaviour in task space
+(:mod:`.ee_opt`), track it with placo IK at a controller rate (:mod:`.ik_track`) and
+classify what goes wrong (:mod:`.classify`).
+
+Durations are the upper bounds of :data:`flipkit.behaviors.T_BOUNDS`. Each subbehaviour's
+end-effector QP starts at the previous one's end state (position, velocity, orientation);
+the IK continues from the previous IK configuration, except after a failed subbehaviour,
+where it restarts from an exact single-pose IK solution of the planned start pose
+(:func:`flipkit.ik.solve_pose`, see :func:`_restart`) so that every subbehaviour is judged
+on its own rather than on the previous one's lag.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import targets as tg
+from ..behaviors import T_BOUNDS, Models
+from ..config import CellConfig
+from ..errors import ConfigError, NoSolutionFound, UnreachableError
+from ..ik import solve_pose
+from ..orientation import rpy
+from .classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
+from .ee_opt import EEState, EETrajectory, plan_segment
+from .ik_track import IKTrack, PlacoTracker
+
+
+def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: float = 200.0,
+                 *, iterations: int = 3, velocity_limits: bool = True,
+                 thresholds: Thresholds = Thresholds()) -> BaselineResult:
+    """Plan pickup-and-flip at ``location`` with the end-effector-space + IK baseline.
+
+    Args:
+        location: Burger location p^b (m), on the grill.
+        cell: Cell configuration (default: the paper's).
+        q_start: Start configuration at rest (rad); default q_home, as the joint-space plan.
+        rate: Sample and IK controller rate (Hz).
+        iterations: placo solver iterations per sample.
+        velocity_limits: Enforce joint velocity limits in the IK.
+        thresholds: Failure thresholds of the classifier.
+
+    Returns:
+        The per-subbehaviour verdicts (with EE and IK wall times), trajectories and tracks.
+
+    Raises:
+        UnreachableError: ``location`` is not on the grill.
+        ConfigError: Bad ``q_start`` or ``rate``.
+    """
+    cell = cell or CellConfig()
+    if not (np.isfinite(rate) and rate > 0):
+        raise ConfigError(f"IK rate must be a positive number of Hz, got {rate!r}")
+    pb = tg.check_location(cell, location)
+    models = Models(cell)
+    robot = models.bare
+    q = robot.q_home.copy() if q_start is None else np.asarray(q_start, dtype=float)
+    if q.shape != (robot.nq,) or not np.all(np.isfinite(q)):
+        raise ConfigError(f"q_start must be {robot.nq} finite joint angles (rad), got {q_start!r}")
+    home_M = robot.placement(robot.q_home)
+    home = tg.Pose(tuple(home_M.translation), tuple(rpy(home_M.rotation)))
+    M0 = robot.placement(q)
+    start = EEState(tuple(M0.translation), (0.0, 0.0, 0.0), tuple(rpy(M0.rotation)))
+    tracker = PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits)
+    result = BaselineResult(tuple(float(x) for x in pb), [])
+    for name in tg.SUBBEHAVIORS:
+        try:
+            traj = plan_segment(name, cell, pb, start, T_BOUNDS[name][1], home=home, rate=rate)
+        except NoSolutionFound as exc:
+            result.segments.append(SegmentVerdict(name, "failed", "ee_infeasible",
+                                                  detail=f"end-effector QP: {exc.status}"))
+            break
+        track = tracker.track(traj, q)
+        verdict = classify_segment(name, models.for_segment(name), track.t, track.q, traj.p,
+                                   traj.R, thresholds=thresholds, ee_time_s=traj.solve_time_s,
+                                   ik_time_s=track.time_s)
+        result.segments.append(verdict)
+        result.trajectories.append(traj)
+        result.tracks.append(track)
+        start = traj.end_state()
+        q = track.q[-1] if verdict.status == "solved" else _restart(robot, traj, track.q)
+    return result
+
+
+def _restart(robot, traj: EETrajectory, q_track: np.ndarray) -> np.ndarray:
+    """An exact IK solution of the end pose of ``traj`` after a failed subbehaviour.
+
+    Seeds, in order: the last IK configuration; the segment's first configuration with the
+    last joint (the roll about the blade axis) turned by the planned roll change; q_home.
+    Falls back to the last IK configuration when none converges.
+    """
+    turned = q_track[0].copy()
+    turned[-1] += traj.o[-1, 0] - traj.o[0, 0]
+    for seed in (q_track[-1], turned, robot.q_home):
+        try:
+            return solve_pose(robot, traj.p[-1], traj.o[-1], q_guess=seed)
+        except UnreachableError:
+            continue
+    return q_track[-1]
+
+
+__all__ = ["run_baseline", "BaselineResult", "SegmentVerdict", "Thresholds", "REASONS",
+           "classify_segment", "EEState", "EETrajectory", "plan_segment", "IKTrack",
+           "PlacoTracker"]
