@@ -51,12 +51,13 @@ class SQPOptions:
     prox0: float = 1e-3
     prox_min: float = 1e-4
     prox_max: float = 1e4
-    slack_reg: float = 1.0
+    slack_reg: float = 1e3
     armijo: float = 1e-4
     min_step: float = 1e-2
     max_iter: int = 300
     accept_ratio: float = 0.1
-    curvature: bool = True
+    curvature: str = "bfgs"
+    bfgs_init: float = 1e-4
 
 
 @dataclass
@@ -89,6 +90,20 @@ def _min_norm_correction(J: sp.csr_matrix, c: np.ndarray, rows: np.ndarray) -> n
     return np.where(np.isfinite(delta), delta, 0.0)
 
 
+def _damped_bfgs(B: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Powell-damped BFGS update of a positive definite block (Nocedal & Wright, Proc. 18.2)."""
+    Bs = B @ s
+    sBs = float(s @ Bs)
+    if sBs <= 1e-16:
+        return B
+    sy = float(s @ y)
+    if sy < 0.2 * sBs:
+        theta = 0.8 * sBs / (sBs - sy)
+        y = theta * y + (1 - theta) * Bs
+        sy = float(s @ y)
+    return B - np.outer(Bs, Bs) / sBs + np.outer(y, y) / sy
+
+
 def _psd_quad(H: np.ndarray, d: np.ndarray) -> float:
     """dᵀ H₊ d with H₊ the PSD part of H (what the subproblem uses)."""
     w, V = np.linalg.eigh(0.5 * (H + H.T))
@@ -116,6 +131,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         return c, jac, nlp.objective(x) * nlp.obj_scale, nlp.scaled_violation(c)
 
     c, jac, f, v = point(x)
+    x_prev, jac_prev = x, jac
     rho, mu = options.rho0, options.prox0
     lam = np.zeros(nlp.m)  # multipliers, raw row units
     eq_rows = np.flatnonzero(nlp.c_lo == nlp.c_hi)
@@ -148,9 +164,11 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
         pred = merit - (f + grad @ d + 0.5 * d @ (hess * d) + 0.5 * curv + rho * lin_v.sum())
         step, accepted, ratio = 1.0, False, 0.0
-        if v.max(initial=0.0) <= options.tol and pred <= options.ftol * max(1.0, abs(f)):
+        qp_ok = sol.status in ("optimal", "optimal_inaccurate")
+        if (sol.status == "optimal" and v.max(initial=0.0) <= options.tol
+                and pred <= options.ftol * max(1.0, abs(f))):
             status = "solved"
-        elif pred > 0:
+        elif qp_ok and pred > 0:
             # Second-order correction (Maratos effect): pull the full step back onto the
             # equality constraints by a minimum-norm Newton step, J_E Δ = −c_E(Z + d).
             x_full = np.clip(x + D * d, nlp.x_lb, nlp.x_ub)
@@ -175,10 +193,22 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
                     x, c, jac, f, v, accepted = x_new, c_n, jac_n, f_n, v_n, True
                     break
                 step *= 0.25
-        if accepted and options.curvature:
+        if accepted and options.curvature == "dynamics":
             lam = lam_new
             curvature = [nlp.obj_scale * np.outer(D[b], D[b]) * H
                          for b, H in zip(nlp.curvature_blocks, nlp.lagrangian_curvature(x, lam))]
+        elif accepted and options.curvature == "bfgs" and sol.eq_duals is not None:
+            # Partitioned damped BFGS on the per-node blocks (q, q̇, q̈): the constraint part
+            # of the Lagrangian gradient, J̃ᵀỹ with this step's multipliers, at both ends.
+            y_eq = np.zeros(nlp.m)
+            y_eq[eq_rows] = sol.eq_duals
+            g_new, g_old = J_of(jac).T @ y_eq, J_of(jac_prev).T @ y_eq
+            s_all = (x - x_prev) / D
+            if curvature is None:
+                curvature = [options.bfgs_init * np.eye(len(b)) for b in nlp.curvature_blocks]
+            curvature = [_damped_bfgs(B, s_all[b], (g_new - g_old)[b])
+                         for B, b in zip(curvature, nlp.curvature_blocks)]
+        x_prev, jac_prev = x, jac
         # Levenberg–Marquardt update from the full step's agreement with the model.
         if status != "solved":
             if ratio < 0.1:
@@ -192,7 +222,18 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         if status == "solved":
             break
         if mu > options.prox_max:
-            status = "stalled"
+            # Before giving up: a few minimum-norm Newton corrections onto the equalities
+            # (feasibility polishing) — the iterate is usually stationary but a hair outside.
+            x_c, c_c = x, c
+            for _ in range(3):
+                delta = _min_norm_correction(J_of(point(x_c)[1]), nlp.c_scale * (c_c - nlp.c_lo), eq_rows)
+                x_c = np.clip(x_c + D * delta, nlp.x_lb, nlp.x_ub)
+                c_c, jac_c, f_c, v_c = point(x_c)
+                if v_c.max(initial=0.0) <= options.tol:
+                    x, c, jac, f, v, status = x_c, c_c, jac_c, f_c, v_c, "solved"
+                    break
+            if status != "solved":
+                status = "stalled"
             break
     result = SolveResult(x=x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
                          objective=nlp.objective(x), max_violation=float(v.max(initial=0.0)),

@@ -1,0 +1,41 @@
+"""The fixed SQP problem whose iteration log is kept under version control.
+
+Regenerate (after an intended change of the solver) with::
+
+    .venv/bin/python tests/sqp_reference.py
+"""
+
+import json
+from pathlib import Path
+
+from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.config import CellConfig
+from flipkit.ik import solve_pose
+from flipkit.sqp import solve_sqp
+
+LOG_PATH = Path(__file__).parent / "data" / "sqp_translate_log.json"
+START, GOAL = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)
+
+
+def reference_nlp():
+    models = Models(CellConfig())
+    q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
+    return build_segment("translate", models, q_start, goal=flat_pose(GOAL))
+
+
+def run():
+    nlp = reference_nlp()
+    return nlp, solve_sqp(nlp)
+
+
+def log_rows(result):
+    return [{"iter": r["iter"], "objective": r["objective"], "violation": r["violation"],
+             "merit": r["merit"], "step": r["step"], "qp_status": r["qp_status"]}
+            for r in result.log]
+
+
+if __name__ == "__main__":
+    _, res = run()
+    LOG_PATH.write_text(json.dumps({"status": res.status, "iterations": res.iterations,
+                                    "objective": res.objective, "log": log_rows(res)}, indent=1))
+    print(f"wrote {LOG_PATH}: {res.iterations} iterations, objective {res.objective:.6f}")
