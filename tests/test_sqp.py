@@ -27,7 +27,7 @@ def test_converges_to_a_feasible_point(reference):
 def test_matches_ipopt_on_the_same_nlp(reference):
     """Both solvers on the very same NLP interface reach the same optimum.
 
-    Measured: SQP 10731 vs IPOPT 10597 (1.3 %); the issue's 1e-3 target is not met yet —
+    Measured: SQP 10720 vs IPOPT 10597 (1.2 %); the issue's 1e-3 target is not met yet —
     the SQP stops on its predicted-decrease test while IPOPT goes on (see sqp.py).
     """
     nlp, res = reference
