@@ -32,6 +32,8 @@ BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.6),
             "pickup": (0.2, 0.4), "flip": (0.2, 0.6), "turn_back": (0.4, 1.6)}
 SCOOP_TIP_BAND = 0.002  # m: the blade tip may ride up to 2 mm above the grill while scooping
+SCOOP_LATERAL_BAND = 0.01  # m: |p_y − p^b_y| during the scoop
+SCOOP_ANGLE_BAND = 0.05  # rad: |o_x|, |o_z| during the scoop
 CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
                   "flip": True, "turn_back": False}
 
@@ -84,7 +86,12 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
     turn back: q_home).
     """
     if name == "turn_back":
-        return bezier_guess(L, robot, q_start, robot.q_home, T, qd_start)
+        # Critically damped return to q_home from the (moving) start state: it brakes first
+        # instead of extrapolating the start velocity past the joint limits.
+        w, t = 4.0 / T, L.s * T  # peak |q̈| ≈ w²|q_0 − q_home| stays near the limit
+        e0 = q_start - robot.q_home
+        waypoints = robot.q_home + (e0 + np.outer(t, qd_start + w * e0)) * np.exp(-w * t)[:, None]
+        return fit_guess(L, robot, np.clip(waypoints, robot.q_min, robot.q_max), T, qd_start, True)
     if name in ("go_to_burger", "scoop", "pickup"):
         p0, R0 = robot.position(q_start), robot.rotation(q_start)
         o0, o1 = rpy(R0), np.asarray(pose.o)
@@ -168,6 +175,13 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             # the flat end pose already puts the tip on the grill.
             blocks.append(KinematicBlock("scoop_tip", L, "tip_height", range(1, L.N), hg,
                                          hg + SCOOP_TIP_BAND, ctx=ctx))
+            # Slide straight under the burger (our addition): without it the blade drifts
+            # sideways and yaws on the way and pushes the burger (seen in MuJoCo).
+            band = np.array([np.inf, SCOOP_LATERAL_BAND, np.inf])
+            blocks.append(KinematicBlock("scoop_lateral", L, "position", range(1, L.N),
+                                         np.asarray(pb) - band, np.asarray(pb) + band))
+            ang = np.array([SCOOP_ANGLE_BAND, np.inf, SCOOP_ANGLE_BAND])
+            blocks.append(KinematicBlock("scoop_attitude", L, "rpy", range(1, L.N), -ang, ang))
         elif name == "pickup":
             pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
         elif name == "flip":

@@ -12,7 +12,7 @@ import sys
 
 from .errors import FlipkitError
 
-COMMANDS = ("plan", "verify", "export", "figures")
+COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -65,7 +65,7 @@ def _label_spots(ax3d, points, gap: float = 0.04) -> list[np.ndarray]:
 
 
 def draw_cell(ax3d, robot: Robot, cell: CellConfig, q, locations, legend: bool = True,
-              view: tuple = (22.0, -60.0)) -> dict:
+              view: tuple = (22.0, -60.0), clip: bool = False, table: bool = True) -> dict:
     """Draw the cell in 3D: arm, spatula, grill, table and burger locations.
 
     The arm is a stick chain through the base, the joint origins (``data.oMi``) and the tool
@@ -82,6 +82,9 @@ def draw_cell(ax3d, robot: Robot, cell: CellConfig, q, locations, legend: bool =
         locations: Burger locations p^b (m), shape (k, 3); e.g. ``config.TABLE1_LOCATIONS``.
         legend: Add a legend naming the parts.
         view: Camera (elevation, azimuth) (deg).
+        clip: Hide what falls outside the axes limits (matplotlib's ``axlim_clip``), for
+            callers that zoom in by setting narrower limits afterwards.
+        table: Draw the table (and include it in the limits).
 
     Returns:
         The drawn geometry in the world frame (m): ``joints`` (n, 3) chain points,
@@ -104,26 +107,33 @@ def draw_cell(ax3d, robot: Robot, cell: CellConfig, q, locations, legend: bool =
     blade = _rectangle(p, R[:, 0], R[:, 1], sp.length / 2, sp.width / 2)
     handle = np.vstack([tool, p - R[:, 0] * sp.length / 2])
     grill = _area(cell.grill.x_range, cell.grill.y_range, cell.grill.height)
-    table = _area(cell.table.x_range, cell.table.y_range, cell.table.height)
+    table = _area(cell.table.x_range, cell.table.y_range, cell.table.height) if table else None
     points = _group_locations(locations)
 
     ax3d.computed_zorder = False  # surfaces below, arm above: drawn in this order
     ax3d.add_collection3d(Poly3DCollection([grill], facecolor=GRILL_COLOR, alpha=0.35,
-                                           edgecolor="0.1", linewidth=0.6, zorder=1))
-    ax3d.add_collection3d(Poly3DCollection([table], facecolor=TABLE_COLOR, alpha=0.35,
-                                           edgecolor="0.1", linewidth=0.6, zorder=1))
+                                           edgecolor="0.1", linewidth=0.6, zorder=1),
+                          axlim_clip=clip)
+    if table is not None:
+        ax3d.add_collection3d(Poly3DCollection([table], facecolor=TABLE_COLOR, alpha=0.35,
+                                               edgecolor="0.1", linewidth=0.6, zorder=1),
+                              axlim_clip=clip)
     for point, _ in points:
-        ax3d.scatter(*point, s=14, color=LOCATION_COLOR, depthshade=False, zorder=2)
-    ax3d.plot(*joints.T, color=ROBOT_COLOR, linewidth=5, solid_capstyle="round", zorder=3)
-    ax3d.plot(*joints.T, "o", color=JOINT_COLOR, markersize=3.5, zorder=4)
-    ax3d.plot(*base, "s", color=JOINT_COLOR, markersize=7, zorder=4)
-    ax3d.plot(*handle.T, color=JOINT_COLOR, linewidth=1.5, zorder=4)
+        ax3d.scatter(*point, s=14, color=LOCATION_COLOR, depthshade=False, zorder=2,
+                     axlim_clip=clip)
+    ax3d.plot(*joints.T, color=ROBOT_COLOR, linewidth=5, solid_capstyle="round", zorder=3,
+              axlim_clip=clip)
+    ax3d.plot(*joints.T, "o", color=JOINT_COLOR, markersize=3.5, zorder=4, axlim_clip=clip)
+    ax3d.plot(*base, "s", color=JOINT_COLOR, markersize=7, zorder=4, axlim_clip=clip)
+    ax3d.plot(*handle.T, color=JOINT_COLOR, linewidth=1.5, zorder=4, axlim_clip=clip)
     ax3d.plot([p[0], p[0]], [p[1], p[1]], [cell.grill.height, p[2]], ":", color=BLADE_COLOR,
-              linewidth=1, zorder=4)
+              linewidth=1, zorder=4, axlim_clip=clip)
     ax3d.add_collection3d(Poly3DCollection([blade], facecolor=BLADE_COLOR, alpha=0.9,
-                                           edgecolor="k", linewidth=0.6, zorder=5))
+                                           edgecolor="k", linewidth=0.6, zorder=5),
+                          axlim_clip=clip)
 
-    every = np.vstack([joints, blade, grill, table, [pt for pt, _ in points]])
+    every = np.vstack([joints, blade, grill] + ([] if table is None else [table])
+                      + [np.reshape([pt for pt, _ in points], (-1, 3))])
     lo, hi = every.min(axis=0) - 0.05, every.max(axis=0) + 0.05
     lo[2] = min(lo[2], 0.0)
     ax3d.set_xlim(lo[0], hi[0])
@@ -134,15 +144,16 @@ def draw_cell(ax3d, robot: Robot, cell: CellConfig, q, locations, legend: bool =
     ax3d.set_xlabel("x (m)")
     ax3d.set_ylabel("y (m)")
     ax3d.set_zlabel("z (m)")
-    for (point, label), spot in zip(points, _label_spots(ax3d, [pt for pt, _ in points])):
+    spots = _label_spots(ax3d, [pt for pt, _ in points]) if points else []
+    for (point, label), spot in zip(points, spots):
         ax3d.text(*spot, label, fontsize=6, ha="center", va="center", color=LOCATION_COLOR,
-                  zorder=6)
+                  zorder=6, axlim_clip=clip)
     if legend:
         ax3d.legend(handles=[
             Patch(color=ROBOT_COLOR, label="arm (joint origins)"),
             Patch(color=BLADE_COLOR, label="spatula blade"),
             Patch(color=GRILL_COLOR, alpha=0.35, label=f"grill, z = {cell.grill.height} m"),
-            Patch(color=TABLE_COLOR, alpha=0.35, label="table"),
+            *([] if table is None else [Patch(color=TABLE_COLOR, alpha=0.35, label="table")]),
             Patch(color=LOCATION_COLOR, label="Table I locations")], loc="upper left")
     return {"joints": joints, "blade": blade, "spatula_position": np.array(p),
             "location_labels": [label for _, label in points]}

@@ -147,11 +147,23 @@ class QPSubproblem:
         self.d_lo.value, self.d_hi.value, self.rho.value = d_lo, d_hi, rho
         self.slack_reg.value = slack_reg
 
-    def solve(self) -> QPSolution:
-        """Solve with OSQP, warm-started from the previous solve of this problem."""
+    def reset(self) -> None:
+        """Forget OSQP's state: the next solve sets up afresh (no warm start)."""
+        self.problem._solver_cache.clear()
+
+    def solve(self, eps: float | None = None) -> QPSolution:
+        """Solve with OSQP, warm-started from the previous solve of this problem.
+
+        Args:
+            eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS` (for a final,
+                accurate solve).
+        """
+        settings = dict(OSQP_SETTINGS)
+        if eps is not None:
+            settings.update(eps_abs=eps, eps_rel=eps)
         with warnings.catch_warnings():  # inaccurate solves are reported through the status
             warnings.simplefilter("ignore", UserWarning)
-            self.problem.solve(solver=cp.OSQP, warm_start=True, **OSQP_SETTINGS)
+            self.problem.solve(solver=cp.OSQP, warm_start=True, **settings)
         stats = self.problem.solver_stats
         d = self.d.value
         if d is None:

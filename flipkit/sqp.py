@@ -45,7 +45,7 @@ class SQPOptions:
     """
 
     tol: float = 1e-6
-    ftol: float = 1e-7
+    ftol: float = 1e-6
     rho0: float = 10.0
     step_cap: float = 1.0
     prox0: float = 1e-3
@@ -58,6 +58,7 @@ class SQPOptions:
     accept_ratio: float = 0.1
     curvature: str = "bfgs"
     bfgs_init: float = 1e-4
+    final_qp_eps: float = 1e-8
 
 
 @dataclass
@@ -79,11 +80,30 @@ class SolveResult:
         return self.status == "solved"
 
 
-def _min_norm_correction(J: sp.csr_matrix, c: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """Δ = −J_Eᵀ (J_E J_Eᵀ)⁻¹ c_E: the least-norm step zeroing the linearised equalities."""
+def _correction_residual(nlp: NLP, c: np.ndarray):
+    """Rows to pull onto their bounds (equalities and violated inequalities) and the
+    scaled residuals there: c − bound."""
+    lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    cs = nlp.c_scale * c
+    target = np.where(cs < lo, lo, np.where(cs > hi, hi, cs))
+    eq = nlp.c_lo == nlp.c_hi
+    target[eq] = lo[eq]
+    rows = np.flatnonzero(eq | (cs < lo) | (cs > hi))
+    return rows, cs - target
+
+
+def _swap(pair):
+    rows, r = pair
+    return r, rows
+
+
+def _min_norm_correction(J: sp.csr_matrix, r: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Δ = −J_Rᵀ (J_R J_Rᵀ)⁻¹ r_R: the least-norm step zeroing the linearised residuals r on
+    the rows R (a singular system skips the correction)."""
     JE = J[rows]
     try:
-        y = spla.spsolve((JE @ JE.T).tocsc(), c[rows])
+        K = (JE @ JE.T + 1e-12 * sp.identity(len(rows))).tocsc()
+        y = spla.spsolve(K, r[rows])
     except RuntimeError:  # singular: skip the correction
         return np.zeros(J.shape[1])
     delta = -(JE.T @ y)
@@ -119,6 +139,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             worst constraint group and its violation, and the result).
     """
     t0 = time.perf_counter()
+    for elastic in (False, True):  # no warm start from another NLP: results must not depend
+        subproblem_for(nlp, elastic).reset()  # on what was solved before in this process
     D = nlp.x_scale
     x = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
@@ -142,7 +164,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         grad = nlp.gradient(x) * nlp.obj_scale * D
         d_lo = np.maximum((nlp.x_lb - x) / D, -options.step_cap)
         d_hi = np.minimum((nlp.x_ub - x) / D, options.step_cap)
-        sol = None
+        sol, restored = None, False
         for elastic in (False, True):
             qp = subproblem_for(nlp, elastic)
             qp.update(nlp, nlp.c_scale * c, jac * Jscale, grad, hess + mu, d_lo, d_hi, rho,
@@ -151,18 +173,52 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             qp_iters += sol.iterations
             if sol.status == "optimal":
                 break
+            if not elastic and v.max(initial=0.0) > options.tol:
+                # Restoration (before the slow elastic QP): a Gauss–Newton step onto the
+                # equalities, J_E Δ = −c_E, kept if it lowers the violation.
+                delta = _min_norm_correction(J_of(jac), *_swap(_correction_residual(nlp, c)))
+                x_r = np.clip(x + D * delta, nlp.x_lb, nlp.x_ub)
+                c_r, jac_r, f_r, v_r = point(x_r)
+                if v_r.sum() < 0.5 * v.sum():
+                    x, c, jac, f, v = x_r, c_r, jac_r, f_r, v_r
+                    restored = True
+                    break
+        if restored:
+            log.append({"iter": it, "objective": nlp.objective(x), "violation": float(v.max(initial=0)),
+                        "merit": float(f + rho * v.sum()), "pred": 0.0, "ratio": 0.0, "step": 1.0,
+                        "prox": mu, "rho": rho, "qp_iters": sol.iterations,
+                        "qp_status": "restoration", "elastic": False})
+            x_prev, jac_prev = x, jac
+            continue
         if sol.eq_duals is not None and sol.status == "optimal":
             rho = max(rho, 2.0 * float(np.abs(sol.eq_duals).max(initial=0.0)))
             lam_new = np.zeros(nlp.m)  # cvxpy: L = f + yᵀ(expr) for `expr == 0`
             lam_new[eq_rows] = sol.eq_duals * nlp.c_scale[eq_rows] / nlp.obj_scale
         else:
             lam_new = lam
-        d = sol.d
-        c_lin = nlp.c_scale * c + J_of(jac) @ d
-        lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin, c_lin - nlp.c_scale * nlp.c_hi), 0)
-        merit = f + rho * v.sum()
-        curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
-        pred = merit - (f + grad @ d + 0.5 * d @ (hess * d) + 0.5 * curv + rho * lin_v.sum())
+        def model(sol):
+            nonlocal rho
+            d = sol.d
+            c_lin = nlp.c_scale * c + J_of(jac) @ d
+            lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin,
+                                          c_lin - nlp.c_scale * nlp.c_hi), 0)
+            curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
+            model_f = grad @ d + 0.5 * d @ (hess * d) + 0.5 * curv
+            reduction = v.sum() - lin_v.sum()
+            if reduction > 0 and model_f > 0:
+                # Penalty large enough for the step to be a descent direction of the merit
+                # (the equality duals alone miss the inequality multipliers).
+                rho = max(rho, 2.0 * model_f / reduction)
+            merit = f + rho * v.sum()
+            return d, merit, merit - (f + model_f + rho * lin_v.sum())
+
+        d, merit, pred = model(sol)
+        if sol.status == "optimal" and pred <= options.ftol * max(1.0, abs(f)):
+            # Looks stationary: confirm with an accurate solve (OSQP's 1e-4 tolerance can
+            # leave the linearised constraints violated by more than the current iterate).
+            sol = qp.solve(eps=options.final_qp_eps)
+            qp_iters += sol.iterations
+            d, merit, pred = model(sol)
         step, accepted, ratio = 1.0, False, 0.0
         qp_ok = sol.status in ("optimal", "optimal_inaccurate")
         if (sol.status == "optimal" and v.max(initial=0.0) <= options.tol
@@ -175,7 +231,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             c_full, jac_full, f_full, v_full = point(x_full)
             ratio = (merit - (f_full + rho * v_full.sum())) / pred
             if ratio < options.accept_ratio:
-                delta = _min_norm_correction(J_of(jac), nlp.c_scale * (c_full - nlp.c_lo), eq_rows)
+                delta = _min_norm_correction(J_of(jac), *_swap(_correction_residual(nlp, c_full)))
                 x_soc = np.clip(x + D * (d + delta), nlp.x_lb, nlp.x_ub)
                 c_s, jac_s, f_s, v_s = point(x_soc)
                 ratio_soc = (merit - (f_s + rho * v_s.sum())) / pred
@@ -226,7 +282,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             # (feasibility polishing) — the iterate is usually stationary but a hair outside.
             x_c, c_c = x, c
             for _ in range(3):
-                delta = _min_norm_correction(J_of(point(x_c)[1]), nlp.c_scale * (c_c - nlp.c_lo), eq_rows)
+                delta = _min_norm_correction(J_of(point(x_c)[1]), *_swap(_correction_residual(nlp, c_c)))
                 x_c = np.clip(x_c + D * delta, nlp.x_lb, nlp.x_ub)
                 c_c, jac_c, f_c, v_c = point(x_c)
                 if v_c.max(initial=0.0) <= options.tol:

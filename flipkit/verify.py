@@ -2,8 +2,8 @@
 
 Nothing here uses :mod:`flipkit.nlp` or :mod:`flipkit.constraints`; kinematics and dynamics
 come from pinocchio through :class:`~flipkit.robot.Robot` rebuilt from the plan file, targets
-from :mod:`flipkit.targets`, and from :mod:`flipkit.behaviors` only the tables T_BOUNDS and
-CARRIES_BURGER. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+from :mod:`flipkit.targets`, and from :mod:`flipkit.behaviors` only the tables T_BOUNDS,
+CARRIES_BURGER and SCOOP_TIP_BAND. Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -17,7 +17,8 @@ q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         t
                                                                                tol·u_max/10
 endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded
-behavior_path      scoop tip height = h_g; flip normal, x axis, height band    tol
+behavior_path      scoop tip height in [h_g, h_g + SCOOP_TIP_BAND]; flip       tol
+                   normal, x axis, height band
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
 grill_clearance    tip, heel and side-edge heights ≥ h_g (m)                   tol
@@ -39,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import targets as tg
-from .behaviors import T_BOUNDS
+from .behaviors import SCOOP_TIP_BAND, T_BOUNDS
 from .contact import make_cone
 from .errors import ConfigError, VerificationError
 from .orientation import rpy
@@ -247,9 +248,9 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         pose(tg.scoop_ready(cell, pb))
     elif seg.name == "scoop":
         pose(tg.scoop_end(cell, pb))
-        for i, st in enumerate(states):
-            add("behavior_path", k, abs(_point_height(st, (cell.spatula.length / 2, 0, 0)) - hg),
-                tol, i)
+        for i, st in enumerate(states):  # tip on the grill, within the solver's band
+            tip = _point_height(st, (cell.spatula.length / 2, 0, 0))
+            add("behavior_path", k, _outside(tip, hg, hg + SCOOP_TIP_BAND), tol, i)
     elif seg.name == "pickup":
         pose(tg.pickup_end(cell, pb))
     elif seg.name == "flip":

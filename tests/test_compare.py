@@ -1,0 +1,103 @@
+"""``flipkit compare-ik`` on one Table I location with IPOPT: the output schema, the
+collocation plan passes the independent check, the baseline names a reason from its tuple,
+and the Dask executor gives the same outcome as local processes."""
+
+import json
+
+import pytest
+
+from flipkit.baseline import REASONS
+from flipkit.cli import main
+from flipkit.compare import compare_ik, plan_filename
+from flipkit.config import TABLE1_LOCATIONS
+from flipkit.plan import Plan
+from flipkit.sweep import make_executor
+from flipkit.targets import SUBBEHAVIORS
+from flipkit.verify import verify_plan
+
+LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
+COLLOCATION_KEYS = {"status", "reason", "time_s"}
+EE_IK_KEYS = {"status", "reason", "subbehavior", "amount", "time_s"}
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """The CLI on local worker processes, with a cache and the plans kept."""
+    tmp = tmp_path_factory.mktemp("compare")
+    out, cache, plans = tmp / "out.json", tmp / "cache", tmp / "plans"
+    argv = ["compare-ik", "--burger", *map(str, LOCATION), "--solver", "ipopt", "--workers", "1",
+            "--cache", str(cache), "--plans", str(plans), "--no-progress", "--json", str(out)]
+    assert main(argv) == 0
+    return json.loads(out.read_text()), argv, out, plans
+
+
+def test_output_schema(run):
+    doc = run[0]
+    assert set(doc) == {"locations", "summary"}
+    (entry,) = doc["locations"]
+    assert set(entry) == {"location", "collocation", "ee_ik"}
+    assert entry["location"] == pytest.approx(list(LOCATION))
+    assert set(entry["collocation"]) == COLLOCATION_KEYS
+    assert set(entry["ee_ik"]) == EE_IK_KEYS
+    for method in ("collocation", "ee_ik"):
+        assert entry[method]["status"] in ("solved", "failed")
+    assert entry["collocation"]["time_s"] > 0
+    assert set(entry["ee_ik"]["time_s"]) <= set(SUBBEHAVIORS)
+    s = doc["summary"]
+    assert s["locations"] == 1 and set(s["success_fraction"]) == {"collocation", "ee_ik"}
+    assert set(s["ik_failure_reasons"]) == set(REASONS)
+    assert set(s["median_time_s"]["collocation"]) == set(SUBBEHAVIORS) | {"total"}
+    assert set(s["median_time_s"]["ee_ik"]) == set(SUBBEHAVIORS)
+
+
+def test_collocation_plan_passes_verify(run):
+    doc, _, _, plans = run
+    c = doc["locations"][0]["collocation"]
+    assert c["status"] == "solved" and c["reason"] is None
+    plan = Plan.load(plans / plan_filename(LOCATION, "ipopt"))
+    assert plan.status == "solved" and verify_plan(plan).ok
+    assert doc["summary"]["success_fraction"]["collocation"] == 1.0
+
+
+def test_ee_ik_failure_has_a_reason_from_the_tuple(run):
+    doc = run[0]
+    e = doc["locations"][0]["ee_ik"]
+    assert e["status"] == "failed"
+    assert e["reason"] in REASONS and e["subbehavior"] in SUBBEHAVIORS
+    assert isinstance(e["amount"], float)
+    assert doc["summary"]["ik_failure_reasons"][e["reason"]] == 1
+
+
+def test_rerun_reads_the_cache(run):
+    doc, argv, out, _ = run
+    out.unlink()
+    assert main(argv) == 0  # everything cached: instant, same answer
+    assert json.loads(out.read_text()) == doc
+
+
+def test_dask_executor_gives_the_same_statuses(run):
+    from dask.distributed import LocalCluster
+
+    want = run[0]["locations"][0]
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        with make_executor(cluster.scheduler_address, None) as executor:
+            got = compare_ik([LOCATION], "ipopt", executor, cache_dir=None, progress=False)
+    entry = got["locations"][0]
+    for method in ("collocation", "ee_ik"):
+        assert entry[method]["status"] == want[method]["status"]
+    assert entry["ee_ik"]["reason"] == want["ee_ik"]["reason"]
+    assert entry["ee_ik"]["subbehavior"] == want["ee_ik"]["subbehavior"]
+
+
+@pytest.mark.parametrize("extra, message", [
+    ([], "give --locations"),
+    (["--burger", "0.2", "0.0", "0.072"], "outside the grill"),
+    (["--burger", "nan", "0.0", "0.072"], "finite"),
+    (["--grid", "0", "2"], "grid nx"),
+])
+def test_bad_input_exits_2(tmp_path, capsys, extra, message):
+    assert main(["compare-ik", *extra, "--json", str(tmp_path / "o.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err
+    assert not (tmp_path / "o.json").exists()

@@ -1,0 +1,128 @@
+"""flipkit.planner: translate / flip / batch front end, status only 'solved' when verified."""
+
+import numpy as np
+import pytest
+
+import flipkit.planner as planner
+from flipkit.bench import TRANSLATE_KEY_POINTS
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
+from flipkit.plan import Plan
+from flipkit.planner import (format_summary, models_for, plan_batch, plan_flip, plan_translate,
+                             solve_segment, summary_table)
+from flipkit.sqp import SolveResult
+from flipkit.verify import verify_plan
+
+GRILL_A, GRILL_B = (0.65, -0.30, 0.15), (0.80, -0.10, 0.15)
+
+
+@pytest.fixture(scope="module")
+def ipopt_translate():
+    return plan_translate(GRILL_A, GRILL_B, solver="ipopt")
+
+
+def test_ipopt_translate_is_solved_and_verified(ipopt_translate):
+    plan = ipopt_translate
+    assert isinstance(plan, Plan) and plan.behavior == "translate"
+    assert plan.status == "solved" and plan.failure is None and plan.report.ok
+    assert verify_plan(plan).ok
+    seg = plan.segments[0]
+    assert seg.solver.name == "ipopt" and seg.solver.status == "solved"
+    assert seg.goal.p == pytest.approx(GRILL_B) and seg.goal.o == pytest.approx((0, 0, 0))
+    robot = models_for(CellConfig()).loaded
+    assert robot.position(seg.q[0]) == pytest.approx(GRILL_A, abs=1e-6)
+    assert robot.position(seg.q[-1]) == pytest.approx(GRILL_B, abs=1e-6)
+    assert plan.wall_time_s >= seg.solver.wall_time_s > 0
+
+
+def test_sqp_translate_status_matches_verification():
+    """The SQP is still being tuned: only the contract is checked, not convergence."""
+    plan = plan_translate((0.70, -0.05, 0.15), (0.75, 0.0, 0.15), solver="sqp")
+    assert isinstance(plan, Plan) and plan.segments[0].solver.name == "sqp"
+    solved = plan.segments[0].solver.status == "solved" and verify_plan(plan).ok
+    assert (plan.status == "solved") == solved
+    if not solved:
+        assert isinstance(plan.failure, str) and "\n" not in plan.failure
+
+
+def _fake_solver(status):
+    """A solve_segment that returns the initial guess with the given status."""
+    def fake(nlp, solver="sqp", x0=None):
+        x = np.clip(nlp.x0, nlp.x_lb, nlp.x_ub)
+        return SolveResult(x=x, status=status, iterations=3, wall_time_s=0.01,
+                           objective=nlp.objective(x), max_violation=1.0, solver=solver)
+    return fake
+
+
+def test_solver_failure_is_reported_with_group(monkeypatch):
+    monkeypatch.setattr(planner, "solve_segment", _fake_solver("max_iter"))
+    plan = plan_translate(GRILL_A, GRILL_B, solver="ipopt")
+    assert plan.status == "failed"
+    assert plan.failure.startswith("translate: ") and "violated by" in plan.failure
+    assert "max_iter" in plan.failure
+    flip = plan_flip(TABLE1_LOCATIONS[2], solver="sqp")  # stops at the first segment
+    assert flip.status == "failed" and [s.name for s in flip.segments] == ["go_to_burger"]
+    assert flip.failure.startswith("go_to_burger: ")
+
+
+def test_solved_claim_is_overruled_by_verification(monkeypatch):
+    monkeypatch.setattr(planner, "solve_segment", _fake_solver("solved"))
+    plan = plan_translate(GRILL_A, GRILL_B)
+    assert plan.segments[0].solver.status == "solved"
+    assert plan.status == "failed" and plan.failure.endswith("(verify)")
+
+
+@pytest.mark.parametrize("start, goal, kwargs, error, match", [
+    ((np.nan, 0, 0.15), GRILL_B, {}, ConfigError, "finite"),
+    ((3.0, 0.0, 0.15), GRILL_B, {}, UnreachableError, "outside the reachable task area"),
+    (GRILL_A, (0.7, 0.0), {}, ConfigError, "three finite numbers"),
+    (None, GRILL_B, {"q_start": [0.0] * 5}, ConfigError, "6 values"),
+    (None, GRILL_B, {"q_start": [0, 0, 0, 0, 0, 3.5]}, ConfigError, "joint 6 .* outside"),
+    (GRILL_A, GRILL_B, {"q_start": CellConfig().robot.q_home}, ConfigError, "mm from"),
+    (GRILL_A, GRILL_B, {"solver": "snopt"}, InvalidChoiceError, "'sqp', 'ipopt'"),
+])
+def test_translate_bad_input(start, goal, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        plan_translate(start, goal, **kwargs)
+
+
+def test_flip_and_batch_bad_input():
+    with pytest.raises(UnreachableError, match="outside the grill"):
+        plan_flip((0.3, 0.0, 0.072))
+    with pytest.raises(ConfigError, match="start velocity"):
+        plan_flip(TABLE1_LOCATIONS[0], qd_start=[10.0] * 6)
+    with pytest.raises(ConfigError, match="1 to 5"):
+        plan_batch(TABLE1_LOCATIONS[:6], progress=False)
+    with pytest.raises(ConfigError, match="1 to 5"):
+        plan_batch([], progress=False)
+    with pytest.raises(UnreachableError, match="^burger 2: "):
+        plan_batch([TABLE1_LOCATIONS[0], (0.7, 0.0, 0.5)], progress=False)
+
+
+def test_solve_segment_rejects_unknown_solver():
+    with pytest.raises(InvalidChoiceError, match="'sqp', 'ipopt'"):
+        solve_segment(None, "snopt")
+
+
+def test_models_are_cached_per_cell():
+    assert models_for(CellConfig()) is models_for(CellConfig())
+
+
+def test_summary_table(ipopt_translate):
+    rows = summary_table([ipopt_translate, ipopt_translate])
+    seg = ipopt_translate.segments[0]
+    assert rows[1] == (2, None, "solved", seg.solver.wall_time_s, seg.solver.iterations,
+                       seg.solver.max_violation)
+    assert len(format_summary(rows).splitlines()) == 3
+
+
+def test_translate_key_points_lie_over_grill_and_table():
+    cell = CellConfig()
+    over = {"grill": 0, "table": 0}
+    for p in TRANSLATE_KEY_POINTS:
+        for name, area in (("grill", cell.grill), ("table", cell.table)):
+            (x0, x1), (y0, y1) = area.x_range, area.y_range
+            if x0 <= p[0] <= x1 and y0 <= p[1] <= y1:
+                assert 0.05 <= p[2] - area.height <= 0.10
+                over[name] += 1
+    assert over == {"grill": 3, "table": 3}

@@ -1,0 +1,120 @@
+"""``flipkit validate`` on one IPOPT plan with two trials: schema, seeded determinism,
+perturbations, and one-line errors (exit 2) on bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from flipkit.cli import main
+from flipkit.config import TABLE1_LOCATIONS
+from flipkit.errors import ConfigError
+from flipkit.planner import plan_flip
+from flipkit.targets import SUBBEHAVIORS
+from flipkit.validate import STAGES, Perturbations, run_trial, track_plan, trial_jobs
+
+LOCATION = TABLE1_LOCATIONS[1]
+TRIALS = 2
+
+
+@pytest.fixture(scope="module")
+def plan_file(tmp_path_factory):
+    plan = plan_flip(LOCATION, solver="ipopt")
+    assert plan.status == "solved", plan.failure
+    return plan.to_json(tmp_path_factory.mktemp("validate") / "plan.json")
+
+
+def validate(plan_file, out, seed, *extra):
+    argv = ["validate", "--plan", str(plan_file), "--trials", str(TRIALS), "--seed", str(seed),
+            "--workers", "1", "--no-progress", "--json", str(out), *extra]
+    assert main(argv) == 0
+    return json.loads(out.read_text())
+
+
+@pytest.fixture(scope="module")
+def result(plan_file):
+    return validate(plan_file, plan_file.with_name("out.json"), 3)
+
+
+def test_schema(result):
+    assert result["trials"] == TRIALS and result["seed"] == 3
+    (entry,) = result["locations"]
+    assert entry["location"] == pytest.approx(list(LOCATION))
+    assert entry["trials"] == TRIALS and set(entry["success"]) == set(STAGES)
+    s = entry["success"]
+    assert TRIALS >= s["scoop"] >= s["pickup"] >= s["flip"] >= 0  # cumulative stages
+    assert len(entry["failures"]) == TRIALS - s["flip"]
+    for f in entry["failures"]:
+        assert 0 <= f["trial"] < TRIALS and f["stage"] in STAGES
+        assert isinstance(f["amount"], float) and isinstance(f["reason"], str)
+    for table in (entry["tracking"], result["tracking"]):
+        assert list(table) == list(SUBBEHAVIORS)
+        for err in table.values():
+            assert 0 < err["rms_m"] <= err["max_m"] < 0.01  # PD tracking: below 1 cm
+    assert result["summary"]["trials"] == TRIALS
+    assert result["perturbations"]["position_sigma"] == 0.005
+
+
+def test_same_seed_same_result_other_seed_other_draws(plan_file, result, tmp_path):
+    again = validate(plan_file, tmp_path / "again.json", 3)
+    assert again == result
+    text = plan_file.read_text()
+    draws = {seed: [run_trial(j)["perturbation"] for j in trial_jobs(text, TRIALS, seed,
+                                                                        Perturbations())]
+             for seed in (3, 4)}
+    assert draws[3][1] == draws[4][0]  # trial i draws from default_rng(seed + i)
+    assert draws[3][0] != draws[4][0]
+
+
+def test_perturbation_draws_within_their_ranges():
+    p = Perturbations()
+    rng = np.random.default_rng(0)
+    d = [p.draw(rng) for _ in range(200)]
+    assert all(abs(x["grill_offset_m"]) <= 0.002 for x in d)
+    assert all(0.8 <= x["mu_factor"] <= 1.2 and 0.9 <= x["mass_factor"] <= 1.1 for x in d)
+    assert np.std([x["dx_m"] for x in d]) == pytest.approx(0.005, rel=0.2)
+    zero = Perturbations(0.0, 0.0, (1.0, 1.0), (1.0, 1.0)).draw(rng)
+    assert zero == {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0,
+                    "mass_factor": 1.0}
+    with pytest.raises(ConfigError):
+        Perturbations(position_sigma=-0.001)
+    with pytest.raises(ConfigError):
+        Perturbations(mu_scale=(1.2, 0.8))
+
+
+def test_tracked_poses_follow_the_plan(plan_file):
+    from flipkit.plan import Plan
+
+    plan = Plan.load(plan_file)
+    t, p, R, bounds, errors = track_plan(plan)
+    assert np.all(np.diff(t) > 0) and t[0] == 0.0
+    assert t[-1] == pytest.approx(sum(s.T for s in plan.segments), abs=2e-3)
+    assert list(bounds) == list(SUBBEHAVIORS) and p.shape == (t.size, 3)
+    assert R.shape == (t.size, 3, 3)
+
+
+@pytest.fixture
+def failed_plan(plan_file, tmp_path):
+    doc = json.loads(plan_file.read_text())
+    doc["status"] = "failed"
+    path = tmp_path / "failed.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.mark.parametrize("case, message", [
+    ("missing", "cannot read"), ("not_json", "not a JSON"), ("failed", "status is 'failed'"),
+    ("zero_trials", "--trials"), ("negative_trials", "--trials"),
+])
+def test_bad_input_exits_2(plan_file, failed_plan, tmp_path, capsys, case, message):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{oops")
+    plan = {"missing": tmp_path / "nope.json", "not_json": bad, "failed": failed_plan}.get(
+        case, plan_file)
+    trials = {"zero_trials": "0", "negative_trials": "-2"}.get(case, "2")
+    out = tmp_path / "out.json"
+    code = main(["validate", "--plan", str(plan), "--trials", trials, "--workers", "1",
+                 "--no-progress", "--json", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and message in err
+    assert not out.exists()
