@@ -30,6 +30,16 @@ figures: $(STAMP)
 figures-quick: $(STAMP)
 	$(VENV)/bin/flipkit figures --quick
 
+# The reproduction report: LaTeX (installed with apt-get if latexmk is missing), the number
+# macros regenerated from figures/manifest.json, then latexmk in paper/.
+paper: $(STAMP)
+	@command -v latexmk >/dev/null 2>&1 || { apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+	  latexmk texlive-latex-recommended texlive-latex-extra; }
+	@test -f figures/manifest.json || { echo "make paper: no figures/manifest.json; run make figures first" >&2; exit 1; }
+	$(PY) -c "from flipkit.figures import write_macros; write_macros('figures/manifest.json', 'paper/numbers.tex')"
+	cd paper && latexmk -pdf -interaction=nonstopmode -halt-on-error main.tex
+
 bench: $(STAMP)
 	$(PY) -m flipkit.bench translate
 

@@ -25,10 +25,12 @@ from .orientation import rpy
 from .robot import Robot
 
 BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
-# Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md). The paper's
-# whole pickup-and-flip runs in < 3 s (Fig. 7); ours adds up to at most 3.2 s because turn
-# back must first stop the flip's end velocity (wrists at their 3.16 rad/s limit) and then
-# unroll ~2.6 rad: with |q̈| ≤ 20 rad/s² that needs ≥ 1.1 s (1.0 s is infeasible).
+# Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md), so a whole
+# pickup-and-flip executes in 4.0 s against the paper's < 3 s (Fig. 7). Shorter bounds were
+# infeasible somewhere on the grill (IPOPT, Table I): going to burgers at y > 0 from q_home
+# needs 0.8 s (pan velocity 2.16 rad/s); the flip needs 0.6 s; turn back must first stop the
+# flip's end velocity (wrists at 3.16 rad/s) and then unroll ~2.6 rad at |q̈| ≤ 20 rad/s²:
+# 1.0 s was infeasible, 1.2 s at some locations.
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.6),
             "pickup": (0.2, 0.4), "flip": (0.2, 0.6), "turn_back": (0.4, 1.6)}
 SCOOP_TIP_BAND = 0.002  # m: the blade tip may ride up to 2 mm above the grill while scooping

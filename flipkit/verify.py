@@ -39,6 +39,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .targets import SUBBEHAVIORS
+
 from . import targets as tg
 from .behaviors import SCOOP_TIP_BAND, T_BOUNDS
 from .contact import make_cone
@@ -51,7 +53,7 @@ TIME_TOL = 1e-9  # s, node times against i T / N
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
-          "cone": "m/s²", "grill_clearance": "m"}
+          "cone": "m/s²", "grill_clearance": "m", "completeness": "segments"}
 
 
 @dataclass
@@ -181,6 +183,13 @@ def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
     report = VerificationReport(tol, [s.name for s in plan.segments])
     if plan.cone == "paper":
         report.groups["cone"].unit = "1"  # cosine margin, dimensionless
+    # A flip plan is the five subbehaviours in order (a plan cut short by a failed segment
+    # must not pass); a translate plan has at least one segment.
+    names = [s.name for s in plan.segments]
+    expected = list(SUBBEHAVIORS) if plan.behavior == "flip" else None
+    missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
+               if expected is not None else int(not names))
+    report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
     robots = {}
     for k, seg in enumerate(plan.segments):
         if seg.name not in robots:

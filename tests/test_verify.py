@@ -36,11 +36,17 @@ def test_consistent_plans_pass(models, chain, which):
     plan = {"translate": lambda: translate_plan(models), "chain": lambda: chain,
             "approach": lambda: chain_plan(models, approach=True)}[which]()
     report = verify_plan(plan)
+    if which != "translate":
+        # the synthetic flip plans are partial chains: every residual passes, but a flip
+        # plan without its five subbehaviours in order must not verify
+        assert not report.groups["completeness"].ok
+        report.groups.pop("completeness")
     assert report.ok, report.table()
-    assert set(report.groups) == set(GROUPS)
     group, segment, amount = report.worst()
     assert amount <= report.groups[group].tolerance
-    report.raise_if_failed()  # no exception
+    if which == "translate":
+        assert set(report.groups) == set(GROUPS)
+        report.raise_if_failed()  # no exception
 
 
 def test_torque_corrupted_at_one_node_fails_dynamics(models):
