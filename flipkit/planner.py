@@ -29,7 +29,7 @@ from .plan import Plan, Segment
 from .sqp import SolveResult
 from .verify import verify_plan
 
-SOLVERS = ("sqp", "ipopt")
+SOLVERS = ("sqp", "ipopt", "auto")
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 _MODELS: dict = {}
 
@@ -47,6 +47,10 @@ def models_for(cell: CellConfig) -> Models:
 
 def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
+
+    ``auto`` runs the SQP and, when it fails, IPOPT from the same start; the segment's
+    ``solver.name`` in the plan file records which one produced it and the wall time counts
+    both.
 
     Returns the result whatever its status (``result.success`` tells); the worst constraint
     group of a failure is ``nlp.worst_group(result.x)``.
@@ -70,6 +74,13 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
         from .ipopt import solve_ipopt
 
         return solve_ipopt(nlp, x0, raise_on_failure=False)
+    if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
+        first = solve_segment(nlp, "sqp", x0)
+        if first.success:
+            return first
+        second = solve_segment(nlp, "ipopt", x0)
+        second.wall_time_s += first.wall_time_s
+        return second
     raise InvalidChoiceError("solver", solver, SOLVERS)
 
 

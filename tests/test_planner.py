@@ -126,3 +126,26 @@ def test_translate_key_points_lie_over_grill_and_table():
                 assert 0.05 <= p[2] - area.height <= 0.10
                 over[name] += 1
     assert over == {"grill": 3, "table": 3}
+
+
+def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
+    import flipkit.sqp as sqp_module
+
+    calls = []
+
+    def failing_sqp(nlp, x0=None, options=None, raise_on_failure=True):
+        calls.append("sqp")
+        x = np.clip(nlp.x0, nlp.x_lb, nlp.x_ub)
+        return SolveResult(x=x, status="stalled", iterations=3, wall_time_s=1.5,
+                           objective=nlp.objective(x), max_violation=1.0)
+
+    monkeypatch.setattr(sqp_module, "solve_sqp", failing_sqp)
+    models = models_for(CellConfig())
+    from flipkit.behaviors import build_segment, flat_pose
+    from flipkit.ik import solve_pose
+
+    nlp = build_segment("translate", models, solve_pose(models.loaded, GRILL_A, (0, 0, 0)),
+                        goal=flat_pose(GRILL_B))
+    res = planner.solve_segment(nlp, "auto")
+    assert calls == ["sqp"] and res.success and res.solver == "ipopt"
+    assert res.wall_time_s > 1.5  # both attempts are counted

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..errors import ConfigError, FlipkitError
 
-SOLVER_CHOICES = ("sqp", "ipopt")
+SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 
 
 def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ..errors import ConfigError, FlipkitError
 
-SOLVER_CHOICES = ("sqp", "ipopt")
+SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 CSV_COLUMNS = (("x", "y", "z"), ("px", "py", "pz"))
 DESCRIPTION = (
     "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
@@ -40,7 +40,7 @@ def register(subparsers) -> None:
 
     def common(p, json_out=True):
         p.add_argument("--solver", choices=SOLVER_CHOICES, default="sqp",
-                       help="NLP solver: sqp (cvxpy/OSQP, default) or ipopt (CasADi)")
+                       help="NLP solver: sqp (cvxpy/OSQP, default), ipopt (CasADi), or auto (SQP, then IPOPT if the SQP fails)")
         if json_out:
             p.add_argument("--json", required=True, metavar="PLAN.json",
                            help="output plan file (flipkit-plan/1)")
