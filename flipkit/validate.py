@@ -22,8 +22,8 @@ import numpy as np
 
 from . import targets as tg
 from .behaviors import CARRIES_BURGER
-from .burger_sim import (LANDING_TOL, SCOOP_OVERLAP, BurgerSim, judge_flip, judge_pickup,
-                         judge_scoop)
+from .burger_sim import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP, BurgerSim,
+                         judge_flip, judge_pickup, judge_scoop)
 from .config import CellConfig
 from .errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from .plan import Plan
@@ -120,11 +120,12 @@ def _failure(scoop, pickup, flip, run) -> dict | None:
         return {"stage": "scoop", "reason": "overlap" if scoop.overlap < SCOOP_OVERLAP
                 else "under_blade", "amount": scoop.overlap}
     if not pickup.ok:
-        return {"stage": "pickup", "reason": "on_grill" if not pickup.off_grill
-                else "off_spatula", "amount": pickup.clearance}
+        if not pickup.off_grill:
+            return {"stage": "pickup", "reason": "on_grill", "amount": pickup.clearance}
+        return {"stage": "pickup", "reason": "off_spatula", "amount": pickup.gap}
     if flip.ok:
         return None
-    if flip.contact_fraction < 0.6:
+    if flip.contact_fraction < FLIP_CONTACT_FRACTION:
         return {"stage": "flip", "reason": "contact", "amount": flip.contact_fraction}
     if not flip.upside_down:
         return {"stage": "flip", "reason": "not_flipped", "amount": flip.up_z}
@@ -146,8 +147,9 @@ def run_trial(job: dict) -> dict:
     Returns:
         ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` ({stage: bool}, each
         judge on its own, whatever the earlier stages did), ``failure`` (first failed stage:
-        ``stage``, ``reason``, ``amount`` — scoop overlap fraction, pickup clearance m,
-        flip contact fraction / up-axis z / height m / landing offset m — or ``None``),
+        ``stage``, ``reason``, ``amount`` — scoop overlap fraction, pickup clearance above
+        the grill (``on_grill``) or gap above the blade (``off_spatula``) m, flip contact
+        fraction / up-axis z / height m / landing offset m — or ``None``),
         ``perturbation`` (the draw) and ``tracking`` (see :func:`track_plan`).
     """
     plan = plan_from_text(job["plan_text"])

@@ -187,8 +187,77 @@ def test_judge_scoop_half_over_vs_mostly_off():
 def test_judge_pickup():
     ok = judge_pickup(made((0.0, 0.0, 0.0075)), (0, 1))
     assert ok.ok and ok.clearance == pytest.approx(0.2, abs=1e-9)
+    assert ok.gap == pytest.approx(0.0, abs=1e-12) and ok.over_blade
     assert not judge_pickup(made((0, 0, 0.0075), touch_grill=True), (0, 1)).ok
     assert not judge_pickup(made((0, 0, 0.0075), touch_spatula=False), (0, 1)).ok
+
+
+def flickering(gap=0.0, n=401, T=0.4, burger_xy=(0.0, 0.0), tilt=0.0, grill=None):
+    """A 1 kHz pickup: the blade rises and decelerates, the burger rests on it (lowest point
+    ``gap`` above the face) and the contact flag alternates every millisecond."""
+    t = np.linspace(0.0, T, n)
+    Rs = rpy_matrix((0.0, tilt, 0.0))
+    P = START + np.outer(smooth(t / T), [0.0, 0.0, 0.05])
+    B = P + Rs @ np.array([*burger_xy, 0.0075 + gap])
+    flag = np.arange(n) % 2 == 0
+    return BurgerRun(
+        t=t, burger_pos=B, burger_rot=np.tile(Rs, (n, 1, 1)), spatula_pos=P,
+        spatula_rot=np.tile(Rs, (n, 1, 1)), touch_spatula=flag,
+        touch_grill=np.zeros(n, bool) if grill is None else grill, force_spatula=np.zeros(n),
+        force_grill=np.zeros(n), burger_diameter=0.10, burger_thickness=0.015,
+        blade_length=0.16, blade_width=0.12, grill_height=START[2] - 0.02)
+
+
+@pytest.mark.parametrize("last", [True, False])
+def test_judge_pickup_flickering_contact_still_on_spatula(last):
+    """The contact flag alternates while the burger rests on the blade: whichever value the
+    last sample has, the burger is on the spatula (gap ~0, contact within the last 50 ms)."""
+    run = flickering(gap=2e-5, n=401 if last else 400)
+    assert bool(run.touch_spatula[-1]) == last
+    v = judge_pickup(run, (0.0, run.t[-1]))
+    assert v.ok and v.on_spatula and v.off_grill
+    assert v.gap == pytest.approx(2e-5, abs=1e-9) and v.spatula_contact == pytest.approx(0.5,
+                                                                                         abs=0.03)
+    tilted = flickering(gap=1e-4, tilt=0.2)  # the gap is along the blade normal, not world z
+    assert judge_pickup(tilted, (0.0, tilted.t[-1])).ok
+
+
+def test_judge_pickup_rejects_burger_off_the_blade_despite_contact():
+    lifted = flickering(gap=0.01)  # 1 cm above the face: tossed, not resting
+    v = judge_pickup(lifted, (0.0, lifted.t[-1]))
+    assert not v.ok and not v.on_spatula and v.gap == pytest.approx(0.01)
+    hanging = flickering(burger_xy=(0.09, 0.0))  # centre past the tip
+    v = judge_pickup(hanging, (0.0, hanging.t[-1]))
+    assert not v.ok and not v.over_blade
+
+
+def test_judge_pickup_grill_contact_in_window_or_too_low_is_on_grill():
+    grill = np.zeros(401, bool)
+    grill[-30] = True  # one grill contact 30 ms before the end
+    v = judge_pickup(flickering(grill=grill), (0.0, 0.4))
+    assert v.on_spatula and not v.off_grill and not v.ok
+    grill[:] = False
+    grill[-60] = True  # 60 ms before the end: outside the window
+    assert judge_pickup(flickering(grill=grill), (0.0, 0.4)).ok
+    # At the pickup's start the blade is 2 cm above the grill: lowest point 1 mm below it
+    early = judge_pickup(flickering(gap=-0.021), (0.0, 0.0))
+    assert not early.off_grill
+
+
+def test_judge_flip_counts_flickering_contact_as_carried():
+    run = flickering(gap=1e-5)
+    v = judge_flip(run, (0.0, run.t[-1]), START[:2])
+    assert v.contact_fraction == 1.0  # the flag is set on only half the samples
+    # Leaving: no contact after mid-flip, though still within BLADE_GAP_TOL for a while —
+    # not bridged (no later contact), so counted off from the last contact on.
+    run.touch_spatula[201:] = False
+    v = judge_flip(run, (0.0, run.t[-1]), START[:2])
+    assert v.contact_fraction == pytest.approx(201 / 401)
+    # A 60 ms flag-off run between contacts is longer than CONTACT_WINDOW: not bridged.
+    run.touch_spatula[:] = True
+    run.touch_spatula[100:160] = False
+    v = judge_flip(run, (0.0, run.t[-1]), START[:2])
+    assert v.contact_fraction == pytest.approx(341 / 401)
 
 
 def test_judge_flip_landing_and_orientation():
