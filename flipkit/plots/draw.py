@@ -18,7 +18,8 @@ DESIRED_COLOR, ACTUAL_COLOR = "#D55E00", "#0072B2"  # paper Figs. 6-7: desired r
 SOLVER_COLORS = {"sqp": "#0072B2", "ipopt": "#E69F00"}
 SOLVER_LABELS = {"sqp": "SQP (cvxpy/OSQP)", "ipopt": "IPOPT (L-BFGS, MUMPS)"}
 BURGER_COLOR = "#8B4513"
-CONE_CLASS_COLORS = ("#CFE8D8", "#0072B2", "#D55E00", "white")  # both, phys only, paper only, neither
+# both admit, physical only, paper only, neither
+CONE_CLASS_COLORS = ("#CFE8D8", "#0072B2", "#D55E00", "white")
 
 
 def plot_tracking(axes, t, p_des, p, boundaries=None, names=None, points=None,
@@ -43,8 +44,11 @@ def plot_tracking(axes, t, p_des, p, boundaries=None, names=None, points=None,
     for k, (ax, label) in enumerate(zip(axes, "xyz")):
         if boundaries is not None:
             shade_segments(ax, boundaries, names)
-        ax.plot(t, p_des[:, k], "--", color=DESIRED_COLOR, lw=1.3, label="desired (plan)")
-        ax.plot(t, p[:, k], color=ACTUAL_COLOR, lw=1.0, label="tracked (simulated PD)")
+        # desired wide and pale underneath, tracked thin on top: both stay visible when
+        # they coincide to within a line width
+        ax.plot(t, p_des[:, k], color=DESIRED_COLOR, lw=3.0, alpha=0.45, solid_capstyle="butt",
+                label="desired (plan)")
+        ax.plot(t, p[:, k], color=ACTUAL_COLOR, lw=0.9, label="tracked (simulated PD)")
         if points is not None:
             ax.plot(points[0], np.asarray(points[1])[:, k], "o", color=DESIRED_COLOR, ms=3,
                     mfc="white", label="key point", zorder=5)
@@ -272,7 +276,8 @@ def plot_tangential_sections(ax, bounds) -> None:
     square and the paper's circle (:func:`~flipkit.plots.data.tangential_boundaries`)."""
     sq, ci = bounds["square"], bounds["circle"]
     ax.fill(*sq.T, color=CONE_CLASS_COLORS[1], alpha=0.15, lw=0)
-    ax.plot(*sq.T, color=CONE_CLASS_COLORS[1], lw=1.2, label=r"physical (5): $|f_{x,y}| \leq \mu f_z$")
+    ax.plot(*sq.T, color=CONE_CLASS_COLORS[1], lw=1.2,
+            label=r"physical (5): $|f_{x,y}| \leq \mu f_z$")
     ax.fill(*ci.T, color=CONE_CLASS_COLORS[2], alpha=0.12, lw=0)
     ax.plot(*ci.T, color=CONE_CLASS_COLORS[2], lw=1.2,
             label=r"paper (20): angle to normal $\leq \mu$ rad")

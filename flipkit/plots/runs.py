@@ -47,7 +47,7 @@ def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None =
         raise ConfigError(f"need at least two key points, got {len(pts)}")
     goals = pts[1:] + (pts[:1] if closed else [])
     plans, q = [], None
-    for k, goal in enumerate(goals):
+    for goal in goals:
         plan = plan_translate(pts[0] if q is None else None, goal, q_start=q, cell=cell,
                               solver=solver)
         plans.append(plan)
@@ -228,5 +228,5 @@ def solve_time_table(rows, names) -> dict:
     return {"times": times, "failed": failed, "solved": solved}
 
 
-__all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times", "solve_time_sweep",
-           "solve_time_table"]
+__all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
+           "solve_time_sweep", "solve_time_table"]
