@@ -42,6 +42,12 @@ class SQPOptions:
         slack_reg: ½σ‖s‖² on the slacks (keeps the QP strongly convex).
         armijo: Sufficient-decrease fraction η. min_step: Smallest line-search step.
         max_iter: Cap on SQP iterations.
+        accept_ratio: Smallest actual/predicted merit decrease for a full (or corrected) step.
+        curvature: Constraint curvature in the subproblem: ``"bfgs"`` (partitioned damped
+            BFGS on the per-node (q, q̇, q̈) blocks), ``"dynamics"`` (finite-difference
+            Hessian of the dynamics rows only) or ``"none"``.
+        bfgs_init: Initial diagonal of the BFGS blocks (scaled units).
+        final_qp_eps: OSQP tolerance of the confirming solve at an apparently stationary point.
     """
 
     tol: float = 1e-6
