@@ -8,7 +8,10 @@ the bounds, the *elastic* subproblem (slacks on the equalities too) gives the st
 so an infeasible linearisation still yields a step. The step is accepted by backtracking
 on φ (Armijo, η = 1e-4); ρ is kept above twice the largest equality multiplier (exactness)
 and never below 10; μ acts as an inverse trust radius: ×10 when the full step's actual
-merit decrease is under 0.1 of the predicted one, ×0.3 when it is over 0.5. Converged: max scaled violation ≤ tol and predicted merit decrease ≤ ftol·max(1, J̃).
+merit decrease is under 0.1 of the predicted one, ×0.3 when it is over 0.5. Converged: max scaled violation ≤ tol and predicted merit decrease ≤ ftol·max(1, J̃),
+confirmed by an accurate QP solve. Curvature: the cost's exact Hessian plus partitioned
+damped-BFGS blocks per node for the constraints; a Gauss–Newton restoration step precedes
+the elastic QP when the linearisation is infeasible.
 
 Why this globalisation rather than TrajOpt's penalty trust region: with every equality
 softened by slacks the subproblem is LP-like and OSQP (ADMM) needs thousands of iterations
