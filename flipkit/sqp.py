@@ -2,13 +2,14 @@
 
 Merit φ(Z) = J̃(Z) + ρ ‖v(Z)‖₁, v the scaled constraint violation. Each iteration linearises
 the constraints at Z_k and solves the convex subproblem (:mod:`flipkit.qp`, cvxpy + OSQP):
-linearised equalities hard, inequalities with ℓ1-penalised slacks, a proximal term ½μ‖d‖²
-and a step cap |d| ≤ Δ (scaled units). If the linearised equalities are incompatible with
-the bounds, the *elastic* subproblem (slacks on the equalities too) gives the step instead,
+all linearised constraints hard, a proximal term ½μ‖d‖² and a step cap |d| ≤ Δ (scaled
+units). If they are incompatible with the bounds, the *elastic* subproblem (ℓ1-penalised
+slacks on every row) gives the step instead,
 so an infeasible linearisation still yields a step. The step is accepted by backtracking
 on φ (Armijo, η = 1e-4); ρ is kept above twice the largest equality multiplier (exactness)
 and never below 10; μ acts as an inverse trust radius: ×10 when the full step's actual
-merit decrease is under 0.1 of the predicted one, ×0.3 when it is over 0.5. Converged: max scaled violation ≤ tol and predicted merit decrease ≤ ftol·max(1, J̃),
+merit decrease is under 0.1 of the predicted one, ×0.3 when it is over 0.5.
+Converged: max scaled violation ≤ tol and predicted merit decrease ≤ ftol·max(1, J̃),
 confirmed by an accurate QP solve. Curvature: the cost's exact Hessian plus partitioned
 damped-BFGS blocks per node for the constraints; a Gauss–Newton restoration step precedes
 the elastic QP when the linearisation is infeasible.
