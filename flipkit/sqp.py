@@ -91,20 +91,15 @@ class SolveResult:
 
 
 def _correction_residual(nlp: NLP, c: np.ndarray):
-    """Rows to pull onto their bounds (equalities and violated inequalities) and the
-    scaled residuals there: c − bound."""
+    """Scaled residuals c − bound and the rows to pull onto their bounds (equalities and
+    violated inequalities), in the argument order of :func:`_min_norm_correction`."""
     lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
     cs = nlp.c_scale * c
     target = np.where(cs < lo, lo, np.where(cs > hi, hi, cs))
     eq = nlp.c_lo == nlp.c_hi
     target[eq] = lo[eq]
     rows = np.flatnonzero(eq | (cs < lo) | (cs > hi))
-    return rows, cs - target
-
-
-def _swap(pair):
-    rows, r = pair
-    return r, rows
+    return cs - target, rows
 
 
 def _min_norm_correction(J: sp.csr_matrix, r: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -163,7 +158,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         return c, jac, nlp.objective(x) * nlp.obj_scale, nlp.scaled_violation(c)
 
     c, jac, f, v = point(x)
-    x_prev, jac_prev = x, jac
+    x_prev = x
     rho, mu = options.rho0, options.prox0
     lam = np.zeros(nlp.m)  # multipliers, raw row units
     eq_rows = np.flatnonzero(nlp.c_lo == nlp.c_hi)
@@ -172,6 +167,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     while it < options.max_iter:
         it += 1
         grad = nlp.gradient(x) * nlp.obj_scale * D
+        J = J_of(jac)  # scaled Jacobian at Z_k, shared by the model, corrections and BFGS
         d_lo = np.maximum((nlp.x_lb - x) / D, -options.step_cap)
         d_hi = np.minimum((nlp.x_ub - x) / D, options.step_cap)
         sol, restored = None, False
@@ -186,7 +182,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             if not elastic and v.max(initial=0.0) > options.tol:
                 # Restoration (before the slow elastic QP): a Gauss–Newton step onto the
                 # equalities, J_E Δ = −c_E, kept if it lowers the violation.
-                delta = _min_norm_correction(J_of(jac), *_swap(_correction_residual(nlp, c)))
+                delta = _min_norm_correction(J, *_correction_residual(nlp, c))
                 x_r = np.clip(x + D * delta, nlp.x_lb, nlp.x_ub)
                 c_r, jac_r, f_r, v_r = point(x_r)
                 if v_r.sum() < 0.5 * v.sum():
@@ -198,7 +194,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
                         "merit": float(f + rho * v.sum()), "pred": 0.0, "ratio": 0.0, "step": 1.0,
                         "prox": mu, "rho": rho, "qp_iters": sol.iterations,
                         "qp_status": "restoration", "elastic": False})
-            x_prev, jac_prev = x, jac
+            x_prev = x
             continue
         if sol.eq_duals is not None and sol.status == "optimal":
             rho = max(rho, 2.0 * float(np.abs(sol.eq_duals).max(initial=0.0)))
@@ -209,7 +205,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         def model(sol):
             nonlocal rho
             d = sol.d
-            c_lin = nlp.c_scale * c + J_of(jac) @ d
+            c_lin = nlp.c_scale * c + J @ d
             lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin,
                                           c_lin - nlp.c_scale * nlp.c_hi), 0)
             curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
@@ -241,7 +237,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             c_full, jac_full, f_full, v_full = point(x_full)
             ratio = (merit - (f_full + rho * v_full.sum())) / pred
             if ratio < options.accept_ratio:
-                delta = _min_norm_correction(J_of(jac), *_swap(_correction_residual(nlp, c_full)))
+                delta = _min_norm_correction(J, *_correction_residual(nlp, c_full))
                 x_soc = np.clip(x + D * (d + delta), nlp.x_lb, nlp.x_ub)
                 c_s, jac_s, f_s, v_s = point(x_soc)
                 ratio_soc = (merit - (f_s + rho * v_s.sum())) / pred
@@ -268,13 +264,13 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             # of the Lagrangian gradient, J̃ᵀỹ with this step's multipliers, at both ends.
             y_eq = np.zeros(nlp.m)
             y_eq[eq_rows] = sol.eq_duals
-            g_new, g_old = J_of(jac).T @ y_eq, J_of(jac_prev).T @ y_eq
+            g_new, g_old = J_of(jac).T @ y_eq, J.T @ y_eq
             s_all = (x - x_prev) / D
             if curvature is None:
                 curvature = [options.bfgs_init * np.eye(len(b)) for b in nlp.curvature_blocks]
             curvature = [_damped_bfgs(B, s_all[b], (g_new - g_old)[b])
                          for B, b in zip(curvature, nlp.curvature_blocks)]
-        x_prev, jac_prev = x, jac
+        x_prev = x
         # Levenberg–Marquardt update from the full step's agreement with the model.
         if status != "solved":
             if ratio < 0.1:
@@ -290,9 +286,9 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         if mu > options.prox_max:
             # Before giving up: a few minimum-norm Newton corrections onto the equalities
             # (feasibility polishing) — the iterate is usually stationary but a hair outside.
-            x_c, c_c = x, c
+            x_c, c_c, jac_c = x, c, jac
             for _ in range(3):
-                delta = _min_norm_correction(J_of(point(x_c)[1]), *_swap(_correction_residual(nlp, c_c)))
+                delta = _min_norm_correction(J_of(jac_c), *_correction_residual(nlp, c_c))
                 x_c = np.clip(x_c + D * delta, nlp.x_lb, nlp.x_ub)
                 c_c, jac_c, f_c, v_c = point(x_c)
                 if v_c.max(initial=0.0) <= options.tol:
