@@ -58,10 +58,6 @@ class NLP:
         self.c_scale = np.concatenate([b.scale for b in self.blocks])
         self.u_index = np.concatenate([layout.iu(i) for i in range(layout.n_nodes)])
         self.obj_scale = 1.0 / (layout.n_nodes * 1e4)  # Σu² of a UR10 holding a pose is ~1e4/node
-        dyn = [b for b in self.blocks if hasattr(b, "lagrangian_hessians")]
-        self._curved = dyn[0] if dyn else None
-        self.curvature_blocks = ([dyn[0].node_indices(i) for i in range(layout.n_nodes)]
-                                 if dyn else [])
 
     @property
     def structure_key(self) -> str:
@@ -98,16 +94,13 @@ class NLP:
         h[self.u_index] = 2.0
         return h
 
-    def lagrangian_curvature(self, x, lam) -> list[np.ndarray]:
-        """Blocks of ∇²(λᵀc) on :attr:`curvature_blocks` (the dynamics rows), raw units.
-
-        Args:
-            x: Point. lam: Multipliers of all m constraint rows, raw (unscaled) row units.
-        """
-        if self._curved is None:
-            return []
-        ev = Evaluation(self.layout, self.robot, np.asarray(x, float))
-        return self._curved.lagrangian_hessians(ev, lam[self.block_slices[self._curved.name]])
+    def project(self, x) -> np.ndarray:
+        """x with the blocks' exact corrections applied (u from the dynamics), within bounds."""
+        x = np.asarray(x, float)
+        for b in self.blocks:
+            if hasattr(b, "project"):
+                x = b.project(x, self.robot)
+        return np.clip(x, self.x_lb, self.x_ub)
 
     # ------------------------------------------------------------- feasibility
     def scaled_violation(self, c: np.ndarray) -> np.ndarray:

@@ -2,26 +2,27 @@
 
 In scaled variables d (Z = Z_k + Z_scale ⊙ d) the subproblem at Z_k is
 
-    minimise   gᵀd + ½ dᵀ H d + ρ (1ᵀ s_lo + 1ᵀ s_hi)
-    subject to (c + J d − c_lo)[equality rows] = 0
-               (c + J d − c_lo)[finite lo] ≥ 0,  (c_hi − c − J d)[finite hi] ≥ 0
-               d_lo ≤ d ≤ d_hi     (variable bounds ∩ trust box |d| ≤ Δ)
+    minimise   gᵀd + ½ dᵀ diag(h) d  [+ ½σ‖s‖²]
+    subject to (c + J d − c_lo)[equality rows] = 0        [= s⁺ − s⁻]
+               (c + J d − c_lo)[finite lo] ≥ 0,  (c_hi − c − J d)[finite hi] ≥ 0   [+ s ≥ 0]
+               d_lo ≤ d ≤ d_hi     (variable bounds ∩ trust box |d|∞ ≤ Δ)
 
-with c, J scaled. The linearised constraints are hard (OSQP treats equality rows with its
-larger step parameter) unless they are incompatible with the bounds, when the *elastic*
-variant with ℓ1-penalised slacks s on every row (and ½σ‖s‖²) is used, so that every
-linearisation still yields a step. A proximal term ½μ‖d‖² makes the QP strongly convex:
-without it, and with slacks on every row, OSQP (ADMM) needs thousands of iterations on this
-LP-like structure; hard rows and the proximal term bring it to tens or hundreds. J enters as a
-parameter vector of its nonzeros on the NLP's fixed pattern: J d = S_r (j ⊙ S_c d), with
-constant selection matrices S_c, S_r, so the problem is DPP and is canonicalised once;
-re-solves only update parameter values and OSQP warm-starts from the previous solution.
-Build (:class:`QPSubproblem`) is separate from solve, so the QP can be inspected alone.
+with c, J scaled. h is the cost's exact (diagonal) Hessian plus a small proximal weight, so
+with the hard linearised dynamics rows this is the Gauss–Newton model of Σu². The bracketed
+slacks form the *elastic* variant, used only when the hard rows are incompatible with the
+box (or OSQP fails on them), so that every linearisation still yields a step. Its slacks are
+penalised quadratically, a least-squares compromise between the rows: with an ℓ1 term
+ρ1ᵀs the QP is LP-like and OSQP hit its iteration cap on the flip segments (measured).
+
+J enters as a parameter vector of its nonzeros on the NLP's fixed pattern: J d = S_r (j ⊙ S_c
+d), with constant selection matrices S_c, S_r, so the problem is DPP and is canonicalised
+once per structure; re-solves only map new parameter values and OSQP warm-starts. Written as
+Σ h_k d_k² the Hessian adds no auxiliary variables to the OSQP problem. Build
+(:class:`QPSubproblem`) is separate from solve, so the QP can be inspected alone.
 """
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -29,26 +30,28 @@ import numpy as np
 import scipy.sparse as sp
 
 from .nlp import NLP
+from .osqp_driver import OSQPDriver
 
-# Tolerances 1e-4 with solution polishing: polishing makes a solve exact once the active
-# set is found, and looser ADMM tolerances cut OSQP iterations ~4x (measured).
-# Deterministic OSQP: a fixed adaptive-rho interval (interval 0 would time the setup and
-# adapt rho after a fraction of it, which varies run to run; OSQP 1.x rejects fraction 0).
-OSQP_SETTINGS = dict(eps_abs=1e-4, eps_rel=1e-4, max_iter=4000, adaptive_rho_interval=25,
-                     polishing=True, polish_refine_iter=5,
-                     check_termination=25, verbose=False)
+# OSQP: solution polishing turns an ADMM iterate into the exact solution of the identified
+# active set; at eps 1e-5 polishing succeeds on these problems, at 1e-4 it mostly fails and
+# the SQP's tail then stalls on the residuals (measured). Deterministic: a fixed adaptive-rho
+# interval (interval 0 would time the setup and adapt rho after a fraction of it, which
+# varies run to run).
+OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
+                     polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
 
 
 @dataclass
 class QPSolution:
-    """d (scaled step), the model's penalised objective value, OSQP status and iterations."""
+    """d (scaled step), OSQP status and iterations, and the row multipliers y (m,) in scaled
+    row units with ∇(gᵀd + ½dᵀHd) + Jᵀy + (box multipliers) = 0 at the solution: y ≥ 0 on an
+    active upper bound, ≤ 0 on an active lower bound, free on an equality."""
 
     d: np.ndarray
-    model_value: float
-    linear_violation: float
     status: str
     iterations: int
-    eq_duals: np.ndarray | None = None
+    multipliers: np.ndarray
+    polished: bool = False
 
 
 class QPSubproblem:
@@ -56,11 +59,12 @@ class QPSubproblem:
 
     Args:
         nlp: An NLP of the structure; its values are not used, only the pattern.
+        elastic: Build the variant with ℓ1-penalised slacks on every row.
     """
 
     def __init__(self, nlp: NLP, elastic: bool = False):
         n, m, nnz = nlp.n, nlp.m, len(nlp.jac_rows)
-        self.elastic = elastic
+        self.elastic, self.m = elastic, m
         self.key = nlp.structure_key
         eq = nlp.c_lo == nlp.c_hi
         self.eq_rows = np.flatnonzero(eq)
@@ -74,24 +78,10 @@ class QPSubproblem:
         self.r_lo = cp.Parameter(len(self.lo_rows), name="c_minus_lo")
         self.r_hi = cp.Parameter(len(self.hi_rows), name="hi_minus_c")
         self.grad = cp.Parameter(n, name="gradient")
+        self.hess = cp.Parameter(n, nonneg=True, name="hessian_diagonal")
         self.d_lo = cp.Parameter(n, name="d_lo")
         self.d_hi = cp.Parameter(n, name="d_hi")
-        self.rho = cp.Parameter(nonneg=True, name="penalty")
         self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
-        self.hess_sqrt = cp.Parameter(n, nonneg=True, name="hessian_sqrt")
-        # Curvature of the Lagrangian on per-node blocks: ½‖F d‖², F stacked factors
-        # F_i (b x b, on the block's variables) with H_i = F_iᵀF_i ⪰ 0, as a parameter on
-        # a fixed pattern (the same selection trick as the Jacobian).
-        self.blocks = [np.asarray(b, int) for b in nlp.curvature_blocks]
-        f_rows = np.concatenate([np.repeat(np.arange(len(b)) + sum(map(len, self.blocks[:k])), len(b))
-                                 for k, b in enumerate(self.blocks)]) if self.blocks else np.zeros(0, int)
-        f_cols = np.concatenate([np.tile(b, len(b)) for b in self.blocks]) if self.blocks else np.zeros(0, int)
-        nf = len(f_cols)
-        self.factor = cp.Parameter(nf, name="curvature_factor")
-        F_c = sp.csr_matrix((np.ones(nf), (np.arange(nf), f_cols)), shape=(nf, n))
-        F_r = sp.csr_matrix((np.ones(nf), (f_rows, np.arange(nf))),
-                            shape=(int(f_rows.max(initial=-1)) + 1, nf))
-        Fd = F_r @ cp.multiply(self.factor, F_c @ self.d)
         Jd = cp.multiply(self.jac, S_c @ self.d)
         cons = [self.d >= self.d_lo, self.d <= self.d_hi]
         slacks = []
@@ -103,77 +93,71 @@ class QPSubproblem:
             slacks.append(s)
             return s
 
-        self.eq_constraint = None
+        self.rows = {}
         if len(self.eq_rows):
             k = len(self.eq_rows)
-            self.eq_constraint = self.r_eq + S_r[self.eq_rows] @ Jd == slack(k, "s_plus") - slack(k, "s_minus")
-            cons.append(self.eq_constraint)
+            self.rows["eq"] = self.r_eq + S_r[self.eq_rows] @ Jd == slack(k, "s_plus") - slack(k, "s_minus")
         if len(self.lo_rows):
-            cons.append(self.r_lo + S_r[self.lo_rows] @ Jd + slack(len(self.lo_rows), "s_lo") >= 0)
+            self.rows["lo"] = self.r_lo + S_r[self.lo_rows] @ Jd + slack(len(self.lo_rows), "s_lo") >= 0
         if len(self.hi_rows):
-            cons.append(self.r_hi - S_r[self.hi_rows] @ Jd + slack(len(self.hi_rows), "s_hi") >= 0)
-        obj = self.grad @ self.d + 0.5 * cp.sum_squares(cp.multiply(self.hess_sqrt, self.d))
-        if nf:
-            obj = obj + 0.5 * cp.sum_squares(Fd)
+            self.rows["hi"] = self.r_hi - S_r[self.hi_rows] @ Jd + slack(len(self.hi_rows), "s_hi") >= 0
+        cons += list(self.rows.values())
+        obj = self.grad @ self.d + 0.5 * cp.sum(cp.multiply(self.hess, cp.square(self.d)))
         if elastic:
-            obj = obj + self.rho * sum(cp.sum(s) for s in slacks) \
-                + 0.5 * self.slack_reg * sum(cp.sum_squares(s) for s in slacks)
+            obj = obj + 0.5 * self.slack_reg * sum(cp.sum_squares(s) for s in slacks)
         self.problem = cp.Problem(cp.Minimize(obj), cons)
-        self._slacks = slacks
         if not self.problem.is_dpp():  # pragma: no cover - a programming error
             raise RuntimeError("the SQP subproblem must be DPP")
 
     def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
-               d_lo: np.ndarray, d_hi: np.ndarray, rho: float, slack_reg: float = 1e-2,
-               curvature: list[np.ndarray] | None = None) -> None:
+               d_lo: np.ndarray, d_hi: np.ndarray, slack_reg: float = 1e2) -> None:
         """Set the parameter values for a linearisation (all in scaled units).
 
-        ``curvature``: per block of ``nlp.curvature_blocks`` a PSD matrix (scaled units);
-        None means zero.
+        Args:
+            nlp: The NLP (for its bounds and row scales). c: Scaled constraint values (m,).
+            jac: Scaled Jacobian entries on the pattern. grad, hess: Cost gradient and
+                Hessian diagonal (with any proximal weight). d_lo, d_hi: Step box.
+            slack_reg: Weight σ of ½σ‖s‖² on the elastic slacks.
         """
-        if curvature is None:
-            self.factor.value = np.zeros(self.factor.shape)
-        else:
-            parts = []
-            for H in curvature:
-                w, V = np.linalg.eigh(0.5 * (H + H.T))
-                parts.append((np.sqrt(np.maximum(w, 0.0))[:, None] * V.T).ravel())
-            self.factor.value = np.concatenate(parts)
         self.jac.value = jac
         self.r_eq.value = (c - nlp.c_scale * nlp.c_lo)[self.eq_rows]
         self.r_lo.value = (c - nlp.c_scale * nlp.c_lo)[self.lo_rows]
         self.r_hi.value = (nlp.c_scale * nlp.c_hi - c)[self.hi_rows]
-        self.grad.value, self.hess_sqrt.value = grad, np.sqrt(hess)
-        self.d_lo.value, self.d_hi.value, self.rho.value = d_lo, d_hi, rho
+        self.grad.value, self.hess.value = grad, hess
+        self.d_lo.value, self.d_hi.value = d_lo, np.maximum(d_hi, d_lo)
         self.slack_reg.value = slack_reg
 
     def reset(self) -> None:
         """Forget OSQP's state: the next solve sets up afresh (no warm start)."""
-        self.problem._solver_cache.clear()
+        if hasattr(self, "_driver"):
+            self._driver.reset()
 
     def solve(self, eps: float | None = None) -> QPSolution:
-        """Solve with OSQP, warm-started from the previous solve of this problem.
+        """Solve with OSQP (:class:`~flipkit.osqp_driver.OSQPDriver`: persistent solver,
+        fixed pattern, warm start, working set of inequality rows).
 
         Args:
-            eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS` (for a final,
-                accurate solve).
+            eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS`.
         """
         settings = dict(OSQP_SETTINGS)
         if eps is not None:
             settings.update(eps_abs=eps, eps_rel=eps)
-        with warnings.catch_warnings():  # inaccurate solves are reported through the status
-            warnings.simplefilter("ignore", UserWarning)
-            self.problem.solve(solver=cp.OSQP, warm_start=True, **settings)
-        stats = self.problem.solver_stats
-        d = self.d.value
-        if d is None:
-            d = np.zeros(self.d.shape)
-        return QPSolution(d=np.asarray(d), model_value=float(self.problem.value or np.inf),
-                          linear_violation=float(sum(np.sum(s.value) for s in self._slacks
-                                                     if s.value is not None)),
-                          status=str(self.problem.status), iterations=int(stats.num_iters or 0),
-                          eq_duals=None if self.eq_constraint is None or self.eq_constraint.dual_value
-                          is None else np.asarray(self.eq_constraint.dual_value))
+        if not hasattr(self, "_driver"):
+            self._driver = OSQPDriver(self.problem)
+        res, iterations = self._driver.solve(settings)
+        ok = res.info.status_val in (1, 2, 3, 4)
+        status = str(self.problem.status) if ok else f"osqp:{res.info.status}"
+        d = self.d.value if ok and res.info.status_val in (1, 2) else None
+        y = np.zeros(self.m)
+        # cvxpy's duals: L = f − μᵀ(expr) for `expr ≥ 0` (μ ≥ 0), f + λᵀ(expr) for `expr == 0`.
+        for key, rows, sign in (("eq", self.eq_rows, 1.0), ("lo", self.lo_rows, -1.0),
+                                ("hi", self.hi_rows, 1.0)):
+            con = self.rows.get(key)
+            if d is not None and con is not None and con.dual_value is not None:
+                y[rows] = sign * np.asarray(con.dual_value)
+        return QPSolution(d=np.zeros(self.d.shape) if d is None else np.asarray(d),
+                          status=status, iterations=iterations,
+                          multipliers=y, polished=res.info.status_polish == 1)
 
 
 _CACHE: dict[tuple[str, bool], QPSubproblem] = {}

@@ -1,23 +1,27 @@
-"""SQP with an exact-ℓ1 merit line search and Levenberg–Marquardt damping.
+"""SQP: Gauss–Newton subproblems (cvxpy + OSQP), exact dynamics projection, ℓ1 merit.
 
-Merit φ(Z) = J̃(Z) + ρ ‖v(Z)‖₁, v the scaled constraint violation. Each iteration linearises
-the constraints at Z_k and solves the convex subproblem (:mod:`flipkit.qp`, cvxpy + OSQP):
-all linearised constraints hard, a proximal term ½μ‖d‖² and a step cap |d| ≤ Δ (scaled
-units). If they are incompatible with the bounds, the *elastic* subproblem (ℓ1-penalised
-slacks on every row) gives the step instead,
-so an infeasible linearisation still yields a step. The step is accepted by backtracking
-on φ (Armijo, η = 1e-4); ρ is kept above twice the largest equality multiplier (exactness)
-and never below 10; μ acts as an inverse trust radius: ×10 when the full step's actual
-merit decrease is under 0.1 of the predicted one, ×0.3 when it is over 0.5.
-Converged: max scaled violation ≤ tol and predicted merit decrease ≤ ftol·max(1, J̃),
-confirmed by an accurate QP solve. Curvature: the cost's exact Hessian plus partitioned
-damped-BFGS blocks per node for the constraints; a Gauss–Newton restoration step precedes
-the elastic QP when the linearisation is infeasible.
+Each iteration linearises the constraints at Z_k and solves the convex subproblem of
+:mod:`flipkit.qp`: the cost's exact Hessian (2 on the torques) plus a small proximal weight,
+every linearised row hard, and a box trust region |d|∞ ≤ Δ in scaled units. With the
+dynamics rows u = RNEA(q, q̇, q̈) hard, this is the Gauss–Newton model of Σ‖RNEA‖² along the
+linearised constraints; it needs no second derivatives and no quasi-Newton memory.
 
-Why this globalisation rather than TrajOpt's penalty trust region: with every equality
-softened by slacks the subproblem is LP-like and OSQP (ADMM) needs thousands of iterations
-per solve; hard equalities plus the proximal term make it strongly convex and OSQP then
-converges in tens to hundreds of iterations, warm-started.
+Globalisation. Every trial point is *projected* first: u_i := RNEA(q_i, q̇_i, q̈_i), which
+satisfies the dynamics rows exactly (u enters them alone and linearly). Without it the
+ℓ1 merit sees the dynamics rows' second-order error and rejects any step longer than a few
+hundredths of a radian (the Maratos effect, measured: actual/predicted ≈ −300 at the step
+cap). A trial point Z + a·d, a ∈ {1, ½, ¼, ⅛}, is accepted when the merit
+φ = J̃ + ρ‖v‖₁ (v the scaled violation) falls by at least η·a·pred, pred being the model's
+decrease; ρ stays above twice the largest QP multiplier (exact penalty). Δ doubles after a
+full step with actual/predicted ≥ 0.75 that used at least half of it and shrinks to the
+accepted length otherwise (a tenth of the step when nothing is accepted). If the hard
+rows are incompatible with the box, the *elastic* subproblem (quadratically penalised
+slacks) gives the step, so an infeasible linearisation still yields one.
+
+Converged: max scaled violation ≤ ``tol`` and predicted merit decrease ≤ ``ftol``·J̃.
+
+Why not TrajOpt's penalty trust region: with every equality softened by slacks the
+subproblem is LP-like and OSQP needed 6 000–20 000 ADMM iterations per solve (measured).
 """
 
 from __future__ import annotations
@@ -29,46 +33,52 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .errors import NoSolutionFound
+from .errors import ConfigError, NoSolutionFound
 from .nlp import NLP
 from .qp import subproblem_for
 
 
 @dataclass(frozen=True)
 class SQPOptions:
-    """Settings.
+    """Settings (lengths in scaled variable units).
 
     Attributes:
         tol: Feasibility tolerance on the max scaled violation.
-        ftol: Relative predicted merit decrease below which the iterate is stationary.
-        rho0: Smallest ℓ1 penalty. step_cap: Bound Δ on |d| (scaled units).
-        prox0, prox_min, prox_max: Levenberg–Marquardt weight μ of ½μ‖d‖² (scaled units).
-        slack_reg: ½σ‖s‖² on the slacks (keeps the QP strongly convex).
-        armijo: Sufficient-decrease fraction η. min_step: Smallest line-search step.
-        max_iter: Cap on SQP iterations.
-        accept_ratio: Smallest actual/predicted merit decrease for a full (or corrected) step.
-        curvature: Constraint curvature in the subproblem: ``"bfgs"`` (partitioned damped
-            BFGS on the per-node (q, q̇, q̈) blocks), ``"dynamics"`` (finite-difference
-            Hessian of the dynamics rows only) or ``"none"``.
-        bfgs_init: Initial diagonal of the BFGS blocks (scaled units).
-        final_qp_eps: OSQP tolerance of the confirming solve at an apparently stationary point.
+        ftol: Predicted merit decrease, relative to J̃ (at least 1e-3), below which Z is
+            stationary; a stationary Z a hair outside gets Newton corrections onto the rows.
+        max_iter: Cap on SQP iterations (QP solves).
+        trust0, trust_min, trust_max: Initial, smallest and largest trust box Δ.
+        prox: Proximal weight μ of ½μ‖d‖² (strong convexity on directions without cost).
+        eta: Sufficient-decrease fraction of the predicted merit decrease.
+        backtracks: Halvings of the step tried before the step is rejected.
+        rho_min: Smallest ℓ1 penalty.
+        slack_reg, restoration_prox: The elastic (restoration) step minimises
+            ½σ‖s‖² + ½μ_r‖d‖², a Levenberg–Marquardt step on the violation.
+        qp_eps, qp_eps_factor: OSQP tolerance = factor × max(violation, last predicted
+            decrease), clipped to the (min, max) range: loose far from the solution, tight
+            near it, where the step must resolve residuals below ``tol`` (inexact SQP).
     """
 
     tol: float = 1e-6
-    ftol: float = 1e-6
-    rho0: float = 10.0
-    step_cap: float = 1.0
-    prox0: float = 1e-3
-    prox_min: float = 1e-4
-    prox_max: float = 1e4
-    slack_reg: float = 1e3
-    armijo: float = 1e-4
-    min_step: float = 1e-2
-    max_iter: int = 300
-    accept_ratio: float = 0.1
-    curvature: str = "bfgs"
-    bfgs_init: float = 1e-4
-    final_qp_eps: float = 1e-8
+    ftol: float = 1e-5
+    max_iter: int = 100
+    trust0: float = 1.0
+    trust_min: float = 1e-6
+    trust_max: float = 1.0
+    prox: float = 1e-4
+    eta: float = 0.1
+    backtracks: int = 5
+    rho_min: float = 1e-3
+    slack_reg: float = 1.0
+    restoration_prox: float = 1e-2
+    qp_eps: tuple[float, float] = (1e-9, 1e-6)
+    qp_eps_factor: float = 0.01
+
+    def __post_init__(self):
+        if not (0 < self.trust_min <= self.trust0 <= self.trust_max):
+            raise ConfigError("need 0 < trust_min <= trust0 <= trust_max")
+        if not (0 < self.eta < 1) or self.tol <= 0 or self.ftol <= 0 or self.max_iter < 1:
+            raise ConfigError("need 0 < eta < 1, tol > 0, ftol > 0 and max_iter >= 1")
 
 
 @dataclass
@@ -90,49 +100,30 @@ class SolveResult:
         return self.status == "solved"
 
 
-def _correction_residual(nlp: NLP, c: np.ndarray):
-    """Scaled residuals c − bound and the rows to pull onto their bounds (equalities and
-    violated inequalities), in the argument order of :func:`_min_norm_correction`."""
+class _Point:
+    """Z with its scaled cost, constraint values, Jacobian entries and violation."""
+
+    def __init__(self, nlp: NLP, x: np.ndarray):
+        self.x = x
+        self.c, self.jac = nlp.evaluate(x)
+        self.f = nlp.objective(x) * nlp.obj_scale
+        self.v = nlp.scaled_violation(self.c)
+
+    def merit(self, rho: float) -> float:
+        return self.f + rho * float(self.v.sum())
+
+
+def _correction(nlp: NLP, p: _Point, J: sp.csr_matrix) -> np.ndarray:
+    """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
+    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound."""
+    cs = nlp.c_scale * p.c
     lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
-    cs = nlp.c_scale * c
-    target = np.where(cs < lo, lo, np.where(cs > hi, hi, cs))
-    eq = nlp.c_lo == nlp.c_hi
-    target[eq] = lo[eq]
-    rows = np.flatnonzero(eq | (cs < lo) | (cs > hi))
-    return cs - target, rows
-
-
-def _min_norm_correction(J: sp.csr_matrix, r: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """Δ = −J_Rᵀ (J_R J_Rᵀ)⁻¹ r_R: the least-norm step zeroing the linearised residuals r on
-    the rows R (a singular system skips the correction)."""
-    JE = J[rows]
-    try:
-        K = (JE @ JE.T + 1e-12 * sp.identity(len(rows))).tocsc()
-        y = spla.spsolve(K, r[rows])
-    except RuntimeError:  # singular: skip the correction
-        return np.zeros(J.shape[1])
-    delta = -(JE.T @ y)
+    r = cs - np.clip(cs, lo, hi)
+    rows = np.flatnonzero((nlp.c_lo == nlp.c_hi) | (r != 0))
+    JR = J[rows]
+    K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
+    delta = -(JR.T @ spla.spsolve(K, r[rows]))
     return np.where(np.isfinite(delta), delta, 0.0)
-
-
-def _damped_bfgs(B: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Powell-damped BFGS update of a positive definite block (Nocedal & Wright, Proc. 18.2)."""
-    Bs = B @ s
-    sBs = float(s @ Bs)
-    if sBs <= 1e-16:
-        return B
-    sy = float(s @ y)
-    if sy < 0.2 * sBs:
-        theta = 0.8 * sBs / (sBs - sy)
-        y = theta * y + (1 - theta) * Bs
-        sy = float(s @ y)
-    return B - np.outer(Bs, Bs) / sBs + np.outer(y, y) / sy
-
-
-def _psd_quad(H: np.ndarray, d: np.ndarray) -> float:
-    """dᵀ H₊ d with H₊ the PSD part of H (what the subproblem uses)."""
-    w, V = np.linalg.eigh(0.5 * (H + H.T))
-    return float(np.maximum(w, 0.0) @ (V.T @ d) ** 2)
 
 
 def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_failure=True
@@ -146,161 +137,84 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     t0 = time.perf_counter()
     for elastic in (False, True):  # no warm start from another NLP: results must not depend
         subproblem_for(nlp, elastic).reset()  # on what was solved before in this process
-    D = nlp.x_scale
-    x = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
+    o, D = options, nlp.x_scale
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
-    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
-    J_of = lambda jac: sp.csr_matrix((jac * Jscale, (nlp.jac_rows, nlp.jac_cols)),
-                                     shape=(nlp.m, nlp.n))
-
-    def point(x):
-        c, jac = nlp.evaluate(x)
-        return c, jac, nlp.objective(x) * nlp.obj_scale, nlp.scaled_violation(c)
-
-    c, jac, f, v = point(x)
-    x_prev = x
-    rho, mu = options.rho0, options.prox0
-    lam = np.zeros(nlp.m)  # multipliers, raw row units
-    eq_rows = np.flatnonzero(nlp.c_lo == nlp.c_hi)
-    curvature = None
-    log, qp_iters, status, it = [], 0, "max_iter", 0
-    while it < options.max_iter:
+    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + o.prox
+    lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    p = _Point(nlp, nlp.project(nlp.x0 if x0 is None else x0))
+    rho, trust = o.rho_min, o.trust0
+    log, qp_iters, status, it, pred = [], 0, "max_iter", 0, np.inf
+    while it < o.max_iter:
         it += 1
-        grad = nlp.gradient(x) * nlp.obj_scale * D
-        J = J_of(jac)  # scaled Jacobian at Z_k, shared by the model, corrections and BFGS
-        d_lo = np.maximum((nlp.x_lb - x) / D, -options.step_cap)
-        d_hi = np.minimum((nlp.x_ub - x) / D, options.step_cap)
-        sol, restored = None, False
+        grad = nlp.gradient(p.x) * nlp.obj_scale * D
+        d_lo = np.maximum((nlp.x_lb - p.x) / D, -trust)
+        d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
         for elastic in (False, True):
             qp = subproblem_for(nlp, elastic)
-            qp.update(nlp, nlp.c_scale * c, jac * Jscale, grad, hess + mu, d_lo, d_hi, rho,
-                      options.slack_reg, curvature)
-            sol = qp.solve()
+            # The elastic step is a feasibility step: least-squares slacks, no cost.
+            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, 0 * grad if elastic else grad,
+                      np.full(nlp.n, o.restoration_prox) if elastic else hess, d_lo, d_hi, o.slack_reg)
+            theta = max(float(p.v.max(initial=0.0)), pred)
+            sol = qp.solve(eps=float(np.clip(o.qp_eps_factor * theta, *o.qp_eps)))
             qp_iters += sol.iterations
             if sol.status == "optimal":
                 break
-            if not elastic and v.max(initial=0.0) > options.tol:
-                # Restoration (before the slow elastic QP): a Gauss–Newton step onto the
-                # equalities, J_E Δ = −c_E, kept if it lowers the violation.
-                delta = _min_norm_correction(J, *_correction_residual(nlp, c))
-                x_r = np.clip(x + D * delta, nlp.x_lb, nlp.x_ub)
-                c_r, jac_r, f_r, v_r = point(x_r)
-                if v_r.sum() < 0.5 * v.sum():
-                    x, c, jac, f, v = x_r, c_r, jac_r, f_r, v_r
-                    restored = True
+        d = sol.d
+        rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
+        J = sp.csr_matrix((p.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
+        c_lin = nlp.c_scale * p.c + J @ d
+        lin_v = np.maximum(np.maximum(lo - c_lin, c_lin - hi), 0.0).sum()
+        model_f = grad @ d + 0.5 * d @ (hess * d)
+        reduction = float(p.v.sum()) - lin_v
+        if model_f > 0 and reduction > 0:  # the step must descend on φ (elastic steps have
+            rho = max(rho, 2.0 * model_f / reduction)  # no informative multipliers)
+        pred = p.merit(rho) - (p.f + model_f + rho * lin_v)
+        step, ratio, accepted = 1.0, 0.0, False
+        stationary = sol.status == "optimal" and pred <= o.ftol * max(p.f, 1e-3)
+        if stationary and p.v.max(initial=0.0) > o.tol:
+            # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
+            # curved active rows): Newton corrections onto the violated rows.
+            for _ in range(3):
+                q = _Point(nlp, nlp.project(p.x + D * _correction(nlp, p, J)))
+                if q.v.sum() >= p.v.sum():
                     break
-        if restored:
-            log.append({"iter": it, "objective": nlp.objective(x), "violation": float(v.max(initial=0)),
-                        "merit": float(f + rho * v.sum()), "pred": 0.0, "ratio": 0.0, "step": 1.0,
-                        "prox": mu, "rho": rho, "qp_iters": sol.iterations,
-                        "qp_status": "restoration", "elastic": False})
-            x_prev = x
-            continue
-        if sol.eq_duals is not None and sol.status == "optimal":
-            rho = max(rho, 2.0 * float(np.abs(sol.eq_duals).max(initial=0.0)))
-            lam_new = np.zeros(nlp.m)  # cvxpy: L = f + yᵀ(expr) for `expr == 0`
-            lam_new[eq_rows] = sol.eq_duals * nlp.c_scale[eq_rows] / nlp.obj_scale
-        else:
-            lam_new = lam
-        def model(sol):
-            nonlocal rho
-            d = sol.d
-            c_lin = nlp.c_scale * c + J @ d
-            lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin,
-                                          c_lin - nlp.c_scale * nlp.c_hi), 0)
-            curv = sum(_psd_quad(H, d[b]) for b, H in zip(nlp.curvature_blocks, curvature or []))
-            model_f = grad @ d + 0.5 * d @ (hess * d) + 0.5 * curv
-            reduction = v.sum() - lin_v.sum()
-            if reduction > 0 and model_f > 0:
-                # Penalty large enough for the step to be a descent direction of the merit
-                # (the equality duals alone miss the inequality multipliers).
-                rho = max(rho, 2.0 * model_f / reduction)
-            merit = f + rho * v.sum()
-            return d, merit, merit - (f + model_f + rho * lin_v.sum())
-
-        d, merit, pred = model(sol)
-        if sol.status == "optimal" and pred <= options.ftol * max(1.0, abs(f)):
-            # Looks stationary: confirm with an accurate solve (OSQP's 1e-4 tolerance can
-            # leave the linearised constraints violated by more than the current iterate).
-            sol = qp.solve(eps=options.final_qp_eps)
-            qp_iters += sol.iterations
-            d, merit, pred = model(sol)
-        step, accepted, ratio = 1.0, False, 0.0
-        qp_ok = sol.status in ("optimal", "optimal_inaccurate")
-        if (sol.status == "optimal" and v.max(initial=0.0) <= options.tol
-                and pred <= options.ftol * max(1.0, abs(f))):
+                p, J = q, sp.csr_matrix((q.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)),
+                                        shape=(nlp.m, nlp.n))
+                if p.v.max(initial=0.0) <= o.tol:
+                    break
+        if stationary and p.v.max(initial=0.0) <= o.tol:
             status = "solved"
-        elif qp_ok and pred > 0:
-            # Second-order correction (Maratos effect): pull the full step back onto the
-            # equality constraints by a minimum-norm Newton step, J_E Δ = −c_E(Z + d).
-            x_full = np.clip(x + D * d, nlp.x_lb, nlp.x_ub)
-            c_full, jac_full, f_full, v_full = point(x_full)
-            ratio = (merit - (f_full + rho * v_full.sum())) / pred
-            if ratio < options.accept_ratio:
-                delta = _min_norm_correction(J, *_correction_residual(nlp, c_full))
-                x_soc = np.clip(x + D * (d + delta), nlp.x_lb, nlp.x_ub)
-                c_s, jac_s, f_s, v_s = point(x_soc)
-                ratio_soc = (merit - (f_s + rho * v_s.sum())) / pred
-                if ratio_soc >= options.accept_ratio:
-                    x, c, jac, f, v, accepted = x_soc, c_s, jac_s, f_s, v_s, True
-                    ratio = ratio_soc
-            else:
-                x, c, jac, f, v, accepted = x_full, c_full, jac_full, f_full, v_full, True
-            step = 1.0 if accepted else 0.25
-            while not accepted and step >= options.min_step:
-                x_new = np.clip(x + step * D * d, nlp.x_lb, nlp.x_ub)
-                c_n, jac_n, f_n, v_n = point(x_new)
-                actual = merit - (f_n + rho * v_n.sum())
-                if actual >= options.armijo * step * pred:
-                    x, c, jac, f, v, accepted = x_new, c_n, jac_n, f_n, v_n, True
+        elif sol.status in ("optimal", "optimal_inaccurate") and pred > 0:
+            for _ in range(o.backtracks + 1):
+                trial = _Point(nlp, nlp.project(p.x + step * D * d))
+                actual = p.merit(rho) - trial.merit(rho)
+                ratio = actual / (step * pred)
+                if actual >= o.eta * step * pred:
+                    accepted = True
                     break
-                step *= 0.25
-        if accepted and options.curvature == "dynamics":
-            lam = lam_new
-            curvature = [nlp.obj_scale * np.outer(D[b], D[b]) * H
-                         for b, H in zip(nlp.curvature_blocks, nlp.lagrangian_curvature(x, lam))]
-        elif accepted and options.curvature == "bfgs" and sol.eq_duals is not None:
-            # Partitioned damped BFGS on the per-node blocks (q, q̇, q̈): the constraint part
-            # of the Lagrangian gradient, J̃ᵀỹ with this step's multipliers, at both ends.
-            y_eq = np.zeros(nlp.m)
-            y_eq[eq_rows] = sol.eq_duals
-            g_new, g_old = J_of(jac).T @ y_eq, J.T @ y_eq
-            s_all = (x - x_prev) / D
-            if curvature is None:
-                curvature = [options.bfgs_init * np.eye(len(b)) for b in nlp.curvature_blocks]
-            curvature = [_damped_bfgs(B, s_all[b], (g_new - g_old)[b])
-                         for B, b in zip(curvature, nlp.curvature_blocks)]
-        x_prev = x
-        # Levenberg–Marquardt update from the full step's agreement with the model.
-        if status != "solved":
-            if ratio < 0.1:
-                mu = min(mu * 10.0, options.prox_max * 10)
-            elif ratio > 0.5:
-                mu = max(mu * 0.3, options.prox_min)
-        log.append({"iter": it, "objective": nlp.objective(x), "violation": float(v.max(initial=0)),
-                    "merit": float(f + rho * v.sum()), "pred": float(pred), "ratio": float(ratio),
-                    "step": step if accepted else 0.0, "prox": mu, "rho": rho, "qp_iters": sol.iterations,
-                    "qp_status": sol.status, "elastic": bool(sol is not None and qp.elastic)})
+                step *= 0.5
+        d_len = float(np.abs(d).max(initial=0.0))
+        if accepted:
+            p = trial
+            if step == 1.0 and ratio >= 0.75 and d_len >= 0.5 * trust:
+                trust = min(2.0 * trust, o.trust_max)
+            elif step < 1.0:
+                trust = max(step * d_len, o.trust_min)
+        elif status != "solved":
+            trust = max(0.1 * d_len, o.trust_min) if d_len > 0 else 0.1 * trust
+        log.append({"iter": it, "objective": nlp.objective(p.x), "violation": float(p.v.max(initial=0)),
+                    "merit": float(p.merit(rho)), "pred": float(pred), "ratio": float(ratio),
+                    "step": step if accepted else 0.0, "trust": trust, "rho": rho,
+                    "qp_iters": sol.iterations, "qp_status": sol.status, "polished": sol.polished, "elastic": qp.elastic})
         if status == "solved":
             break
-        if mu > options.prox_max:
-            # Before giving up: a few minimum-norm Newton corrections onto the equalities
-            # (feasibility polishing) — the iterate is usually stationary but a hair outside.
-            x_c, c_c, jac_c = x, c, jac
-            for _ in range(3):
-                delta = _min_norm_correction(J_of(jac_c), *_correction_residual(nlp, c_c))
-                x_c = np.clip(x_c + D * delta, nlp.x_lb, nlp.x_ub)
-                c_c, jac_c, f_c, v_c = point(x_c)
-                if v_c.max(initial=0.0) <= options.tol:
-                    x, c, jac, f, v, status = x_c, c_c, jac_c, f_c, v_c, "solved"
-                    break
-            if status != "solved":
-                status = "stalled"
+        if trust <= o.trust_min and not accepted:
+            status = "stalled"
             break
-    result = SolveResult(x=x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
-                         objective=nlp.objective(x), max_violation=float(v.max(initial=0.0)),
+    result = SolveResult(x=p.x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
+                         objective=nlp.objective(p.x), max_violation=float(p.v.max(initial=0.0)),
                          log=log, qp_iterations=qp_iters)
     if status != "solved" and raise_on_failure:
-        group, amount = nlp.worst_group(x)
+        group, amount = nlp.worst_group(p.x)
         raise NoSolutionFound(nlp, status, group, amount, result)
     return result

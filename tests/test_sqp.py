@@ -25,15 +25,12 @@ def test_converges_to_a_feasible_point(reference):
 
 
 def test_matches_ipopt_on_the_same_nlp(reference):
-    """Both solvers on the very same NLP interface reach the same optimum.
-
-    Measured: SQP 10720 vs IPOPT 10597 (1.2 %); the issue's 1e-3 target is not met yet —
-    the SQP stops on its predicted-decrease test while IPOPT goes on (see sqp.py).
-    """
+    """Both solvers on the very same NLP interface reach the same optimum within 1e-3
+    (measured: SQP 10597.91 vs IPOPT 10597.28, 5.9e-5 relative)."""
     nlp, res = reference
     ip = solve_ipopt(nlp)
     assert ip.status == "solved"
-    assert abs(res.objective - ip.objective) / ip.objective < 0.02
+    assert abs(res.objective - ip.objective) / ip.objective < 1e-3
     # and the same duration (the cost drives T to its upper bound)
     L = nlp.layout
     assert res.x[L.T_index] == pytest.approx(ip.x[L.T_index], abs=1e-4)
@@ -63,3 +60,17 @@ def test_failure_raises_with_group_and_amount(reference):
     assert err.value.group in nlp.violation_by_group(nlp.x0)
     assert err.value.status == "max_iter" and np.isfinite(err.value.amount)
     assert err.value.problem is nlp and err.value.result.iterations == 2
+
+
+def test_projection_satisfies_the_dynamics_rows_exactly(reference):
+    """u := RNEA(q, q̇, q̈) zeroes the dynamics rows at any point (the SQP projects every
+    trial point) and leaves every other variable alone."""
+    nlp, _ = reference
+    rng = np.random.default_rng(3)
+    x = np.clip(nlp.x0 + 0.05 * nlp.x_scale * rng.standard_normal(nlp.n), nlp.x_lb, nlp.x_ub)
+    xp = nlp.project(x)
+    rows = nlp.block_slices["dynamics"]
+    assert np.abs(nlp.constraints(x)[rows]).max() > 1e-3
+    assert np.abs(nlp.constraints(xp)[rows]).max() < 1e-9
+    moved = np.flatnonzero(xp != x)
+    assert set(moved) <= set(nlp.u_index)

@@ -24,32 +24,17 @@ class Dynamics(Block):
         self.m = nq * layout.n_nodes
         self._finish(0.0, 0.0, np.tile(1.0 / np.asarray(torque_scale), layout.n_nodes))
 
-    def node_indices(self, i: int) -> np.ndarray:
-        """Variables (q_i, q̇_i, q̈_i) on which the curvature of node i's rows lives."""
-        L = self.layout
-        return np.concatenate([L.iq(i), L.iqd(i), L.iqdd(i)])
+    def project(self, x: np.ndarray, robot) -> np.ndarray:
+        """x with u_i = RNEA(q_i, q̇_i, q̈_i) at every node: these rows hold exactly.
 
-    def lagrangian_hessians(self, ev, lam: np.ndarray, h: float = 1e-6) -> list[np.ndarray]:
-        """Per node, ∇²_z (λ_iᵀ r_i) over z = (q_i, q̇_i, q̈_i) (18x18), λ in raw row units.
-
-        Forward differences of the analytic gradient Jᵀλ (RNEA derivatives) along q and q̇;
-        r is linear in q̈, so the q̈ columns follow by symmetry and ∂²/∂q̈² = 0.
+        u enters eq. (7) alone and linearly, so this is the exact nonlinear correction of
+        the dynamics rows (the SQP applies it to every trial point).
         """
-        nq, robot, out = self.layout.nq, ev.robot, []
+        x = np.array(x, float)
+        nodes = self.layout.nodes(x)
         for i in range(self.layout.n_nodes):
-            q, qd, qdd, _ = ev.node(i)
-            li = lam[i * nq:(i + 1) * nq]
-            _, dq, dqd, dqdd, _ = ev.rnea(i)
-            g0 = np.concatenate([dq.T @ li, dqd.T @ li, dqdd.T @ li])
-            H = np.zeros((3 * nq, 3 * nq))
-            for k in range(2 * nq):
-                z = [q.copy(), qd.copy()]
-                z[k // nq][k % nq] += h
-                _, a, b, c, _ = robot.dynamics_residual_jacobians(z[0], z[1], qdd)
-                H[:, k] = (np.concatenate([a.T @ li, b.T @ li, c.T @ li]) - g0) / h
-            H[:2 * nq, 2 * nq:] = H[2 * nq:, :2 * nq].T
-            out.append(0.5 * (H + H.T))
-        return out
+            nodes[i, 3] = robot.inverse_dynamics(nodes[i, 0], nodes[i, 1], nodes[i, 2])
+        return x
 
     def evaluate(self, ev):
         vals, jac = [], []
