@@ -65,7 +65,8 @@ class SQPOptions:
     trust0: float = 1.0
     trust_min: float = 1e-6
     trust_max: float = 1.0
-    prox: float = 1e-4
+    prox: float = 1e-3
+    prox_range: tuple[float, float] = (1e-5, 1.0)
     eta: float = 0.1
     backtracks: int = 5
     rho_min: float = 1e-3
@@ -139,7 +140,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         subproblem_for(nlp, elastic).reset()  # on what was solved before in this process
     o, D = options, nlp.x_scale
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
-    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + o.prox
+    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
+    mu = o.prox
     lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
     p = _Point(nlp, nlp.project(nlp.x0 if x0 is None else x0))
     rho, trust = o.rho_min, o.trust0
@@ -149,16 +151,25 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
         d_lo = np.maximum((nlp.x_lb - p.x) / D, -trust)
         d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
-        for elastic in (False, True):
-            qp = subproblem_for(nlp, elastic)
-            # The elastic step is a feasibility step: least-squares slacks, no cost.
-            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, 0 * grad if elastic else grad,
-                      np.full(nlp.n, o.restoration_prox) if elastic else hess, d_lo, d_hi, o.slack_reg)
-            theta = max(float(p.v.max(initial=0.0)), pred)
-            sol = qp.solve(eps=float(np.clip(o.qp_eps_factor * theta, *o.qp_eps)))
+        theta = max(float(p.v.max(initial=0.0)), pred)
+        eps = float(np.clip(o.qp_eps_factor * theta, *o.qp_eps))
+        # The hard subproblem; if OSQP runs out of iterations (not infeasible), the proximal
+        # weight is raised (better conditioned for ADMM, shorter step) and it is tried again.
+        for attempt in range(3):
+            qp = subproblem_for(nlp)
+            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, grad, hess + mu, d_lo, d_hi)
+            sol = qp.solve(eps=eps)
             qp_iters += sol.iterations
-            if sol.status == "optimal":
+            if sol.status == "optimal" or "infeasible" in sol.status:
                 break
+            mu = min(10.0 * mu, o.prox_range[1])
+        hard = sol.status == "optimal"
+        if not hard:  # restoration: a least-squares (Levenberg–Marquardt) step on the rows
+            qp = subproblem_for(nlp, elastic=True)
+            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, 0 * grad,
+                      np.full(nlp.n, o.restoration_prox), d_lo, d_hi, o.slack_reg)
+            sol = qp.solve(eps=eps)
+            qp_iters += sol.iterations
         d = sol.d
         rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
         J = sp.csr_matrix((p.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
@@ -170,7 +181,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             rho = max(rho, 2.0 * model_f / reduction)  # no informative multipliers)
         pred = p.merit(rho) - (p.f + model_f + rho * lin_v)
         step, ratio, accepted = 1.0, 0.0, False
-        stationary = sol.status == "optimal" and pred <= o.ftol * max(p.f, 1e-3)
+        stationary = hard and pred <= o.ftol * max(p.f, 1e-3)
         if stationary and p.v.max(initial=0.0) > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows.
@@ -194,6 +205,12 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
                     break
                 step *= 0.5
         d_len = float(np.abs(d).max(initial=0.0))
+        # Levenberg–Marquardt weight: relaxed after a full step the model predicted well,
+        # raised when the step had to be shortened or was rejected.
+        if accepted and step == 1.0 and ratio >= 0.75:
+            mu = max(mu / 4.0, o.prox_range[0])
+        elif status != "solved" and (not accepted or step < 1.0):
+            mu = min(mu * 4.0, o.prox_range[1])
         if accepted:
             p = trial
             if step == 1.0 and ratio >= 0.75 and d_len >= 0.5 * trust:
@@ -204,7 +221,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             trust = max(0.1 * d_len, o.trust_min) if d_len > 0 else 0.1 * trust
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": float(p.v.max(initial=0)),
                     "merit": float(p.merit(rho)), "pred": float(pred), "ratio": float(ratio),
-                    "step": step if accepted else 0.0, "trust": trust, "rho": rho,
+                    "step": step if accepted else 0.0, "trust": trust, "prox": mu, "rho": rho,
                     "qp_iters": sol.iterations, "qp_status": sol.status, "polished": sol.polished, "elastic": qp.elastic})
         if status == "solved":
             break
