@@ -32,11 +32,10 @@ import scipy.sparse as sp
 from .nlp import NLP
 from .osqp_driver import OSQPDriver
 
-# OSQP: solution polishing turns an ADMM iterate into the exact solution of the identified
-# active set; at eps 1e-5 polishing succeeds on these problems, at 1e-4 it mostly fails and
-# the SQP's tail then stalls on the residuals (measured). Deterministic: a fixed adaptive-rho
-# interval (interval 0 would time the setup and adapt rho after a fraction of it, which
-# varies run to run).
+# OSQP: polishing turns an ADMM iterate into the exact solution of the identified active set;
+# the SQP passes its own tolerance per solve (this eps is the default for a direct solve).
+# Deterministic: a fixed adaptive-rho interval (interval 0 would time the setup and adapt rho
+# after a fraction of it, which varies run to run).
 OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
                      polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
 
