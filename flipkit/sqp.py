@@ -22,9 +22,9 @@ predicted step that used at least half of it and shrinks to the accepted length 
 Subproblem failures. If OSQP runs out of iterations on the hard QP, μ is raised tenfold and
 the QP re-solved (up to three tries); if the linearisation is infeasible, a restoration
 step minimises ½σ‖s‖² + ½μ_r‖d‖² over the elastic rows (:class:`~flipkit.qp.QPSubproblem`
-with ``elastic=True``). The OSQP tolerance follows the iterate (inexact SQP): 0.1 × max(
-violation, last predicted decrease), within ``qp_eps`` — loose far from a solution, tight
-near it, where the step must resolve residuals below ``tol``.
+with ``elastic=True``). The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
+violation (or, at a feasible iterate, the last predicted decrease), within ``qp_eps`` — loose
+far from a solution, tight near it, where the step must resolve residuals below ``tol``.
 
 Converged: the hard QP's predicted decrease ≤ ``ftol``·J̃ and max scaled violation ≤ ``tol``
 (a stationary point a hair outside gets up to three minimum-norm Newton corrections).
@@ -63,9 +63,8 @@ class SQPOptions:
         rho_min: Smallest ℓ1 penalty.
         slack_reg, restoration_prox: The elastic (restoration) step minimises
             ½σ‖s‖² + ½μ_r‖d‖², a Levenberg–Marquardt step on the violation.
-        qp_eps, qp_eps_factor: OSQP tolerance = factor × max(violation, last predicted
-            decrease), clipped to the (min, max) range: loose far from the solution, tight
-            near it, where the step must resolve residuals below ``tol`` (inexact SQP).
+        qp_eps, qp_eps_factor: OSQP tolerance = factor × violation (at a feasible iterate:
+            × last predicted decrease), clipped to the (min, max) range (inexact SQP).
     """
 
     tol: float = 1e-6
@@ -164,7 +163,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
         d_lo = np.maximum((nlp.x_lb - p.x) / D, -trust)
         d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
-        theta = max(float(p.v.max(initial=0.0)), pred)
+        v_max = float(p.v.max(initial=0.0))
+        theta = v_max if v_max > o.tol else pred  # resolve the violation, else the decrease
         eps = float(np.clip(o.qp_eps_factor * theta, *o.qp_eps))
         # The hard subproblem; if OSQP runs out of iterations (not infeasible), the proximal
         # weight is raised (better conditioned for ADMM, shorter step) and it is tried again.
