@@ -7,7 +7,7 @@ With the dynamics rows u = RNEA(q, q̇, q̈) hard this is the Gauss–Newton mod
 along the linearised constraints: no second derivatives, no quasi-Newton memory. Σu² is
 nearly flat along wrist motions (9 of the 19 reduced-Hessian eigenvalues below 4e-6, the
 largest 5e-3, measured), which μ regularises: μ is divided by 4 after a full step the
-model predicted well (actual/predicted ≥ 0.75) and multiplied by 4 when a step had to be
+model predicted well (actual/predicted ≥ ``good_ratio``) and multiplied by 4 when a step had to be
 shortened, within ``prox_range``.
 
 Globalisation. Every trial point is *projected* first: u_i := RNEA(q_i, q̇_i, q̈_i), which
@@ -59,6 +59,7 @@ class SQPOptions:
         trust0, trust_min, trust_max: Initial, smallest and largest trust box Δ.
         prox, prox_range: Initial Levenberg–Marquardt weight μ of ½μ‖d‖² and its range.
         eta: Sufficient-decrease fraction of the predicted merit decrease.
+        good_ratio: actual/predicted decrease of a full step above which μ falls and Δ grows.
         backtracks: Halvings of the step tried before the step is rejected.
         rho_min: Smallest ℓ1 penalty.
         slack_reg, restoration_prox: The elastic (restoration) step minimises
@@ -76,10 +77,11 @@ class SQPOptions:
     prox: float = 1e-3
     prox_range: tuple[float, float] = (1e-5, 1.0)
     eta: float = 0.1
+    good_ratio: float = 0.5
     backtracks: int = 5
     rho_min: float = 1e-3
     slack_reg: float = 1.0
-    restoration_prox: float = 1e-2
+    restoration_prox: float = 1e-4
     qp_eps: tuple[float, float] = (1e-9, 1e-4)
     qp_eps_factor: float = 0.1
 
@@ -229,13 +231,13 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         d_len = float(np.abs(d).max(initial=0.0))
         # Levenberg–Marquardt weight: relaxed after a full step the model predicted well,
         # raised when the step had to be shortened or was rejected.
-        if accepted and step == 1.0 and ratio >= 0.75:
+        if accepted and step == 1.0 and ratio >= o.good_ratio:
             mu = max(mu / 4.0, o.prox_range[0])
         elif status != "solved" and (not accepted or step < 1.0):
             mu = min(mu * 4.0, o.prox_range[1])
         if accepted:
             p = trial
-            if step == 1.0 and ratio >= 0.75 and d_len >= 0.5 * trust:
+            if step == 1.0 and ratio >= o.good_ratio and d_len >= 0.5 * trust:
                 trust = min(2.0 * trust, o.trust_max)
             elif step < 1.0:
                 trust = max(step * d_len, o.trust_min)
