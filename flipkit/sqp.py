@@ -170,11 +170,12 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         eps = float(np.clip(o.qp_eps_factor * theta, *o.qp_eps))
         # The hard subproblem; if OSQP runs out of iterations (not infeasible), the proximal
         # weight is raised (better conditioned for ADMM, shorter step) and it is tried again.
+        admm = 0
         for attempt in range(3):
             qp = subproblem_for(nlp)
             qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, grad, hess + mu, d_lo, d_hi)
             sol = qp.solve(eps=eps)
-            qp_iters += sol.iterations
+            admm += sol.iterations
             if sol.status == "optimal" or "infeasible" in sol.status:
                 break
             mu = min(10.0 * mu, o.prox_range[1])
@@ -184,7 +185,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, 0 * grad,
                       np.full(nlp.n, o.restoration_prox), d_lo, d_hi, o.slack_reg)
             sol = qp.solve(eps=eps)
-            qp_iters += sol.iterations
+            admm += sol.iterations
+        qp_iters += admm
         d = sol.d
         rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
         J = sp.csr_matrix((p.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
@@ -246,7 +248,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": float(p.v.max(initial=0)),
                     "merit": float(p.merit(rho)), "pred": float(pred), "ratio": float(ratio),
                     "step": step if accepted else 0.0, "trust": trust, "prox": mu, "rho": rho,
-                    "qp_iters": sol.iterations, "qp_status": sol.status, "polished": sol.polished, "elastic": qp.elastic})
+                    "qp_iters": admm, "qp_tries": attempt + 1 + (not hard), "qp_status": sol.status, "polished": sol.polished, "elastic": qp.elastic})
         if status == "solved":
             break
         if trust <= o.trust_min and not accepted:
