@@ -126,6 +126,12 @@ class QPSubproblem:
         self.d_lo.value, self.d_hi.value = d_lo, np.maximum(d_hi, d_lo)
         self.slack_reg.value = slack_reg
 
+    def compile(self) -> OSQPDriver:
+        """Canonicalise with cvxpy (once; ~1–3 s) and return the OSQP driver."""
+        if not hasattr(self, "_driver"):
+            self._driver = OSQPDriver(self.problem)
+        return self._driver
+
     def reset(self) -> None:
         """Forget OSQP's state: the next solve sets up afresh (no warm start)."""
         if hasattr(self, "_driver"):
@@ -141,9 +147,7 @@ class QPSubproblem:
         settings = dict(OSQP_SETTINGS)
         if eps is not None:
             settings.update(eps_abs=eps, eps_rel=eps)
-        if not hasattr(self, "_driver"):
-            self._driver = OSQPDriver(self.problem)
-        res, iterations = self._driver.solve(settings)
+        res, iterations = self.compile().solve(settings)
         ok = res.info.status_val in (1, 2, 3, 4)
         status = str(self.problem.status) if ok else f"osqp:{res.info.status}"
         d = self.d.value if ok and res.info.status_val in (1, 2) else None
