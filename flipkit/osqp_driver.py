@@ -109,7 +109,8 @@ class OSQPDriver:
                 self._osqp.setup(P, q, A, lw, uw, **settings)
             else:
                 self._osqp.update(q=q, l=lw, u=uw, Px=P.data, Ax=A.data)
-                self._osqp.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"])
+                self._osqp.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"],
+                                           max_iter=settings["max_iter"])
                 if self._x is not None:
                     self._osqp.warm_start(x=self._x, y=self._y)
             res = self._osqp.solve(raise_error=False)

@@ -137,16 +137,19 @@ class QPSubproblem:
         if hasattr(self, "_driver"):
             self._driver.reset()
 
-    def solve(self, eps: float | None = None) -> QPSolution:
+    def solve(self, eps: float | None = None, max_iter: int | None = None) -> QPSolution:
         """Solve with OSQP (:class:`~flipkit.osqp_driver.OSQPDriver`: persistent solver,
         fixed pattern, warm start, working set of inequality rows).
 
         Args:
             eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS`.
+            max_iter: ADMM iteration cap overriding :data:`OSQP_SETTINGS`.
         """
         settings = dict(OSQP_SETTINGS)
         if eps is not None:
             settings.update(eps_abs=eps, eps_rel=eps)
+        if max_iter is not None:
+            settings.update(max_iter=int(max_iter))
         res, iterations = self.compile().solve(settings)
         ok = res.info.status_val in (1, 2, 3, 4)
         status = str(self.problem.status) if ok else f"osqp:{res.info.status}"

@@ -66,6 +66,9 @@ class SQPOptions:
             ½σ‖s‖² + ½μ_r‖d‖², a Levenberg–Marquardt step on the violation.
         qp_eps, qp_eps_factor: OSQP tolerance = factor × violation (at a feasible iterate:
             × last predicted decrease), clipped to the (min, max) range (inexact SQP).
+        qp_max_iter: OSQP iteration caps of the three tries of the hard QP (lower first
+            caps, e.g. (2000, 4000, 10000), cut flip solve times ~30 % but solved 8/10 Table I
+            locations instead of 9/10, measured).
     """
 
     tol: float = 1e-6
@@ -84,6 +87,7 @@ class SQPOptions:
     restoration_prox: float = 1e-4
     qp_eps: tuple[float, float] = (1e-9, 1e-4)
     qp_eps_factor: float = 0.1
+    qp_max_iter: tuple[int, int, int] = (10000, 10000, 10000)
 
     def __post_init__(self):
         if not (0 < self.trust_min <= self.trust0 <= self.trust_max):
@@ -174,7 +178,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         for attempt in range(3):
             qp = subproblem_for(nlp)
             qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, grad, hess + mu, d_lo, d_hi)
-            sol = qp.solve(eps=eps)
+            sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
             admm += sol.iterations
             if sol.status == "optimal" or "infeasible" in sol.status:
                 break
