@@ -120,26 +120,34 @@ class SolveResult:
 
 
 class _Point:
-    """Z with its scaled cost, constraint values, Jacobian entries and violation."""
+    """Z with its scaled cost, constraint values, violation and (on first use) the scaled
+    Jacobian J̃ = c_scale · ∂c/∂Z · Z_scale on the NLP's pattern."""
 
-    def __init__(self, nlp: NLP, x: np.ndarray):
-        self.x = x
-        self.c, self.jac = nlp.evaluate(x)
+    def __init__(self, nlp: NLP, x: np.ndarray, jscale: np.ndarray):
+        self.x, self._nlp, self._jscale, self._J = x, nlp, jscale, None
+        self.c, jac = nlp.evaluate(x)
+        self.jac = jac * jscale  # scaled entries, pattern order
+        self.cs = nlp.c_scale * self.c
         self.f = nlp.objective(x) * nlp.obj_scale
         self.v = nlp.scaled_violation(self.c)
+
+    @property
+    def J(self) -> sp.csr_matrix:
+        if self._J is None:
+            n = self._nlp
+            self._J = sp.csr_matrix((self.jac, (n.jac_rows, n.jac_cols)), shape=(n.m, n.n))
+        return self._J
 
     def merit(self, rho: float) -> float:
         return self.f + rho * float(self.v.sum())
 
 
-def _correction(nlp: NLP, p: _Point, J: sp.csr_matrix) -> np.ndarray:
+def _correction(nlp: NLP, p: _Point) -> np.ndarray:
     """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
     Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound."""
-    cs = nlp.c_scale * p.c
-    lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
-    r = cs - np.clip(cs, lo, hi)
+    r = p.cs - np.clip(p.cs, nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi)
     rows = np.flatnonzero((nlp.c_lo == nlp.c_hi) | (r != 0))
-    JR = J[rows]
+    JR = p.J[rows]
     K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
     delta = -(JR.T @ spla.spsolve(K, r[rows]))
     return np.where(np.isfinite(delta), delta, 0.0)
@@ -161,7 +169,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     mu = o.prox
     lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
-    p = _Point(nlp, nlp.project(nlp.x0 if x0 is None else x0))
+    point = lambda x: _Point(nlp, nlp.project(x), Jscale)  # noqa: E731
+    p = point(nlp.x0 if x0 is None else x0)
     rho, trust = o.rho_min, o.trust0
     log, qp_iters, status, it, pred = [], 0, "max_iter", 0, np.inf
     while it < o.max_iter:
@@ -177,7 +186,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         admm = 0
         for attempt in range(3):
             qp = subproblem_for(nlp)
-            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, grad, hess + mu, d_lo, d_hi)
+            qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
             sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
             admm += sol.iterations
             if sol.status == "optimal" or "infeasible" in sol.status:
@@ -186,15 +195,14 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         hard = sol.status == "optimal"
         if not hard:  # restoration: a least-squares (Levenberg–Marquardt) step on the rows
             qp = subproblem_for(nlp, elastic=True)
-            qp.update(nlp, nlp.c_scale * p.c, p.jac * Jscale, 0 * grad,
+            qp.update(nlp, p.cs, p.jac, 0 * grad,
                       np.full(nlp.n, o.restoration_prox), d_lo, d_hi, o.slack_reg)
             sol = qp.solve(eps=eps)
             admm += sol.iterations
         qp_iters += admm
         d = sol.d
         rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
-        J = sp.csr_matrix((p.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
-        c_lin = nlp.c_scale * p.c + J @ d
+        c_lin = p.cs + p.J @ d
         lin_v = np.maximum(np.maximum(lo - c_lin, c_lin - hi), 0.0).sum()
         model_f = grad @ d + 0.5 * d @ (hess * d)
         reduction = float(p.v.sum()) - lin_v
@@ -207,25 +215,22 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows.
             for _ in range(3):
-                q = _Point(nlp, nlp.project(p.x + D * _correction(nlp, p, J)))
+                q = point(p.x + D * _correction(nlp, p))
                 if q.v.sum() >= p.v.sum():
                     break
-                p, J = q, sp.csr_matrix((q.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)),
-                                        shape=(nlp.m, nlp.n))
+                p = q
                 if p.v.max(initial=0.0) <= o.tol:
                     break
         if stationary and p.v.max(initial=0.0) <= o.tol:
             status = "solved"
         elif sol.status in ("optimal", "optimal_inaccurate") and pred > 0:
             for _ in range(o.backtracks + 1):
-                trial = _Point(nlp, nlp.project(p.x + step * D * d))
+                trial = point(p.x + step * D * d)
                 if (step == 1.0 and trial.v.max(initial=0.0) > o.tol
                         and p.merit(rho) - trial.merit(rho) < 0.75 * pred):
                     # Second-order correction: the full step's curvature error on the rows
                     # (cone, blade heights) removed by a minimum-norm Newton step at Z + d.
-                    Jt = sp.csr_matrix((trial.jac * Jscale, (nlp.jac_rows, nlp.jac_cols)),
-                                       shape=(nlp.m, nlp.n))
-                    soc = _Point(nlp, nlp.project(trial.x + D * _correction(nlp, trial, Jt)))
+                    soc = point(trial.x + D * _correction(nlp, trial))
                     if soc.merit(rho) < trial.merit(rho):
                         trial = soc
                 actual = p.merit(rho) - trial.merit(rho)
@@ -252,7 +257,8 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": float(p.v.max(initial=0)),
                     "merit": float(p.merit(rho)), "pred": float(pred), "ratio": float(ratio),
                     "step": step if accepted else 0.0, "trust": trust, "prox": mu, "rho": rho,
-                    "qp_iters": admm, "qp_tries": attempt + 1 + (not hard), "qp_status": sol.status, "polished": sol.polished, "elastic": qp.elastic})
+                    "qp_iters": admm, "qp_tries": attempt + 1 + (not hard), "qp_status": sol.status,
+                    "polished": sol.polished, "elastic": qp.elastic})
         if status == "solved":
             break
         if trust <= o.trust_min and not accepted:
