@@ -1,0 +1,109 @@
+"""The condensed (null-space) subproblem: same step and multipliers as the full-space QP,
+linearised equalities exact, a compiled problem per structure, warm starts that pay."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.ik import solve_pose
+from flipkit.qp import QPSubproblem
+from flipkit.reduced_qp import ReducedQP, reduced_subproblem_for
+from flipkit.sqp import SQPOptions, solve_sqp
+
+
+@pytest.fixture(scope="module")
+def segments():
+    models = Models(CellConfig())
+    qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
+    translate = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    scoop_start = build_segment("go_to_burger", models, models.bare.q_home, None,
+                                location=TABLE1_LOCATIONS[3])
+    end = scoop_start.layout.nodes(scoop_start.x0)[-1]
+    scoop = build_segment("scoop", models, end[0], end[1], location=TABLE1_LOCATIONS[3])
+    return {"translate": translate, "scoop": scoop}
+
+
+def _linearise(nlp, box):
+    """Scaled c, entries, J, gradient, Hessian (with a proximal weight) and step box at the
+    projected initial guess."""
+    x = nlp.project(nlp.x0)
+    D = nlp.x_scale
+    c, jac = nlp.evaluate(x)
+    entries = jac * nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
+    J = sp.csr_matrix((entries, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
+    g = nlp.gradient(x) * nlp.obj_scale * D
+    h = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + 1e-3
+    lo, hi = np.maximum((nlp.x_lb - x) / D, -box), np.minimum((nlp.x_ub - x) / D, box)
+    return nlp.c_scale * c, entries, J, g, h, lo, hi
+
+
+@pytest.mark.parametrize("name", ["translate", "scoop"])
+def test_condensed_step_is_the_full_space_step(segments, name):
+    """Both forms solve one strictly convex QP: the steps agree, the condensed one holds the
+    linearised equalities to round-off, and its recovered multipliers close the KKT system
+    g + H d + Jᵀy = 0 on the variables whose box is inactive."""
+    nlp = segments[name]
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    full, red = QPSubproblem(nlp), ReducedQP(nlp)
+    for qp in (full, red):
+        qp.update(nlp, c, entries, g, h, lo, hi)
+    a, b = full.solve(eps=1e-10, max_iter=50000), red.solve(eps=1e-10, max_iter=50000)
+    assert a.status == b.status == "optimal"
+    assert np.abs(a.d - b.d).max() < 1e-6 * max(1.0, np.abs(a.d).max())
+    eq = nlp.c_lo == nlp.c_hi
+    lin = c + J @ b.d
+    assert np.abs((lin - nlp.c_scale * nlp.c_lo)[eq]).max() < 1e-10
+    s_lo, s_hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    assert np.all(lin[~eq] >= s_lo[~eq] - 1e-8) and np.all(lin[~eq] <= s_hi[~eq] + 1e-8)
+    free = (b.d > lo + 1e-7) & (b.d < hi - 1e-7)
+    kkt = g + h * b.d + J.T @ b.multipliers
+    assert np.abs(kkt[free]).max() < 1e-6 * max(1.0, np.abs(g).max())
+
+
+def test_null_space_dimension_and_basis(segments):
+    """r = n − (equality rows); the basis T spans the null space of the equality Jacobian."""
+    nlp = segments["scoop"]
+    qp = ReducedQP(nlp)
+    assert qp.r == nlp.n - int(np.sum(nlp.c_lo == nlp.c_hi))
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    qp.update(nlp, c, entries, g, h, lo, hi)
+    E = J[np.flatnonzero(nlp.c_lo == nlp.c_hi)]
+    T = qp.T.value
+    assert np.linalg.matrix_rank(T) == qp.r
+    assert np.abs(E @ T).max() < 1e-9 * np.abs(T).max()
+    # The reduced Hessian is the identity: Tᵀ H T = I.
+    assert np.allclose(T.T @ (h[:, None] * T), np.eye(qp.r), atol=1e-8)
+
+
+def test_structure_shares_one_compiled_problem(segments):
+    nlp = segments["translate"]
+    assert reduced_subproblem_for(nlp) is reduced_subproblem_for(nlp)
+    assert reduced_subproblem_for(nlp).problem.is_dpp()
+
+
+def test_warm_start_cuts_iterations(segments):
+    """Re-solving a perturbed subproblem from the previous primal–dual pair takes fewer
+    ADMM iterations than from scratch."""
+    nlp = segments["scoop"]
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    qp = ReducedQP(nlp)
+    qp.update(nlp, c, entries, g, h, lo, hi)
+    qp.solve(eps=1e-8)
+    qp.update(nlp, c, entries, 1.01 * g, h, lo, hi)
+    warm = qp.solve(eps=1e-8).iterations
+    qp.reset()
+    qp.update(nlp, c, entries, 1.01 * g, h, lo, hi)
+    cold = qp.solve(eps=1e-8).iterations
+    assert warm < cold
+
+
+def test_sqp_condensed_and_full_space_agree(segments):
+    """The SQP takes the same path with either form of the subproblem."""
+    nlp = segments["translate"]
+    a = solve_sqp(nlp, options=SQPOptions(condense=True))
+    b = solve_sqp(nlp, options=SQPOptions(condense=False))
+    assert a.success and b.success
+    assert a.objective == pytest.approx(b.objective, rel=1e-6)
+    assert a.iterations == b.iterations
