@@ -150,6 +150,7 @@ def track(robot: Robot, t_des, q_des, qd_des, *, kp=None, kd=None, u_ff=None, ra
 
     dt = 1.0 / rate_hz
     t = t_des[0] + dt * np.arange(int(np.floor((t_des[-1] - t_des[0]) * rate_hz + 1e-9)) + 1)
+    t = np.minimum(t, t_des[-1])  # the 1e-9 slack may put the last sample a hair past the end
     spline = CubicHermiteSpline(t_des, Q, QD, axis=0)
     qs, qds, qdds = spline(t), spline(t, 1), spline(t, 2)
     if isinstance(u_ff, str) or u_ff is None:

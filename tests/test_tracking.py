@@ -109,3 +109,14 @@ def test_unknown_feedforward_lists_choices(ctrl):
         track(ctrl, *hold(ctrl, 0.1), u_ff="magic")
     with pytest.raises(ConfigError):
         track(ctrl, *hold(ctrl, 0.1)).errors([0.05, 0.01])
+
+
+def test_duration_a_hair_short_of_the_sample_grid(ctrl):
+    """A plan time grid ending at 0.6 − 2e-16 (a duration summed from node spacings) still
+    gets its last controller sample at 0.6 s rounded down onto the plan, not past its end."""
+    t_end = 0.5999999999999998
+    t = np.array([0.0, 0.3, t_end])
+    Q, QD = np.tile(ctrl.q_home, (3, 1)), np.zeros((3, ctrl.nq))
+    U = np.tile(ctrl.inverse_dynamics(ctrl.q_home, np.zeros(6), np.zeros(6)), (3, 1))
+    res = track(ctrl, t, Q, QD, u_ff=U, rate_hz=500)
+    assert res.t[-1] <= t_end and res.t[-1] == pytest.approx(0.6)
