@@ -25,7 +25,9 @@ predicted step that used at least half of it and shrinks to the accepted length 
 Subproblem failures. If OSQP runs out of iterations on the hard QP, μ is raised tenfold and
 the QP re-solved (up to three tries); if the linearisation is infeasible, a restoration
 step minimises ½σ‖s‖² + ½μ_r‖d‖² over the elastic rows (:class:`~flipkit.qp.QPSubproblem`
-with ``elastic=True``). The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
+with ``elastic=True``); when ``stall_iterations`` restoration steps in a row barely reduce
+the violation, Z is a stationary point of the violation and the solve stops as
+``infeasible``. The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
 violation (or, at a feasible iterate, the last predicted decrease), within ``qp_eps`` — loose
 far from a solution, tight near it, where the step must resolve residuals below ``tol``.
 
@@ -65,6 +67,10 @@ class SQPOptions:
         tol: Feasibility tolerance on the max scaled violation.
         ftol: Predicted merit decrease, relative to J̃ (at least 1e-3), below which Z is
             stationary; a stationary Z a hair outside gets Newton corrections onto the rows.
+        stall_iterations, stall_progress: Locally infeasible — status ``infeasible`` — after
+            this many consecutive restoration steps that each cut the summed violation by
+            less than this fraction (a stationary point of the violation: measured, a scoop
+            at the grill's corner spent 100 iterations and 23 s at 5.6e-3 without it).
         condense: Solve the hard subproblem in null-space form (:mod:`flipkit.reduced_qp`);
             False solves the full-space QP of :mod:`flipkit.qp` (slower, same solution).
         max_iter: Cap on SQP iterations (QP solves).
@@ -100,6 +106,8 @@ class SQPOptions:
     qp_eps_factor: float = 0.1
     qp_max_iter: tuple[int, int, int] = (10000, 10000, 10000)
     condense: bool = True
+    stall_iterations: int = 5
+    stall_progress: float = 1e-2
 
     def __post_init__(self):
         if not (0 < self.trust_min <= self.trust0 <= self.trust_max):
@@ -110,6 +118,8 @@ class SQPOptions:
             raise ConfigError("need 0 < prox_range[0] <= prox <= prox_range[1]")
         if not (0 < self.qp_eps[0] <= self.qp_eps[1]):
             raise ConfigError("need 0 < qp_eps[0] <= qp_eps[1]")
+        if self.stall_iterations < 1 or not (0 <= self.stall_progress < 1):
+            raise ConfigError("need stall_iterations >= 1 and 0 <= stall_progress < 1")
 
 
 @dataclass
@@ -186,7 +196,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     point = lambda x: _Point(nlp, nlp.project(x), Jscale)  # noqa: E731
     p = point(nlp.x0 if x0 is None else x0)
     rho, trust = o.rho_min, o.trust0
-    log, qp_iters, status, it, pred = [], 0, "max_iter", 0, np.inf
+    log, qp_iters, status, it, pred, stalls = [], 0, "max_iter", 0, np.inf, 0
     while it < o.max_iter:
         it += 1
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
@@ -260,6 +270,9 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             mu = max(mu / 4.0, o.prox_range[0])
         elif status != "solved" and (not accepted or step < 1.0):
             mu = min(mu * 4.0, o.prox_range[1])
+        if not hard:  # restoration: count the steps that barely reduce the violation
+            gain = float(p.v.sum()) - float(trial.v.sum()) if accepted else 0.0
+            stalls = stalls + 1 if gain < o.stall_progress * float(p.v.sum()) else 0
         if accepted:
             p = trial
             if step == 1.0 and ratio >= o.good_ratio and d_len >= 0.5 * trust:
@@ -277,6 +290,9 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             break
         if trust <= o.trust_min and not accepted:
             status = "stalled"
+            break
+        if stalls >= o.stall_iterations:
+            status = "infeasible"
             break
     result = SolveResult(x=p.x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
                          objective=nlp.objective(p.x), max_violation=float(p.v.max(initial=0.0)),

@@ -74,3 +74,36 @@ def test_projection_satisfies_the_dynamics_rows_exactly(reference):
     assert np.abs(nlp.constraints(xp)[rows]).max() < 1e-9
     moved = np.flatnonzero(xp != x)
     assert set(moved) <= set(nlp.u_index)
+
+
+def test_locally_infeasible_segment_stops_early_as_infeasible():
+    """A goal half a metre below the grill: restoration steps stop reducing the violation and
+    the solve ends as ``infeasible`` long before ``max_iter``, naming the end pose."""
+    from sqp_reference import START
+
+    from flipkit.behaviors import Models, build_segment, flat_pose
+    from flipkit.config import CellConfig
+    from flipkit.ik import solve_pose
+
+    models = Models(CellConfig())
+    q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
+    nlp = build_segment("translate", models, q_start, goal=flat_pose((0.75, 0.0, -0.5)))
+    with pytest.raises(NoSolutionFound) as err:
+        solve_sqp(nlp)
+    assert err.value.status == "infeasible" and err.value.group == "end_pose"
+    assert err.value.result.iterations < SQPOptions().max_iter // 2
+    assert err.value.amount > 0.1
+    elastic = [row["elastic"] for row in err.value.result.log]
+    assert all(elastic[-SQPOptions().stall_iterations:])
+
+
+def test_sequential_solves_repeat_exactly(reference):
+    """Results do not depend on what was solved before in the process (subproblem state,
+    basis and warm starts are reset per solve)."""
+    nlp, res = reference
+    from sqp_reference import reference_nlp
+
+    other = reference_nlp()
+    solve_sqp(other, x0=other.x0 + 0.01 * other.x_scale, raise_on_failure=False)
+    again = solve_sqp(nlp)
+    assert np.array_equal(again.x, res.x) and again.iterations == res.iterations
