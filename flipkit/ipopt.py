@@ -41,7 +41,7 @@ import numpy as np
 
 from .errors import NoSolutionFound
 from .nlp import NLP
-from .sqp import SolveResult
+from .result import SolveResult
 
 #: IPOPT return statuses treated as convergence (the violation is checked independently).
 IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -98,7 +98,7 @@ class IpoptOptions:
 
 @dataclass
 class IpoptResult(SolveResult):
-    """A :class:`~flipkit.sqp.SolveResult` with IPOPT's own return status.
+    """A :class:`~flipkit.result.SolveResult` with IPOPT's own return status.
 
     Attributes:
         return_status: IPOPT's ``return_status`` string (e.g. ``"Solve_Succeeded"``);

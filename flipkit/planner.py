@@ -26,7 +26,7 @@ from .config import CellConfig
 from .errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from .ik import solve_pose
 from .plan import Plan, Segment
-from .sqp import SolveResult
+from .result import SolveResult
 from .verify import verify_plan
 
 SOLVERS = ("sqp", "ipopt", "auto")

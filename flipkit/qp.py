@@ -64,7 +64,6 @@ class QPSubproblem:
     def __init__(self, nlp: NLP, elastic: bool = False):
         n, m, nnz = nlp.n, nlp.m, len(nlp.jac_rows)
         self.elastic, self.m = elastic, m
-        self.key = nlp.structure_key
         eq = nlp.c_lo == nlp.c_hi
         self.eq_rows = np.flatnonzero(eq)
         self.lo_rows = np.flatnonzero(np.isfinite(nlp.c_lo) & ~eq)

@@ -47,16 +47,18 @@ subproblem is LP-like and OSQP needed 6 000–20 000 ADMM iterations per solve (
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .errors import ConfigError, NoSolutionFound
+from .iterate import Iterate, newton_correction
 from .nlp import NLP
-from .qp import subproblem_for
+from .qp import QPSolution, subproblem_for
 from .reduced_qp import reduced_subproblem_for
+from .result import SolveResult
+
+__all__ = ["SQPOptions", "SolveResult", "solve_sqp"]
 
 
 @dataclass(frozen=True)
@@ -122,57 +124,83 @@ class SQPOptions:
             raise ConfigError("need stall_iterations >= 1 and 0 <= stall_progress < 1")
 
 
-@dataclass
-class SolveResult:
-    """Outcome of a solve: iterate, status, statistics and the iteration log."""
-
-    x: np.ndarray
-    status: str
-    iterations: int
-    wall_time_s: float
-    objective: float
-    max_violation: float
-    solver: str = "sqp"
-    log: list = field(default_factory=list)
-    qp_iterations: int = 0
-
-    @property
-    def success(self) -> bool:
-        return self.status == "solved"
-
-
-class _Point:
-    """Z with its scaled cost, constraint values, violation and (on first use) the scaled
-    Jacobian J̃ = c_scale · ∂c/∂Z · Z_scale on the NLP's pattern."""
-
-    def __init__(self, nlp: NLP, x: np.ndarray, jscale: np.ndarray):
-        self.x, self._nlp, self._jscale, self._J = x, nlp, jscale, None
-        self.c, jac = nlp.evaluate(x)
-        self.jac = jac * jscale  # scaled entries, pattern order
-        self.cs = nlp.c_scale * self.c
-        self.f = nlp.objective(x) * nlp.obj_scale
-        self.v = nlp.scaled_violation(self.c)
-
-    @property
-    def J(self) -> sp.csr_matrix:
-        if self._J is None:
-            n = self._nlp
-            self._J = sp.csr_matrix((self.jac, (n.jac_rows, n.jac_cols)), shape=(n.m, n.n))
-        return self._J
-
-    def merit(self, rho: float) -> float:
-        return self.f + rho * float(self.v.sum())
+def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
+                eps: float):
+    """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
+    raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again),
+    else the restoration QP. Returns (solution, QP object, μ, tries, ADMM iterations)."""
+    admm = 0
+    for attempt in range(3):
+        qp = reduced_subproblem_for(nlp) if o.condense else subproblem_for(nlp)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
+        sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
+        admm += sol.iterations
+        if sol.status == "optimal" or "infeasible" in sol.status:
+            break
+        mu = min(10.0 * mu, o.prox_range[1])
+    if sol.status == "optimal":
+        return sol, qp, mu, attempt + 1, admm
+    # Restoration: a least-squares (Levenberg–Marquardt) step on the rows.
+    qp = subproblem_for(nlp, elastic=True)
+    qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), d_lo, d_hi,
+              o.slack_reg)
+    sol = qp.solve(eps=eps)
+    return sol, qp, mu, attempt + 2, admm + sol.iterations
 
 
-def _correction(nlp: NLP, p: _Point) -> np.ndarray:
-    """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
-    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound."""
-    r = p.cs - np.clip(p.cs, nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi)
-    rows = np.flatnonzero((nlp.c_lo == nlp.c_hi) | (r != 0))
-    JR = p.J[rows]
-    K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
-    delta = -(JR.T @ spla.spsolve(K, r[rows]))
-    return np.where(np.isfinite(delta), delta, 0.0)
+def _line_search(o: SQPOptions, p: Iterate, d, pred: float, rho: float, point, correct):
+    """Backtracking on φ from p along d, with a second-order correction of a poorly
+    predicted, infeasible full step. Returns (trial, step, ratio, accepted)."""
+    step, ratio, trial = 1.0, 0.0, None
+    for _ in range(o.backtracks + 1):
+        trial = point(p.x + step * d)
+        if step == 1.0 and trial.v_max > o.tol and p.merit(rho) - trial.merit(rho) < 0.75 * pred:
+            # Second-order correction: the full step's curvature error on the rows (cone,
+            # blade heights) removed by a minimum-norm Newton step at Z + d.
+            soc = correct(trial)
+            if soc.merit(rho) < trial.merit(rho):
+                trial = soc
+        actual = p.merit(rho) - trial.merit(rho)
+        ratio = actual / (step * pred)
+        if actual >= o.eta * step * pred:
+            return trial, step, ratio, True
+        step *= 0.5
+    return trial, step, ratio, False
+
+
+def _adapt(o: SQPOptions, accepted: bool, step: float, ratio: float, d_len: float,
+           trust: float, mu: float) -> tuple[float, float]:
+    """New (Δ, μ): μ relaxed after a full step the model predicted well and raised when the
+    step had to be shortened or was rejected; Δ doubled after a full, well predicted step
+    that used at least half of it, shrunk to the accepted length, or to a tenth of the
+    rejected one."""
+    good = accepted and step == 1.0 and ratio >= o.good_ratio
+    if good:
+        mu = max(mu / 4.0, o.prox_range[0])
+    elif not accepted or step < 1.0:
+        mu = min(mu * 4.0, o.prox_range[1])
+    if good and d_len >= 0.5 * trust:
+        trust = min(2.0 * trust, o.trust_max)
+    elif accepted and step < 1.0:
+        trust = max(step * d_len, o.trust_min)
+    elif not accepted:
+        trust = max(0.1 * d_len, o.trust_min) if d_len > 0 else 0.1 * trust
+    return trust, mu
+
+
+def _descent_model(nlp: NLP, p: Iterate, sol: QPSolution, grad, hess, rho: float):
+    """(ρ, pred): ρ ≥ twice the largest multiplier and large enough for d to descend on φ
+    (elastic steps have no informative multipliers); pred = φ(p) − model(d)."""
+    d = sol.d
+    rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
+    c_lin = p.cs + p.J @ d
+    lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin, c_lin - nlp.c_scale * nlp.c_hi),
+                       0.0).sum()
+    model_f = grad @ d + 0.5 * d @ (hess * d)
+    reduction = float(p.v.sum()) - lin_v
+    if model_f > 0 and reduction > 0:
+        rho = max(rho, 2.0 * model_f / reduction)
+    return rho, p.merit(rho) - (p.f + model_f + rho * lin_v)
 
 
 def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_failure=True
@@ -191,100 +219,52 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     o, D = options, nlp.x_scale
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
-    mu = o.prox
-    lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
-    point = lambda x: _Point(nlp, nlp.project(x), Jscale)  # noqa: E731
+    point = lambda x: Iterate(nlp, nlp.project(x), Jscale)  # noqa: E731  (x unscaled)
+    scaled_point = lambda x, d: point(x + D * d)  # noqa: E731
+    correct = lambda q: scaled_point(q.x, newton_correction(nlp, q))  # noqa: E731
     p = point(nlp.x0 if x0 is None else x0)
-    rho, trust = o.rho_min, o.trust0
+    rho, trust, mu = o.rho_min, o.trust0, o.prox
     log, qp_iters, status, it, pred, stalls = [], 0, "max_iter", 0, np.inf, 0
     while it < o.max_iter:
         it += 1
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
         d_lo = np.maximum((nlp.x_lb - p.x) / D, -trust)
         d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
-        v_max = float(p.v.max(initial=0.0))
-        theta = v_max if v_max > o.tol else pred  # resolve the violation, else the decrease
+        theta = p.v_max if p.v_max > o.tol else pred  # resolve the violation, else the decrease
         eps = float(np.clip(o.qp_eps_factor * theta, *o.qp_eps))
-        # The hard subproblem; if OSQP runs out of iterations (not infeasible), the proximal
-        # weight is raised (better conditioned for ADMM, shorter step) and it is tried again.
-        admm = 0
-        for attempt in range(3):
-            qp = reduced_subproblem_for(nlp) if o.condense else subproblem_for(nlp)
-            qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
-            sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
-            admm += sol.iterations
-            if sol.status == "optimal" or "infeasible" in sol.status:
-                break
-            mu = min(10.0 * mu, o.prox_range[1])
-        hard = sol.status == "optimal"
-        if not hard:  # restoration: a least-squares (Levenberg–Marquardt) step on the rows
-            qp = subproblem_for(nlp, elastic=True)
-            qp.update(nlp, p.cs, p.jac, 0 * grad,
-                      np.full(nlp.n, o.restoration_prox), d_lo, d_hi, o.slack_reg)
-            sol = qp.solve(eps=eps)
-            admm += sol.iterations
+        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps)
         qp_iters += admm
-        d = sol.d
-        rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
-        c_lin = p.cs + p.J @ d
-        lin_v = np.maximum(np.maximum(lo - c_lin, c_lin - hi), 0.0).sum()
-        model_f = grad @ d + 0.5 * d @ (hess * d)
-        reduction = float(p.v.sum()) - lin_v
-        if model_f > 0 and reduction > 0:  # the step must descend on φ (elastic steps have
-            rho = max(rho, 2.0 * model_f / reduction)  # no informative multipliers)
-        pred = p.merit(rho) - (p.f + model_f + rho * lin_v)
+        hard = not qp.elastic
+        rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)
         step, ratio, accepted = 1.0, 0.0, False
         stationary = hard and pred <= o.ftol * max(p.f, 1e-3)
-        if stationary and p.v.max(initial=0.0) > o.tol:
+        if stationary and p.v_max > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows.
             for _ in range(3):
-                q = point(p.x + D * _correction(nlp, p))
+                q = correct(p)
                 if q.v.sum() >= p.v.sum():
                     break
                 p = q
-                if p.v.max(initial=0.0) <= o.tol:
+                if p.v_max <= o.tol:
                     break
-        if stationary and p.v.max(initial=0.0) <= o.tol:
+        if stationary and p.v_max <= o.tol:
             status = "solved"
         elif sol.status in ("optimal", "optimal_inaccurate") and pred > 0:
-            for _ in range(o.backtracks + 1):
-                trial = point(p.x + step * D * d)
-                if (step == 1.0 and trial.v.max(initial=0.0) > o.tol
-                        and p.merit(rho) - trial.merit(rho) < 0.75 * pred):
-                    # Second-order correction: the full step's curvature error on the rows
-                    # (cone, blade heights) removed by a minimum-norm Newton step at Z + d.
-                    soc = point(trial.x + D * _correction(nlp, trial))
-                    if soc.merit(rho) < trial.merit(rho):
-                        trial = soc
-                actual = p.merit(rho) - trial.merit(rho)
-                ratio = actual / (step * pred)
-                if actual >= o.eta * step * pred:
-                    accepted = True
-                    break
-                step *= 0.5
-        d_len = float(np.abs(d).max(initial=0.0))
-        # Levenberg–Marquardt weight: relaxed after a full step the model predicted well,
-        # raised when the step had to be shortened or was rejected.
-        if accepted and step == 1.0 and ratio >= o.good_ratio:
-            mu = max(mu / 4.0, o.prox_range[0])
-        elif status != "solved" and (not accepted or step < 1.0):
-            mu = min(mu * 4.0, o.prox_range[1])
+            trial, step, ratio, accepted = _line_search(
+                o, p, D * sol.d, pred, rho, point, correct)
+        d_len = float(np.abs(sol.d).max(initial=0.0))
+        if status != "solved":
+            trust, mu = _adapt(o, accepted, step, ratio, d_len, trust, mu)
         if not hard:  # restoration: count the steps that barely reduce the violation
             gain = float(p.v.sum()) - float(trial.v.sum()) if accepted else 0.0
             stalls = stalls + 1 if gain < o.stall_progress * float(p.v.sum()) else 0
         if accepted:
             p = trial
-            if step == 1.0 and ratio >= o.good_ratio and d_len >= 0.5 * trust:
-                trust = min(2.0 * trust, o.trust_max)
-            elif step < 1.0:
-                trust = max(step * d_len, o.trust_min)
-        elif status != "solved":
-            trust = max(0.1 * d_len, o.trust_min) if d_len > 0 else 0.1 * trust
-        log.append({"iter": it, "objective": nlp.objective(p.x), "violation": float(p.v.max(initial=0)),
+        log.append({"iter": it, "objective": nlp.objective(p.x), "violation": p.v_max,
                     "merit": float(p.merit(rho)), "pred": float(pred), "ratio": float(ratio),
                     "step": step if accepted else 0.0, "trust": trust, "prox": mu, "rho": rho,
-                    "qp_iters": admm, "qp_tries": attempt + 1 + (not hard), "qp_status": sol.status,
+                    "qp_iters": admm, "qp_tries": tries, "qp_status": sol.status,
                     "polished": sol.polished, "elastic": qp.elastic})
         if status == "solved":
             break
@@ -295,7 +275,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             status = "infeasible"
             break
     result = SolveResult(x=p.x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
-                         objective=nlp.objective(p.x), max_violation=float(p.v.max(initial=0.0)),
+                         objective=nlp.objective(p.x), max_violation=p.v_max,
                          log=log, qp_iterations=qp_iters)
     if status != "solved" and raise_on_failure:
         group, amount = nlp.worst_group(p.x)
