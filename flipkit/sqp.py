@@ -154,7 +154,7 @@ def _line_search(o: SQPOptions, p: Iterate, d, pred: float, rho: float, point, c
     step, ratio, trial = 1.0, 0.0, None
     for _ in range(o.backtracks + 1):
         trial = point(p.x + step * d)
-        if step == 1.0 and trial.v_max > o.tol and p.merit(rho) - trial.merit(rho) < 0.75 * pred:
+        if step == 1.0 and trial.v.sum() > p.v.sum() and p.merit(rho) - trial.merit(rho) < 0.75 * pred:
             # Second-order correction: the full step's curvature error on the rows (cone,
             # blade heights) removed by a minimum-norm Newton step at Z + d.
             soc = correct(trial)
