@@ -114,7 +114,7 @@ class OSQPDriver:
                 import osqp
 
                 rows = np.flatnonzero(work)
-                solver = osqp.OSQP()
+                solver = osqp.OSQP(algebra="builtin")
                 solver.setup(P, q, A[rows], l[rows], u[rows], **settings)
                 if self._x is not None:
                     solver.warm_start(x=self._x, y=self._y[rows])
@@ -132,7 +132,7 @@ class OSQPDriver:
             elif self._osqp is None:
                 import osqp
 
-                self._osqp = osqp.OSQP()
+                self._osqp = osqp.OSQP(algebra="builtin")
                 self._osqp.setup(P, q, A, lw, uw, **settings)
             else:
                 self._osqp.update(q=q, l=lw, u=uw, Px=P.data, Ax=A.data)
