@@ -92,6 +92,40 @@ class OSQPDriver:
         np.add.at(out.data, pos, M.data)
         return out
 
+    def _solve_persistent(self, P, q, A, l, u, work, settings):
+        """One round on the persistent solver: every row, the dropped ones unbounded."""
+        import osqp
+
+        lw, uw = np.where(work, l, -np.inf), np.where(work, u, np.inf)
+        if self._osqp is None:
+            self._osqp = osqp.OSQP(algebra="builtin")  # named: no probing of cuda/mkl modules
+            self._osqp.setup(P, q, A, lw, uw, **settings)
+        else:
+            self._osqp.update(q=q, l=lw, u=uw, Px=P.data, Ax=A.data)
+            self._osqp.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"],
+                                       max_iter=settings["max_iter"])
+            if self._x is not None:
+                self._osqp.warm_start(x=self._x, y=self._y)
+        return self._osqp.solve(raise_error=False)
+
+    def _solve_compact(self, P, q, A, l, u, work, settings):
+        """One round on a fresh solver holding the working rows only; the result's dual
+        vectors are returned at full length (zero on the dropped rows), as cvxpy unpacks."""
+        import osqp
+
+        rows = np.flatnonzero(work)
+        solver = osqp.OSQP(algebra="builtin")
+        solver.setup(P, q, A[rows], l[rows], u[rows], **settings)
+        if self._x is not None:
+            solver.warm_start(x=self._x, y=self._y[rows])
+        res = solver.solve(raise_error=False)
+        for name in ("y", "prim_inf_cert"):
+            full = np.zeros(len(l))
+            if getattr(res, name, None) is not None:
+                full[rows] = getattr(res, name)
+            setattr(res, name, full)
+        return res
+
     def solve(self, settings: dict):
         """Solve for the current parameter values; returns (OSQP result, total ADMM iterations).
 
@@ -109,43 +143,12 @@ class OSQPDriver:
         for rnd in range(MAX_ROUNDS + 1):
             if rnd == MAX_ROUNDS:
                 work[:] = True
-            lw, uw = np.where(work, l, -np.inf), np.where(work, u, np.inf)
-            if self.compact:  # OSQP gets the working rows only: set up afresh (small KKT)
-                import osqp
-
-                rows = np.flatnonzero(work)
-                solver = osqp.OSQP(algebra="builtin")
-                solver.setup(P, q, A[rows], l[rows], u[rows], **settings)
-                if self._x is not None:
-                    solver.warm_start(x=self._x, y=self._y[rows])
-                res = solver.solve(raise_error=False)
-                total += res.info.iter
-                for name in ("y", "prim_inf_cert"):  # full length, as cvxpy unpacks them
-                    full = np.zeros(len(l))
-                    if getattr(res, name, None) is not None:
-                        full[rows] = getattr(res, name)
-                    setattr(res, name, full)
-                y = res.y
-                if res.x is None or not np.all(np.isfinite(res.x)):
-                    break
-                self._x, self._y = res.x, y
-            elif self._osqp is None:
-                import osqp
-
-                self._osqp = osqp.OSQP(algebra="builtin")
-                self._osqp.setup(P, q, A, lw, uw, **settings)
-            else:
-                self._osqp.update(q=q, l=lw, u=uw, Px=P.data, Ax=A.data)
-                self._osqp.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"],
-                                           max_iter=settings["max_iter"])
-                if self._x is not None:
-                    self._osqp.warm_start(x=self._x, y=self._y)
-            if not self.compact:
-                res = self._osqp.solve(raise_error=False)
-                total += res.info.iter
-                if res.x is None or not np.all(np.isfinite(res.x)):
-                    break
-                self._x, self._y = res.x, res.y
+            round_solve = self._solve_compact if self.compact else self._solve_persistent
+            res = round_solve(P, q, A, l, u, work, settings)
+            total += res.info.iter
+            if res.x is None or not np.all(np.isfinite(res.x)):
+                break
+            self._x, self._y = res.x, res.y
             if res.info.status_val not in (1, 2) or work.all():  # solved (inaccurate) or full
                 break
             z = A @ res.x
