@@ -54,7 +54,9 @@ class OSQPDriver:
 
     def _data(self):
         """(P upper triangle, A, q, l, u, chain, inverse data) for the current parameters."""
-        data, chain, inverse = self.problem.get_problem_data(cp.OSQP)
+        with warnings.catch_warnings():  # cvxpy reads sparse parameters through `.value`
+            warnings.filterwarnings("ignore", "Reading from a sparse", RuntimeWarning)
+            data, chain, inverse = self.problem.get_problem_data(cp.OSQP)
         A = sp.vstack([data["A"], data["F"]]).tocsc()
         b, g = data["b"], data["G"]
         l = np.concatenate([b, np.full(g.shape, -np.inf)])
@@ -64,12 +66,22 @@ class OSQPDriver:
         """Sparsity of P and A for every parameter value: cvxpy drops explicit zeros, OSQP's
         ``update`` needs the pattern of its setup. Found once with random parameter values."""
         rng = np.random.default_rng(0)
-        saved = {prm: prm.value for prm in self.problem.parameters()}
+        saved = {prm: prm.value_sparse if prm.sparse_idx is not None else prm.value
+                 for prm in self.problem.parameters()}
         for prm in self.problem.parameters():
-            prm.value = rng.uniform(0.5, 1.5, prm.shape) if prm.shape else 1.0
+            if prm.sparse_idx is not None:  # a sparse parameter: random values on its pattern
+                prm.value_sparse = sp.coo_array(
+                    (rng.uniform(0.5, 1.5, len(prm.sparse_idx[0])), prm.sparse_idx), shape=prm.shape)
+            else:
+                prm.value = rng.uniform(0.5, 1.5, prm.shape) if prm.shape else 1.0
         P, A, *_ = self._data()
         for prm, val in saved.items():
-            prm.value = val
+            if val is None:
+                continue
+            if prm.sparse_idx is not None:
+                prm.value_sparse = val
+            else:
+                prm.value = val
         self._patterns = []
         self._keys = []
         for M in (P, A):

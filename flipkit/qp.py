@@ -14,11 +14,13 @@ box (or OSQP fails on them), so that every linearisation still yields a step. It
 penalised quadratically, a least-squares compromise between the rows: with an ℓ1 term
 ρ1ᵀs the QP is LP-like and OSQP hit its iteration cap on the flip segments (measured).
 
-J enters as a parameter vector of its nonzeros on the NLP's fixed pattern: J d = S_r (j ⊙ S_c
-d), with constant selection matrices S_c, S_r, so the problem is DPP and is canonicalised
-once per structure; re-solves only map new parameter values and OSQP warm-starts. Written as
-Σ h_k d_k² the Hessian adds no auxiliary variables to the OSQP problem. Build
-(:class:`QPSubproblem`) is separate from solve, so the QP can be inspected alone.
+J enters as sparse cvxpy Parameters (one per row group: equalities, finite lower and finite
+upper bounds) on the NLP's fixed pattern, so the problem is DPP and is canonicalised once per
+structure — in ~0.01 s (measured; J d written as a dense parameter vector times selection
+matrices took 1.3–1.9 s per structure); re-solves only map new parameter values and OSQP
+warm-starts. Written as Σ h_k d_k² the Hessian adds no auxiliary variables to the OSQP
+problem. Build (:class:`QPSubproblem`) is separate from solve, so the QP can be inspected
+alone.
 """
 
 from __future__ import annotations
@@ -53,6 +55,26 @@ class QPSolution:
     polished: bool = False
 
 
+class _SparseRows:
+    """A sparse cvxpy Parameter holding the Jacobian rows ``rows`` on the NLP's pattern
+    (duplicate pattern entries summed)."""
+
+    def __init__(self, nlp: NLP, rows: np.ndarray, name: str):
+        rank = np.full(nlp.m, -1)
+        rank[rows] = np.arange(len(rows))
+        self.entries = np.flatnonzero(rank[nlp.jac_rows] >= 0)
+        keys = rank[nlp.jac_rows[self.entries]] * nlp.n + nlp.jac_cols[self.entries]
+        unique, self._slot = np.unique(keys, return_inverse=True)
+        self._ij = (unique // nlp.n, unique % nlp.n)
+        self.shape = (len(rows), nlp.n)
+        self.param = cp.Parameter(self.shape, sparsity=self._ij, name=name)
+
+    def set(self, jac: np.ndarray) -> None:
+        """Values from the Jacobian entries ``jac`` (pattern order)."""
+        vals = np.bincount(self._slot, weights=jac[self.entries], minlength=len(self._ij[0]))
+        self.param.value_sparse = sp.coo_array((vals, self._ij), shape=self.shape)
+
+
 class QPSubproblem:
     """The convex subproblem for NLPs sharing one structure (pattern and bound types).
 
@@ -62,16 +84,16 @@ class QPSubproblem:
     """
 
     def __init__(self, nlp: NLP, elastic: bool = False):
-        n, m, nnz = nlp.n, nlp.m, len(nlp.jac_rows)
+        n, m = nlp.n, nlp.m
         self.elastic, self.m = elastic, m
         eq = nlp.c_lo == nlp.c_hi
         self.eq_rows = np.flatnonzero(eq)
         self.lo_rows = np.flatnonzero(np.isfinite(nlp.c_lo) & ~eq)
         self.hi_rows = np.flatnonzero(np.isfinite(nlp.c_hi) & ~eq)
-        S_c = sp.csr_matrix((np.ones(nnz), (np.arange(nnz), nlp.jac_cols)), shape=(nnz, n))
-        S_r = sp.csr_matrix((np.ones(nnz), (nlp.jac_rows, np.arange(nnz))), shape=(m, nnz))
         self.d = cp.Variable(n, name="d")
-        self.jac = cp.Parameter(nnz, name="jacobian")
+        self._jacobians = {key: _SparseRows(nlp, rows, f"jacobian_{key}") for key, rows in
+                           (("eq", self.eq_rows), ("lo", self.lo_rows), ("hi", self.hi_rows))}
+        Jd = {key: J.param @ self.d for key, J in self._jacobians.items()}
         self.r_eq = cp.Parameter(len(self.eq_rows), name="c_minus_target")
         self.r_lo = cp.Parameter(len(self.lo_rows), name="c_minus_lo")
         self.r_hi = cp.Parameter(len(self.hi_rows), name="hi_minus_c")
@@ -80,7 +102,6 @@ class QPSubproblem:
         self.d_lo = cp.Parameter(n, name="d_lo")
         self.d_hi = cp.Parameter(n, name="d_hi")
         self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
-        Jd = cp.multiply(self.jac, S_c @ self.d)
         cons = [self.d >= self.d_lo, self.d <= self.d_hi]
         slacks = []
 
@@ -94,11 +115,11 @@ class QPSubproblem:
         self.rows = {}
         if len(self.eq_rows):
             k = len(self.eq_rows)
-            self.rows["eq"] = self.r_eq + S_r[self.eq_rows] @ Jd == slack(k, "s_plus") - slack(k, "s_minus")
+            self.rows["eq"] = self.r_eq + Jd["eq"] == slack(k, "s_plus") - slack(k, "s_minus")
         if len(self.lo_rows):
-            self.rows["lo"] = self.r_lo + S_r[self.lo_rows] @ Jd + slack(len(self.lo_rows), "s_lo") >= 0
+            self.rows["lo"] = self.r_lo + Jd["lo"] + slack(len(self.lo_rows), "s_lo") >= 0
         if len(self.hi_rows):
-            self.rows["hi"] = self.r_hi - S_r[self.hi_rows] @ Jd + slack(len(self.hi_rows), "s_hi") >= 0
+            self.rows["hi"] = self.r_hi - Jd["hi"] + slack(len(self.hi_rows), "s_hi") >= 0
         cons += list(self.rows.values())
         obj = self.grad @ self.d + 0.5 * cp.sum(cp.multiply(self.hess, cp.square(self.d)))
         if elastic:
@@ -117,7 +138,8 @@ class QPSubproblem:
                 Hessian diagonal (with any proximal weight). d_lo, d_hi: Step box.
             slack_reg: Weight σ of ½σ‖s‖² on the elastic slacks.
         """
-        self.jac.value = jac
+        for J in self._jacobians.values():
+            J.set(jac)
         self.r_eq.value = (c - nlp.c_scale * nlp.c_lo)[self.eq_rows]
         self.r_lo.value = (c - nlp.c_scale * nlp.c_lo)[self.lo_rows]
         self.r_hi.value = (nlp.c_scale * nlp.c_hi - c)[self.hi_rows]

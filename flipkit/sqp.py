@@ -4,7 +4,7 @@ Model. Each iteration linearises the constraints at Z_k and solves the convex su
 :mod:`flipkit.qp` — in its null-space (condensed) form, :mod:`flipkit.reduced_qp`, by
 default: the 516–528 linearised equality rows are eliminated by a sparse LU, leaving 19–31
 variables with an identity Hessian and only inequality rows for OSQP (measured on the ten
-Table I pickup-and-flip chains: median 11.7 s → 2.1 s per burger). The model: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt
+Table I pickup-and-flip chains: median 11.7 s → 1.6 s per burger). The model: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt
 weight ½μ‖d‖², every linearised row hard, and a box trust region |d|∞ ≤ Δ (scaled units).
 With the dynamics rows u = RNEA(q, q̇, q̈) hard this is the Gauss–Newton model of Σ‖RNEA‖²
 along the linearised constraints: no second derivatives, no quasi-Newton memory. Σu² is

@@ -1,6 +1,8 @@
 """The SQP subproblem: DPP, compiled once per structure, exact multipliers, the working set
 returns the full QP's solution, warm starts cut OSQP iterations."""
 
+import warnings
+
 import cvxpy as cp
 import numpy as np
 import pytest
@@ -80,7 +82,9 @@ def test_working_set_solution_is_the_full_qp_solution(setup):
     _load(qp, a, x2)
     sol = qp.solve(eps=1e-9)
     assert qp._driver._active.sum() < 0.1 * len(qp._driver._active)  # a small working set
-    qp.problem.solve(solver=cp.OSQP, eps_abs=1e-9, eps_rel=1e-9, max_iter=200000)
+    with warnings.catch_warnings():  # cvxpy reads sparse parameters through `.value`
+        warnings.filterwarnings("ignore", "Reading from a sparse", RuntimeWarning)
+        qp.problem.solve(solver=cp.OSQP, eps_abs=1e-9, eps_rel=1e-9, max_iter=200000)
     ref = qp.problem.value
     _, _, J, g, h = _scaled(a, x2)
     value = g @ sol.d + 0.5 * sol.d @ (h * sol.d)
