@@ -10,7 +10,7 @@ a batch of the first K locations with the SQP, beside the paper's budgets (Sec. 
 per trajectory, 4–5 burgers within 90 s). Times are wall-clock seconds of the solver calls
 (IPOPT's include building its CasADi problem). Before timing, every NLP structure gets one
 SQP iteration, and its hard and elastic QPs are compiled, so that cvxpy's one-off
-canonicalisation (1–3 s per QP, once per process) is not timed.
+canonicalisation (0.01–0.4 s per QP, once per process) is not timed.
 """
 
 from __future__ import annotations

@@ -148,7 +148,7 @@ class QPSubproblem:
         self.slack_reg.value = slack_reg
 
     def compile(self) -> OSQPDriver:
-        """Canonicalise with cvxpy (once; ~1–3 s) and return the OSQP driver."""
+        """Canonicalise with cvxpy (once; 0.1–0.4 s) and return the OSQP driver."""
         if not hasattr(self, "_driver"):
             self._driver = OSQPDriver(self.problem)
         return self._driver
