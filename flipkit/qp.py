@@ -147,6 +147,11 @@ class QPSubproblem:
         self.d_lo.value, self.d_hi.value = d_lo, np.maximum(d_hi, d_lo)
         self.slack_reg.value = slack_reg
 
+    def cold(self) -> None:
+        """Drop OSQP's warm start and working set (the next solve starts from zero)."""
+        if hasattr(self, "_driver"):
+            self._driver.reset()
+
     def compile(self) -> OSQPDriver:
         """Canonicalise with cvxpy (once; 0.1–0.4 s) and return the OSQP driver."""
         if not hasattr(self, "_driver"):

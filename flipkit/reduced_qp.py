@@ -105,6 +105,11 @@ class ReducedQP:
         if hasattr(self, "_driver"):
             self._driver.reset()
 
+    def cold(self) -> None:
+        """Drop OSQP's warm start and working set (the next solve starts from zero)."""
+        if hasattr(self, "_driver"):
+            self._driver.reset()
+
     def compile(self) -> OSQPDriver:
         """Canonicalise with cvxpy (once) and return the OSQP driver."""
         if not hasattr(self, "_driver"):

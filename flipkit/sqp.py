@@ -136,6 +136,10 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
         sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
         admm += sol.iterations
+        if "infeasible" in sol.status:  # a warm start from the previous subproblem's duals
+            qp.cold()  # can fake an infeasibility certificate (measured): confirm it cold
+            sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
+            admm += sol.iterations
         if sol.status == "optimal" or "infeasible" in sol.status:
             break
         mu = min(10.0 * mu, o.prox_range[1])

@@ -107,3 +107,20 @@ def test_sequential_solves_repeat_exactly(reference):
     solve_sqp(other, x0=other.x0 + 0.01 * other.x_scale, raise_on_failure=False)
     again = solve_sqp(nlp)
     assert np.array_equal(again.x, res.x) and again.iterations == res.iterations
+
+
+def test_no_restoration_from_a_feasible_point():
+    """At a feasible iterate the linearisation is feasible (d = 0 satisfies it), so the SQP
+    must never fall back to restoration there. Regression: a warm start from the previous
+    subproblem's duals made OSQP report a false infeasibility certificate at this go-to-
+    burger segment, and the solve stalled at J = 15 838 instead of reaching 13 678."""
+    from flipkit.behaviors import Models, build_segment
+    from flipkit.config import CellConfig
+
+    models = Models(CellConfig())
+    nlp = build_segment("go_to_burger", models, models.bare.q_home, np.zeros(6),
+                        location=(0.677778, -0.17, 0.072))
+    res = solve_sqp(nlp)
+    feasible_before = [True] + [row["violation"] <= 1e-6 for row in res.log[:-1]]
+    assert not any(row["elastic"] for row, ok in zip(res.log, feasible_before) if ok)
+    assert res.objective == pytest.approx(solve_ipopt(nlp).objective, rel=1e-3)
