@@ -32,6 +32,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .errors import ConfigError
 from .nlp import NLP
 from .osqp_driver import OSQPDriver
 from .qp import OSQP_SETTINGS, QPSolution
@@ -44,7 +45,7 @@ class ReducedQP:
         nlp: An NLP of the structure (its pattern and bound types are used, not its values).
 
     Raises:
-        ValueError: More equality rows than variables.
+        ConfigError: As many equality rows as variables or more (nothing left to optimise).
     """
 
     elastic = False
@@ -56,7 +57,8 @@ class ReducedQP:
         self.eq_rows, self.ineq_rows = np.flatnonzero(eq), np.flatnonzero(~eq)
         self.r = n - len(self.eq_rows)
         if self.r <= 0:
-            raise ValueError(f"{len(self.eq_rows)} equality rows for {n} variables")
+            raise ConfigError(f"segment {nlp.name!r}: {len(self.eq_rows)} equality rows for {n} "
+                              "variables leave no null space to optimise in")
         # Jacobian entries of the equality / inequality rows, and their row numbers there.
         self._eq_entries = eq[nlp.jac_rows]
         rank = np.full(m, -1)
@@ -99,6 +101,15 @@ class ReducedQP:
         self.basis = np.sort(piv[: len(self.eq_rows)])
         self.free = np.sort(piv[len(self.eq_rows):])
 
+    def _factor(self, E):
+        """Sparse LU of E_B, or None if it is singular or its pivots span more than 1e12."""
+        try:
+            lu = spla.splu(E[:, self.basis])
+        except RuntimeError:
+            return None
+        pivots = np.abs(lu.U.diagonal())
+        return lu if pivots.min() > 1e-12 * pivots.max() else None
+
     def reset(self) -> None:
         """Forget OSQP's state and the basis."""
         self.basis = None
@@ -124,11 +135,12 @@ class ReducedQP:
         E, JI = self._split(jac)
         if self.basis is None:
             self.choose_basis(jac)
-        try:
-            lu = spla.splu(E[:, self.basis])
-        except RuntimeError:  # E_B singular here: pivot again at this point
+        lu = self._factor(E)
+        if lu is None:  # E_B (nearly) singular here: pivot again at this point
             self.choose_basis(jac)
-            lu = spla.splu(E[:, self.basis])
+            lu = self._factor(E)
+            if lu is None:
+                raise ConfigError("the equality rows' Jacobian is rank deficient")
         B, N, n, r = self.basis, self.free, self.n, self.r
         lo_s, hi_s = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
         Z = np.zeros((n, r))

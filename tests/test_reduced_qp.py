@@ -125,3 +125,22 @@ def test_infeasible_linearisation_is_reported_not_raised():
     sol = qp.solve(eps=1e-6, max_iter=20000)
     assert "infeasible" in sol.status
     assert not np.any(sol.d) and not np.any(sol.multipliers)
+
+
+def test_singular_basis_is_pivoted_again(segments):
+    """If the basic columns' block E_B turns singular (here: one basic column's Jacobian
+    entries zeroed), the update re-pivots at the current point instead of producing garbage."""
+    nlp = segments["translate"]
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    qp = ReducedQP(nlp)
+    qp.choose_basis(entries)
+    eq = np.flatnonzero(nlp.c_lo == nlp.c_hi)
+    for dead in qp.basis[::-1]:  # a basic column whose loss leaves E with full row rank
+        bad = np.where(nlp.jac_cols == dead, 0.0, entries)
+        Jbad = sp.csr_matrix((bad, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
+        E = Jbad[eq]
+        if np.linalg.matrix_rank(E.toarray()) == len(eq):
+            break
+    qp.update(nlp, c, bad, g, h, lo, hi)
+    assert dead not in qp.basis
+    assert np.abs(E @ qp.T.value).max() < 1e-9 * np.abs(qp.T.value).max()
