@@ -42,6 +42,22 @@ OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_in
                      polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
 
 
+def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_iter: int | None):
+    """Solve ``problem`` through its driver with :data:`OSQP_SETTINGS` (``eps`` and
+    ``max_iter`` overriding); returns (OSQP result, ADMM iterations, status, solved), status
+    cvxpy's, or ``osqp:<status>`` when cvxpy could not unpack it, solved for (inaccurately)
+    optimal."""
+    settings = dict(OSQP_SETTINGS)
+    if eps is not None:
+        settings.update(eps_abs=eps, eps_rel=eps)
+    if max_iter is not None:
+        settings.update(max_iter=int(max_iter))
+    res, iterations = driver.solve(settings)
+    ok = res.info.status_val in (1, 2, 3, 4)
+    status = str(problem.status) if ok else f"osqp:{res.info.status}"
+    return res, iterations, status, res.info.status_val in (1, 2)
+
+
 @dataclass
 class QPSolution:
     """d (scaled step), OSQP status and iterations, and the row multipliers y (m,) in scaled
@@ -171,15 +187,8 @@ class QPSubproblem:
             eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS`.
             max_iter: ADMM iteration cap overriding :data:`OSQP_SETTINGS`.
         """
-        settings = dict(OSQP_SETTINGS)
-        if eps is not None:
-            settings.update(eps_abs=eps, eps_rel=eps)
-        if max_iter is not None:
-            settings.update(max_iter=int(max_iter))
-        res, iterations = self.compile().solve(settings)
-        ok = res.info.status_val in (1, 2, 3, 4)
-        status = str(self.problem.status) if ok else f"osqp:{res.info.status}"
-        d = self.d.value if ok and res.info.status_val in (1, 2) else None
+        res, iterations, status, solved = run_osqp(self.compile(), self.problem, eps, max_iter)
+        d = self.d.value if solved else None
         y = np.zeros(self.m)
         # cvxpy's duals: L = f − μᵀ(expr) for `expr ≥ 0` (μ ≥ 0), f + λᵀ(expr) for `expr == 0`.
         for key, rows, sign in (("eq", self.eq_rows, 1.0), ("lo", self.lo_rows, -1.0),

@@ -35,7 +35,7 @@ import scipy.sparse.linalg as spla
 from .errors import ConfigError
 from .nlp import NLP
 from .osqp_driver import OSQPDriver
-from .qp import OSQP_SETTINGS, QPSolution
+from .qp import QPSolution, run_osqp
 
 
 class ReducedQP:
@@ -163,16 +163,9 @@ class ReducedQP:
     def solve(self, eps: float | None = None, max_iter: int | None = None) -> QPSolution:
         """Solve with OSQP and map back: the full-space step d and row multipliers y (m,), in
         the sign convention of :class:`~flipkit.qp.QPSolution`."""
-        settings = dict(OSQP_SETTINGS)
-        if eps is not None:
-            settings.update(eps_abs=eps, eps_rel=eps)
-        if max_iter is not None:
-            settings.update(max_iter=int(max_iter))
-        res, iterations = self.compile().solve(settings)
-        ok = res.info.status_val in (1, 2, 3, 4)
-        status = str(self.problem.status) if ok else f"osqp:{res.info.status}"
+        res, iterations, status, solved = run_osqp(self.compile(), self.problem, eps, max_iter)
         y = np.zeros(self.m)
-        if not (ok and res.info.status_val in (1, 2)):
+        if not solved:
             return QPSolution(np.zeros(self.n), status, iterations, y, False)
         lu, T, d_p, JI, grad, hess = self._state
         d = d_p + T @ self.v.value
