@@ -45,7 +45,8 @@ class OSQPDriver:
 
     def __init__(self, problem: cp.Problem, compact: bool = False):
         self.problem, self.compact = problem, compact
-        self._fixed_pattern()
+        if not compact:  # compact mode sets up afresh each round: no pattern to keep
+            self._fixed_pattern()
         self.reset()
 
     def reset(self) -> None:
@@ -144,7 +145,11 @@ class OSQPDriver:
         The cvxpy variables and constraint duals are set as by ``problem.solve``.
         """
         P, A, q, l, u, chain, inverse = self._data()
-        P, A = self._on_pattern(0, P), self._on_pattern(1, A)
+        if self.compact:  # OSQP takes 32-bit indices
+            P, A = (sp.csc_matrix((M.data, M.indices.astype(np.int32), M.indptr.astype(np.int32)),
+                                  shape=M.shape) for M in (P, A))
+        else:  # `update` needs the setup's sparsity pattern
+            P, A = self._on_pattern(0, P), self._on_pattern(1, A)
         ineq = ~(l == u)
         if self._active is None:  # first solve: the rows within INITIAL_SLACK of a bound
             self._active = ineq & (np.minimum(u, -l) <= INITIAL_SLACK)
