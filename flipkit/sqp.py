@@ -225,8 +225,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     point = lambda x: Iterate(nlp, nlp.project(x), Jscale)  # noqa: E731  (x unscaled)
-    scaled_point = lambda x, d: point(x + D * d)  # noqa: E731
-    correct = lambda q: scaled_point(q.x, newton_correction(nlp, q))  # noqa: E731
+    correct = lambda q: point(q.x + D * newton_correction(nlp, q))  # noqa: E731
     p = point(nlp.x0 if x0 is None else x0)
     rho, trust, mu = o.rho_min, o.trust0, o.prox
     log, qp_iters, status, it, pred, stalls = [], 0, "max_iter", 0, np.inf, 0
