@@ -134,14 +134,30 @@ class SpatulaConfig:
 
 @dataclass(frozen=True)
 class BurgerConfig:
-    """The burger patty: a uniform disc (paper Sec. II.C).
+    """The burger patty: a uniform disc (paper Sec. II.C). Sources beside each value; the
+    plausible ranges the sensitivity study sweeps are in :data:`PHYSICAL_RANGES`.
 
     Attributes:
-        diameter: d (m); a quarter-pound patty is about 10 cm.
-        thickness: Patty thickness (m).
-        mass: m (kg); a quarter pound is 0.113 kg.
-        mu: Spatula–burger friction coefficient μ (paper leaves it unspecified; 0.5 is a
-            greased steel–meat value).
+        diameter: d (m). 0.10 m = 3.9 in: "a standard hamburger patty is formed into a 4-5
+            inch wide patty that is about 3/4 inch thick" (The Donut Whole, "How many ounces
+            is a 1/4 burger?", https://www.thedonutwhole.com/how-many-ounces-is-a-1-4-burger/);
+            homemade 3.5-4 in (Kitchen Wisdom, "How many ounces are in a quarter-pound
+            burger?", https://kitchenwisdom.info/how-many-ounces-are-in-a-quarter-pound-burger).
+        thickness: Patty thickness (m). The same sources give 3/4 in (19 mm) for the raw,
+            hand-formed patty; 15 mm is a pressed patty (no source gives it: range
+            10-19 mm, stated as ours).
+        mass: m (kg). A quarter pound = 4 oz = 113.4 g raw (ChefRadar, "How many ounces does
+            a hamburger weighing a quarter pound have?", https://chefradar.com/how-many-ounces-
+            does-a-hamburger-weighing-a-quarter-pound-have/); cooking loses 15-25 % (The Donut
+            Whole, above), 24.7-32.1 % for 5-30 % fat patties (J. Food Sci., "Chemical,
+            physical and sensory characterization of ground beef containing 5 to 30 percent
+            fat").
+        mu: Spatula-burger (meat on stainless steel) friction coefficient mu. No measurement
+            of meat on stainless steel was found; friction coefficients of foods on a texture
+            test cell's surface range 0.04-0.52 ("Effect of friction on the performance of
+            texture test cells", J. Texture Studies; https://paperexplained.cn/articles/paper/
+            detail/0401cf38c535a35e153632f5b9bb1a2a752387d2). 0.5 (the planner's value, top of
+            that range) is kept; range 0.2-0.8 stated as ours.
     """
 
     diameter: float = 0.10
@@ -152,6 +168,105 @@ class BurgerConfig:
     def __post_init__(self):
         for name in ("diameter", "thickness", "mass", "mu"):
             _positive(f"burger {name}", getattr(self, name))
+
+
+@dataclass(frozen=True)
+class PhysicsConfig:
+    """Simulation-only physics of the cell (MuJoCo scene, closed-loop execution).
+
+    One parameter set serves every location; no value is tuned to make plans pass. Each
+    value's source is stated beside it; where none was found a range is given and said so.
+    The ranges swept by the sensitivity study are in :data:`PHYSICAL_RANGES`.
+
+    Attributes:
+        mu_grill: Burger-grill friction (meat on a steel grill plate). Same material pair and
+            source as :attr:`BurgerConfig.mu` (foods on a test surface 0.04-0.52); the paper
+            only says a cool grill makes burgers "sticky", which would raise it. 0.5; range
+            0.2-1.0 stated as ours.
+        burger_modulus: Young's modulus E of the patty (Pa). Grilled pork 28-147 kPa,
+            grilled poultry 31-75 kPa (Hindawi J. Food Quality 2022, "Application of Food
+            Mechanics and Oral Processing in Modelling First Bite of Grilled Meat", Table 4,
+            https://www.hindawi.com/journals/jfq/2022/9176628/tab4/); no beef-patty modulus
+            was found: 50 kPa, range 28-147 kPa.
+        burger_dampratio: Damping ratio of the burger contacts (MuJoCo solref[1]); a patty
+            does not bounce (no source: 1 = critically damped, range 0.7-2).
+        blade_thickness: Blade thickness (m). A stiff one-piece stainless turner is 0.04 in
+            = 1 mm, 18 gauge (J. Kenji Lopez-Alt, "The Food Lab", equipment chapter); a thin
+            plated-steel turner 0.45 mm (softsolder.com, "Kitchen Spatula Search", 2016);
+            heavy griddle turners up to 2 mm (no source). 1 mm, range 0.45-2 mm.
+        bevel_length: Length of the ground bevel on the underside of the leading edge (m).
+            No source: 5 mm, range 2-10 mm.
+        edge_thickness: Thickness left at the leading edge (m); "keen and sturdy front edge"
+            (The Food Lab) gives no number: 0.2 mm, range 0.1-0.5 mm (ours).
+        mu_blade_grill: Blade-grill friction, steel on steel. Dry, clean steel: static
+            0.6-0.8, kinetic 0.4-0.6 (enersection.io, "Understanding the friction coefficient
+            of steel on steel"); an oiled griddle is lower (no number found). 0.3, range
+            0.1-0.6.
+        steel_timeconst: MuJoCo solref time constant of the blade-grill contact (s). Steel on
+            steel is far stiffer than any step can integrate; the compliance that matters is
+            the arm's servo. The smallest stable value, 2 timesteps (MuJoCo XML reference:
+            solref timeconst at least twice the timestep): 1 ms. Range 1-10 ms (ours).
+        timestep: MuJoCo integration step (s).
+        servo_rate_hz: Rate at which the robot's controller receives desired (q, qd) in
+            ``position`` mode (Hz). Real-time client interface: CB-series 125 Hz, e-Series
+            500 Hz (Universal Robots, "Remote Control Via TCP/IP", https://www.universal-
+            robots.com/articles/ur/interface-communication/remote-control-via-tcpip/).
+            The paper's arm is unnamed: CB3 rate 125 Hz, range 125-500 Hz.
+        latency_s: Delay (s) between a desired state and its arrival at the joint servo in
+            ``position`` mode. One 125 Hz period of transport plus one of the controller's
+            cycle is 16 ms; the UR10 performance analysis of DTU (Ravn, Andersen, Andersen
+            2014, "UR10 Performance Analysis", orbit.dtu.dk) measures the real-time
+            interface's delays, its number was not read here: 8 ms, range 2-20 ms (ours).
+        kp, kd: Joint PD gains (N m/rad, N m s/rad), the values of
+            :data:`flipkit.tracking.DEFAULT_KP` / ``DEFAULT_KD`` (about critical damping at
+            q_home, stated there); UR does not publish its servo gains.
+    """
+
+    mu_grill: float = 0.5
+    burger_modulus: float = 50e3
+    burger_dampratio: float = 1.0
+    blade_thickness: float = 0.001
+    bevel_length: float = 0.005
+    edge_thickness: float = 0.0002
+    mu_blade_grill: float = 0.3
+    steel_timeconst: float = 0.001
+    timestep: float = 0.0005
+    servo_rate_hz: float = 125.0
+    latency_s: float = 0.008
+    kp: tuple = (2000.0, 2000.0, 1000.0, 300.0, 300.0, 50.0)
+    kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
+
+    def __post_init__(self):
+        for name in ("mu_grill", "burger_modulus", "burger_dampratio", "blade_thickness",
+                     "bevel_length", "edge_thickness", "mu_blade_grill", "steel_timeconst",
+                     "timestep", "servo_rate_hz"):
+            _positive(f"physics {name}", getattr(self, name))
+        if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
+            raise ConfigError(f"physics latency_s must be >= 0 s, got {self.latency_s!r}")
+        if self.edge_thickness >= self.blade_thickness:
+            raise ConfigError("physics edge_thickness must be below blade_thickness, got "
+                              f"{self.edge_thickness} >= {self.blade_thickness}")
+        if self.steel_timeconst < 2 * self.timestep - 1e-12:
+            raise ConfigError(f"physics steel_timeconst must be >= 2 timesteps "
+                              f"({2 * self.timestep} s), got {self.steel_timeconst}")
+        for name in ("kp", "kd"):
+            g = _finite(f"physics {name}", getattr(self, name))
+            if g.ndim != 1 or np.any(g < 0):
+                raise ConfigError(f"physics {name} must be non-negative gains, got {g}")
+
+    def burger_timeconst(self, burger: "BurgerConfig", mass: float | None = None) -> float:
+        """MuJoCo solref time constant (s) of the burger's contacts, from the patty stiffness.
+
+        The patty compressed through its thickness is a spring k = E A / h (N/m), A its face
+        area; carrying mass m it has the natural frequency ω = √(k/m), and MuJoCo's
+        reference spring with time constant τ and damping ratio 1 has ω = 1/τ. So
+        τ = √(m h / (E A)), clipped below at 2 timesteps (MuJoCo's stability floor).
+        Default patty: k = 26 kN/m, τ = 2.1 ms.
+        """
+        m = burger.mass if mass is None else float(mass)
+        area = math.pi * burger.diameter**2 / 4
+        tau = math.sqrt(m * burger.thickness / (self.burger_modulus * area))
+        return max(tau, 2 * self.timestep)
 
 
 @dataclass(frozen=True)
@@ -232,6 +347,7 @@ class CellConfig:
     table: TableConfig = field(default_factory=TableConfig)
     limits: TaskLimits = field(default_factory=TaskLimits)
     gravity: tuple = GRAVITY
+    physics: PhysicsConfig = field(default_factory=PhysicsConfig)
 
     def __post_init__(self):
         _finite("gravity", self.gravity, (3,))
@@ -242,3 +358,41 @@ TABLE1_LOCATIONS = (  # Table I of the paper: p^b (m), robot base frame (shared/
     (0.68, -0.31, 0.072), (0.69, -0.16, 0.072), (0.73, -0.13, 0.072), (0.73, -0.18, 0.072),
     (0.75, -0.45, 0.072), (0.84, 0.12, 0.072),
 )
+
+
+_NO_SOURCE = "no source found; range ours"
+PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time
+    "burger.diameter": (0.089, 0.127, "3.5-5 in: The Donut Whole / Kitchen Wisdom (BurgerConfig)"),
+    "burger.thickness": (0.010, 0.019, "19 mm raw (3/4 in, same sources); lower end " + _NO_SOURCE),
+    "burger.mass": (0.085, 0.1134, "quarter pound raw 113.4 g; cooked -15..25 % (BurgerConfig)"),
+    "burger.mu": (0.2, 0.8, "foods on a test surface 0.04-0.52 (J. Texture Studies); "
+                  + _NO_SOURCE + " for meat on stainless"),
+    "physics.mu_grill": (0.2, 1.0, "as burger.mu; sticky patty (paper) raises it; " + _NO_SOURCE),
+    "physics.burger_modulus": (28e3, 147e3, "grilled pork/poultry E (Hindawi JFQ 2022, Table 4)"),
+    "physics.burger_dampratio": (0.7, 2.0, _NO_SOURCE),
+    "physics.blade_thickness": (0.00045, 0.002, "1 mm (The Food Lab), 0.45 mm (softsolder.com); "
+                                "2 mm " + _NO_SOURCE),
+    "physics.bevel_length": (0.002, 0.010, _NO_SOURCE),
+    "physics.edge_thickness": (0.0001, 0.0005, _NO_SOURCE),
+    "physics.mu_blade_grill": (0.1, 0.6, "dry steel-steel kinetic 0.4-0.6 (enersection.io); "
+                               "oiled " + _NO_SOURCE),
+    "physics.steel_timeconst": (0.001, 0.010, "MuJoCo floor 2 timesteps; " + _NO_SOURCE),
+    "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
+                              "(UR 'Remote Control Via TCP/IP')"),
+    "physics.latency_s": (0.002, 0.020, _NO_SOURCE + " (UR10 Performance Analysis, DTU 2014, "
+                          "measures it; not read)"),
+}
+"""Plausible range (lo, hi) of each physical parameter, with its source text: the values a
+sensitivity study sweeps one at a time (see :func:`with_parameter`)."""
+
+
+def with_parameter(cell: "CellConfig", name: str, value: float) -> "CellConfig":
+    """``cell`` with one dotted parameter (a key of :data:`PHYSICAL_RANGES`) replaced."""
+    from dataclasses import replace
+
+    from .errors import InvalidChoiceError
+
+    if name not in PHYSICAL_RANGES:
+        raise InvalidChoiceError("physical parameter", name, PHYSICAL_RANGES)
+    group, attr = name.split(".")
+    return replace(cell, **{group: replace(getattr(cell, group), **{attr: float(value)})})
