@@ -51,10 +51,15 @@ def test_mass_matrix_includes_spatula(bare, scene):
     q = bare.q_home
     d.qpos[:ARM_JOINTS] = q
     mujoco.mj_forward(m, d)
-    M = np.zeros((m.nv, m.nv))
-    mujoco.mj_fullM(m, M, d.qM)
+    M, col = np.zeros((m.nv, m.nv)), np.zeros(m.nv)
+    for i, e in enumerate(np.eye(m.nv)):
+        mujoco.mj_mulM(m, d, col, e)
+        M[:, i] = col
     np.testing.assert_allclose(M[:6, :6], pin.crba(bare.model, bare.data, q), atol=1e-9)
-    assert m.body_mass[m.nbody - 2] == pytest.approx(bare.model.inertias[6].mass)
+    last = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, bare.model.names[6])
+    assert m.body_mass[last] == pytest.approx(bare.model.inertias[6].mass)
+    urdf_mass = pin.buildModelFromUrdf(bare.urdf).inertias[6].mass
+    assert m.body_mass[last] == pytest.approx(urdf_mass + bare.cell.spatula.mass)
 
 
 def test_blade_top_face_and_tip(bare, scene):
