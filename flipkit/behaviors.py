@@ -16,6 +16,7 @@ from .collocation import Layout, bezier_guess, fit_guess
 from .config import CellConfig
 from .constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
 from .constraints.braking import BrakingMargin
+from .constraints.flight import FlightClearance, Landing
 from .constraints.kinematic import Cone
 from .contact import make_cone
 from .errors import ConfigError, InvalidChoiceError
@@ -34,7 +35,14 @@ BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.8), "scoop": (0.2, 0.6),
             "pickup": (0.2, 0.4), "flip": (0.2, 0.6), "turn_back": (0.4, 1.6)}
 BRAKING_FRACTION = 0.5  # share of q̈_max assumed for braking at a moving segment end
-SCOOP_TIP_BAND = 0.002  # m: the blade tip may ride up to 2 mm above the grill while scooping
+# Scoop (eq. 24): the blade tip stays on the grill, pressed into it by a commanded SCOOP_PRESS
+# that the grill's contact absorbs (the arm's PD then presses the blade onto the grill, and a
+# grill up to SCOOP_PRESS lower than modelled still meets the tip), within ±SCOOP_TIP_BAND.
+SCOOP_PRESS = tg.SCOOP_PRESS  # m, commanded depth of the tip below the grill surface
+SCOOP_TIP_BAND = 0.0005  # m, the tip's band about h_g − SCOOP_PRESS: never above h_g + 0.5 mm
+RELEASE_FRACTION = 0.7  # flip release node r = ceil(0.7 N): contact on 70 % of the flip
+R_LAND = 0.02  # m, default radius of the landing disc about the target spot
+FLIGHT_MARGIN = 0.002  # m, blade plane below the flying burger from node r + 2 on
 SCOOP_LATERAL_BAND = 0.01  # m: |p_y − p^b_y| during the scoop
 SCOOP_ANGLE_BAND = 0.05  # rad: |o_x|, |o_z| during the scoop
 CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
@@ -49,16 +57,31 @@ class SegmentOptions:
         N: Intervals per segment (paper: 20, i.e. 21 nodes).
         epsilon: Output convergence rate ε of eq. (18) (1/s).
         cone: Friction-cone form, ``physical`` (eq. 5) or ``paper`` (eq. 20).
+        r_land: Flip: radius (m) of the disc about the target spot where the burger's centre
+            must land (:class:`~flipkit.constraints.flight.Landing`).
+        release_fraction: Flip: the release node is ⌈release_fraction · N⌉; the cone holds up
+            to it, the flying burger clears the blade after it.
     """
 
     N: int = 20
     epsilon: float = 10.0
     cone: str = "physical"
+    r_land: float = R_LAND
+    release_fraction: float = RELEASE_FRACTION
 
     def __post_init__(self):
         if self.epsilon <= 0 or not np.isfinite(self.epsilon):
             raise ConfigError(f"epsilon must be positive, got {self.epsilon!r}")
+        if not (np.isfinite(self.r_land) and 0 < self.r_land <= 0.1):
+            raise ConfigError(f"r_land must be in (0, 0.1] m, got {self.r_land!r}")
+        if not (np.isfinite(self.release_fraction) and 0.3 <= self.release_fraction <= 0.9):
+            raise ConfigError(f"release_fraction must be in [0.3, 0.9], got "
+                              f"{self.release_fraction!r}")
         make_cone(self.cone, 0.5)  # validates the name
+
+    def release_node(self) -> int:
+        """The flip's release node r = ⌈release_fraction · N⌉."""
+        return int(np.ceil(self.release_fraction * self.N - 1e-9))
 
 
 class Models:
@@ -71,6 +94,23 @@ class Models:
 
     def for_segment(self, name: str) -> Robot:
         return self.loaded if CARRIES_BURGER[name] else self.bare
+
+
+def grill_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
+    """Lowest height (m) of the blade's tip, heel and side edges at each node 0..N.
+
+    Above the grill, but: the scoop presses the blade SCOOP_PRESS into it (the grill's contact
+    absorbs it), the pickup lifts it out from there, going to the burger the blade comes down
+    onto the grill only at the last node (the scoop's start pose presses the tip in), and the
+    turn back stays clear of a flipped burger lying anywhere on the grill.
+    """
+    hg = cell.grill.height
+    pressed = hg - SCOOP_PRESS - SCOOP_TIP_BAND
+    floor = np.full(N + 1, {"scoop": pressed, "pickup": pressed,
+                            "turn_back": hg + cell.burger.thickness + FLIGHT_MARGIN}.get(name, hg))
+    if name == "go_to_burger":
+        floor[-1] = pressed
+    return floor
 
 
 def _flip_guess_pose(cell: CellConfig, pb) -> tg.Pose:
@@ -103,8 +143,8 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
             w = s * s * (3 - 2 * s)
             o = (1 - w) * o0 + w * o1
             p = (1 - w) * p0 + w * np.asarray(pose.p)
-            if name == "scoop":  # keep the tip on the grill: p_z = h_g + (l/2) sin o_y
-                p[2] = cell.grill.height + cell.spatula.length / 2 * np.sin(o[1])
+            if name == "scoop":  # keep the tip pressed: p_z = h_g − press + (l/2) sin o_y
+                p[2] = cell.grill.height - SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
             q = solve_pose(robot, p, o, q)
             waypoints.append(q)
         return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end)
@@ -117,7 +157,8 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
 
 
 def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
-                  goal: tg.Pose | None = None, options: SegmentOptions = SegmentOptions()) -> NLP:
+                  goal: tg.Pose | None = None, land=None,
+                  options: SegmentOptions = SegmentOptions()) -> NLP:
     """The NLP of one behaviour segment.
 
     Args:
@@ -126,6 +167,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         q_start, qd_start: Start state (rad, rad/s); q̇ defaults to rest.
         location: Burger location p^b (m) for the subbehaviours of pickup-and-flip.
         goal: End pose for ``translate``.
+        land: Flip: landing spot (x, y) (m); default where the burger was picked up
+            (:func:`~flipkit.targets.landing_spot`).
         options: Transcription options.
     """
     if name not in BEHAVIORS:
@@ -140,20 +183,20 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     moving = range(1, L.n_nodes)
     ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
     lim, hg = cell.limits, cell.grill.height
+    p_floor = np.array(lim.p_min, float)  # the scoop's press takes the blade centre below h_g
+    if name in ("go_to_burger", "scoop", "pickup"):
+        p_floor[2] -= SCOOP_PRESS + SCOOP_TIP_BAND
     blocks = [
         Dynamics(L, robot.u_max / 10), HermiteSimpson(L), BezierOutput(L, options.epsilon),
         FixedValues("start_state", L, np.concatenate([L.iq(0), L.iqd(0)]),
                     np.concatenate([q_start, qd_start])),
-        KinematicBlock("task_position", L, "position", moving, lim.p_min, lim.p_max),
+        KinematicBlock("task_position", L, "position", moving, p_floor, lim.p_max),
         KinematicBlock("task_velocity", L, "velocity", moving, -lim.v_max, lim.v_max),
         KinematicBlock("task_acceleration", L, "acceleration", all_nodes, -lim.a_max, lim.a_max,
                        scale=0.1),
     ]
-    # Blade above the grill; on the scoop the tip equality (and at its end the flat pose)
-    # already holds the blade on the grill, so the clearance rows stop before the end.
-    clear_nodes = range(1, L.N) if name == "scoop" else moving
-    blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", clear_nodes, hg, np.inf,
-                                 ctx=ctx))
+    blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", moving,
+                                 grill_floor(name, cell, L.N)[1:, None], np.inf, ctx=ctx))
     cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity))
     cone_nodes: list[int] = []
     # The scoop ends at rest too (our addition): the blade lies flat on the grill at its end,
@@ -172,12 +215,14 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             pose = tg.scoop_ready(cell, pb)
         elif name == "scoop":
             pose = tg.scoop_end(cell, pb)
-            # The tip stays on the grill (eq. 24), relaxed to a band [h_g, h_g + SCOOP_TIP_BAND]:
-            # with q held to a degree-6 polynomial by the outputs (18), 19 tip equalities plus
-            # the end pose and rest leave a square, generically infeasible system. At node N
-            # the flat end pose already puts the tip on the grill.
-            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", range(1, L.N), hg,
-                                         hg + SCOOP_TIP_BAND, ctx=ctx))
+            # The tip stays on the grill (eq. 24), pressed SCOOP_PRESS into it, within a band
+            # of ±SCOOP_TIP_BAND: with q held to a degree-6 polynomial by the outputs (18), 19
+            # tip equalities plus the end pose and rest leave a square, generically infeasible
+            # system. Go-to-burger leaves the tip pressed at node 0; at node N the flat end
+            # pose presses the whole blade.
+            blocks.append(KinematicBlock("scoop_tip", L, "tip_height", range(1, L.N),
+                                         hg - SCOOP_PRESS - SCOOP_TIP_BAND,
+                                         hg - SCOOP_PRESS + SCOOP_TIP_BAND, ctx=ctx))
             # Slide straight under the burger (our addition): without it the blade drifts
             # sideways and yaws on the way and pushes the burger (seen in MuJoCo).
             band = np.array([np.inf, SCOOP_LATERAL_BAND, np.inf])
@@ -188,7 +233,20 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         elif name == "pickup":
             pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
         elif name == "flip":
-            cone_nodes = [i for i in all_nodes if i <= tg.FLIP_CONE_FRACTION * L.N]
+            # Contact up to the release node r (the paper's cone on i ≤ 0.6 N, extended to r),
+            # ballistic flight after it (flipkit.constraints.flight explains the choice).
+            r = options.release_node()
+            cone_nodes = [i for i in all_nodes if i <= max(r, tg.FLIP_CONE_FRACTION * L.N)]
+            spot = tg.landing_spot(cell, pb) if land is None else tg.check_spot(cell, land)
+            bg = cell.burger
+            margin = np.full(L.N - r, FLIGHT_MARGIN)
+            margin[0] = 0.0  # the burger has only just left the blade at node r + 1
+            blocks += [
+                Landing(L, r, spot, options.r_land, thickness=bg.thickness, grill_height=hg,
+                        gravity=cell.gravity),
+                FlightClearance(L, r, margin, thickness=bg.thickness, diameter=bg.diameter,
+                                gravity=cell.gravity),
+            ]
             lo_n, hi_n = tg.FLIP_NORMAL_BOUNDS
             lo_x, hi_x = tg.FLIP_XAXIS_BOUNDS
             band = tg.FLIP_HEIGHT_BAND
@@ -236,4 +294,5 @@ def flat_pose(position, yaw: float = 0.0) -> tg.Pose:
     return tg.Pose(tuple(float(v) for v in position), (0.0, 0.0, float(yaw)))
 
 
-__all__ = ["BEHAVIORS", "T_BOUNDS", "SegmentOptions", "Models", "build_segment", "flat_pose"]
+__all__ = ["BEHAVIORS", "T_BOUNDS", "SegmentOptions", "Models", "build_segment", "flat_pose",
+           "grill_floor"]

@@ -143,6 +143,11 @@ class Segment:
         alpha: Bezier coefficients (nq, M+1) (rad).
         cone_nodes: Nodes where the friction cone was enforced.
         solver: Solver statistics. goal: End pose of a ``translate`` segment (extension).
+        release: Flip only: ``{"node": r, "time": t_r (s)}``, where the burger leaves the blade.
+        landing: Flip only: the predicted landing — ``target`` (x, y) and ``r_land`` (m), the
+            ``point`` (x, y, z) of the burger's centre at landing (m), its ``offset`` from the
+            target (m), ``tilt_deg`` (angle of the top face's normal from +z, deg) and
+            ``time_of_flight`` (s) (:func:`flipkit.flight.predict_landing`).
     """
 
     name: str
@@ -156,6 +161,8 @@ class Segment:
     cone_nodes: list
     solver: SolverInfo
     goal: Pose | None = None
+    release: dict | None = None
+    landing: dict | None = None
 
     def __post_init__(self):
         _choice("name", self.name, BEHAVIORS)
@@ -185,6 +192,23 @@ class Segment:
             self.goal = Pose(*(tuple(_array(f"goal.{k}", g[k], (3,))) for k in ("p", "o")))
         if self.goal is not None and self.name != "translate":
             raise ConfigError("goal: only translate segments have a goal pose")
+        if (self.release is not None or self.landing is not None) and self.name != "flip":
+            raise ConfigError("release, landing: only flip segments have them")
+        if self.release is not None:
+            r = _fields(self.release, "release", ("node", "time"))
+            node = r["node"]
+            if isinstance(node, bool) or not isinstance(node, (int, np.integer)) or not (
+                    0 < node < n - 1):
+                raise ConfigError(f"release.node: expected a node index in 1..{n - 2}, "
+                                  f"got {node!r}")
+            self.release = {"node": int(node), "time": _number("release.time", r["time"])}
+        if self.landing is not None:
+            f = _fields(self.landing, "landing", _LANDING_KEYS)
+            self.landing = {
+                "target": _array("landing.target", f["target"], (2,)).tolist(),
+                "r_land": _number("landing.r_land", f["r_land"], positive=True),
+                "point": _array("landing.point", f["point"], (3,)).tolist(),
+                **{k: _number(f"landing.{k}", f[k]) for k in _LANDING_KEYS[3:]}}
 
     @property
     def N(self) -> int:
@@ -205,8 +229,12 @@ class Segment:
                             tuple(blocks["end_orientation"].lo[:3]))
         info = SolverInfo(result.solver, result.status, result.iterations, result.wall_time_s,
                           result.objective, result.max_violation)
+        release = landing = None
+        block = next((b for b in nlp.blocks if b.name == "landing"), None)
+        if block is not None:
+            release, landing = block.record(nlp.robot, x)
         return cls(nlp.name, T, L.s * T, nodes[:, 0], nodes[:, 1], nodes[:, 2], nodes[:, 3],
-                   L.alpha(x), list(nlp.cone_nodes), info, goal)
+                   L.alpha(x), list(nlp.cone_nodes), info, goal, release, landing)
 
     def to_json(self) -> dict:
         """The segment as JSON values, keys in file order (``goal`` last, if any)."""
@@ -215,10 +243,14 @@ class Segment:
                "solver": dict(vars(self.solver))}
         if self.goal is not None:
             out["goal"] = {k: [float(v) for v in getattr(self.goal, k)] for k in ("p", "o")}
+        for key in ("release", "landing"):
+            if getattr(self, key) is not None:
+                out[key] = dict(getattr(self, key))
         return out
 
 
 _SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
+_LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
 _ROBOT_KEYS = ("urdf", "base_in_world", "tool_parent_frame", "spatula_in_parent", "payload",
                "q_home")
 _BURGER_KEYS = ("location", "diameter", "thickness", "mass", "mu")
@@ -298,7 +330,8 @@ class Plan:
         nq, names = self.robot["q_home"].size, []
         for k, seg in enumerate(self.segments):
             if isinstance(seg, dict):
-                keys = _SEGMENT_KEYS + (("goal",) if "goal" in seg else ())
+                keys = _SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing")
+                                             if k in seg)
                 seg = self.segments[k] = _nested(f"segments[{k}]", Segment, seg, keys)
             if not isinstance(seg, Segment):
                 raise ConfigError(f"segments[{k}]: expected a segment")

@@ -146,6 +146,20 @@ class Robot:
                             dv_dq=np.array(v_dq), dv_dqd=J[:3].copy(), da_dq=np.array(a_dq),
                             da_dqd=np.array(a_dqd), da_dqdd=np.array(a_dqdd))
 
+    def angular_velocity_jacobian(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+        """Spatula angular velocity ω = J_ω q̇ (world, rad/s) and ∂ω/∂q (3×nq); ∂ω/∂q̇ = J_ω.
+
+        From pinocchio's frame velocity derivatives; only their angular rows are used (the
+        linear rows of the LOCAL_WORLD_ALIGNED derivative are not ∂v/∂q of the frame origin —
+        :meth:`state` gives that one)."""
+        m, d = self.model, self.data
+        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+        pin.computeForwardKinematicsDerivatives(m, d, q, qd, np.zeros(self.nq))
+        pin.updateFramePlacements(m, d)
+        dv_dq, _ = pin.getFrameVelocityDerivatives(m, d, self.frame_id, LWA)
+        w = pin.getFrameVelocity(m, d, self.frame_id, LWA).angular
+        return np.array(w), np.array(dv_dq[3:])
+
     # ----------------------------------------------------------------- dynamics
     def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
         """D(q)q̈ + C(q,q̇)q̇ + G(q) by RNEA (N·m), payload included."""

@@ -13,6 +13,7 @@ from .config import CellConfig
 from .errors import UnreachableError
 
 SCOOP_PITCH = 0.314  # o_y* (rad), eq. (22)
+SCOOP_PRESS = 0.003  # m: the scoop presses the blade this far into the grill (flipkit's choice)
 PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, eq. (25)
 PICKUP_PITCH = -0.05  # rad, eq. (25)
 FLIP_CONE_FRACTION = 0.6  # cone on nodes i <= 0.6 N, eq. (26)
@@ -47,20 +48,37 @@ def check_location(cell: CellConfig, location) -> np.ndarray:
 
 
 def scoop_ready(cell: CellConfig, pb) -> Pose:
-    """End of go-to-burger / start of scoop (eqs. 22–23): tip at the burger's near edge."""
+    """End of go-to-burger / start of scoop (eqs. 22–23): tip at the burger's near edge,
+    pressed :data:`SCOOP_PRESS` into the grill."""
     d, l, oy = cell.burger.diameter, cell.spatula.length, SCOOP_PITCH
-    return Pose((pb[0] - d / 2 - l / 2 * math.cos(oy), pb[1], pb[2] + l / 2 * math.sin(oy)),
+    z = cell.grill.height - SCOOP_PRESS  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+    return Pose((pb[0] - d / 2 - l / 2 * math.cos(oy), pb[1], z + l / 2 * math.sin(oy)),
                 (0.0, oy, 0.0))
 
 
 def scoop_end(cell: CellConfig, pb) -> Pose:
-    """End of scoop (eq. 23): blade flat, centred under the burger."""
-    return Pose(tuple(float(x) for x in pb), (0.0, 0.0, 0.0))
+    """End of scoop (eq. 23): blade flat, centred under the burger, pressed
+    :data:`SCOOP_PRESS` into the grill."""
+    z = cell.grill.height - SCOOP_PRESS  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+    return Pose((float(pb[0]), float(pb[1]), z), (0.0, 0.0, 0.0))
 
 
 def pickup_end(cell: CellConfig, pb) -> Pose:
     """End of pickup (eq. 25): 2 cm forward, 5 cm up, slightly tipped back."""
     return Pose(tuple(float(pb[k] + PICKUP_OFFSET[k]) for k in range(3)), (0.0, PICKUP_PITCH, 0.0))
+
+
+def check_spot(cell: CellConfig, spot) -> np.ndarray:
+    """A landing spot (x, y) (m) on the grill as an array, or :class:`UnreachableError`."""
+    xy = np.asarray(spot, dtype=float).ravel()
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+        raise UnreachableError(f"landing spot must be two finite numbers (m), got {spot!r}")
+    g = cell.grill
+    if not g.contains(xy):
+        raise UnreachableError(
+            f"landing spot ({xy[0]:.3f}, {xy[1]:.3f}) is outside the grill area "
+            f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
+    return xy
 
 
 def landing_spot(cell: CellConfig, pb) -> np.ndarray:

@@ -3,7 +3,7 @@
 Nothing here uses :mod:`flipkit.nlp` or :mod:`flipkit.constraints`; kinematics and dynamics
 come from pinocchio through :class:`~flipkit.robot.Robot` rebuilt from the plan file, targets
 from :mod:`flipkit.targets`, and from :mod:`flipkit.behaviors` only the tables T_BOUNDS,
-CARRIES_BURGER and SCOOP_TIP_BAND. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+CARRIES_BURGER, SCOOP_PRESS, SCOOP_TIP_BAND and grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -17,11 +17,17 @@ q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         t
                                                                                tol·u_max/10
 endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded
-behavior_path      scoop tip height in [h_g, h_g + SCOOP_TIP_BAND]; flip       tol
+behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip   tol
                    normal, x axis, height band
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
-grill_clearance    tip, heel and side-edge heights ≥ h_g (m)                   tol
+                   (flip: nodes ≤ max(0.6 N, release node))
+grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m):  tol
+                   h_g, pressed SCOOP_PRESS into it on scoop and pickup,
+                   a burger's thickness above it on turn back (grill_floor)
+landing            flip: landing recomputed (:mod:`flipkit.verify_flight`):    0.1 mm,
+                   within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
+flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
 =================  ==========================================================  ==============
 
 ``tol`` (:data:`TOL` = 1e-5) is in the solver's scaled units, so every group's tolerance is
@@ -42,18 +48,20 @@ import numpy as np
 from .targets import SUBBEHAVIORS
 
 from . import targets as tg
-from .behaviors import SCOOP_TIP_BAND, T_BOUNDS
+from .behaviors import SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, grill_floor
 from .contact import make_cone
 from .errors import ConfigError, VerificationError
 from .orientation import rpy
 from .plan import Plan
+from .verify_flight import check_flight
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
-          "cone": "m/s²", "grill_clearance": "m", "completeness": "segments"}
+          "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
+          "flight_clearance": "m", "completeness": "segments"}
 
 
 @dataclass
@@ -225,13 +233,15 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
             add("defects", k, np.abs(np.concatenate([interp, simpson])), tol, i)
 
     states = [robot.state(seg.q[i], seg.qd[i], seg.qdd[i]) for i in range(N + 1)]
-    l, w, hg = cell.spatula.length / 2, cell.spatula.width / 2, cell.grill.height
-    for i, st in enumerate(states):
+    l, w = cell.spatula.length / 2, cell.spatula.width / 2
+    floor = grill_floor(seg.name, cell, N)
+    for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
         heights = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
-        add("grill_clearance", k, np.maximum(hg - np.array(heights), 0.0), tol, i)
+        add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
     cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
+    release = seg.release["node"] if seg.release else 0
     required = {"translate": range(N + 1), "pickup": range(N + 1),
-                "flip": [i for i in range(N + 1) if i <= tg.FLIP_CONE_FRACTION * N]}
+                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)]}
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
         add("cone", k, max(-cone.margin(states[i]), 0.0), 10 * tol, i)
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
@@ -257,9 +267,10 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         pose(tg.scoop_ready(cell, pb))
     elif seg.name == "scoop":
         pose(tg.scoop_end(cell, pb))
-        for i, st in enumerate(states):  # tip on the grill, within the solver's band
+        for i, st in enumerate(states):  # tip pressed into the grill, within the band
             tip = _point_height(st, (cell.spatula.length / 2, 0, 0))
-            add("behavior_path", k, _outside(tip, hg, hg + SCOOP_TIP_BAND), tol, i)
+            add("behavior_path", k, _outside(tip, hg - SCOOP_PRESS - SCOOP_TIP_BAND,
+                                             hg - SCOOP_PRESS + SCOOP_TIP_BAND), tol, i)
     elif seg.name == "pickup":
         pose(tg.pickup_end(cell, pb))
     elif seg.name == "flip":
@@ -268,5 +279,6 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         add("behavior_path", k, _outside(end.p[2], hg + lo, hg + hi), tol, N)
         for i, st in enumerate(states):
             add("behavior_path", k, _outside(st.R[:, 0], *tg.FLIP_XAXIS_BOUNDS), tol, i)
+        check_flight(report, k, seg, robot, cell, states)
     elif seg.name == "turn_back":
         add("endpoints", k, np.abs(seg.q[-1] - robot.q_home), tol, N)
