@@ -188,6 +188,8 @@ class PhysicsConfig:
             Mechanics and Oral Processing in Modelling First Bite of Grilled Meat", Table 4,
             https://www.hindawi.com/journals/jfq/2022/9176628/tab4/); no beef-patty modulus
             was found: 50 kPa, range 28-147 kPa.
+        burger_edge_radius: Radius (m) of the patty's rounded rim (a hand-formed or pressed
+            patty has no sharp edge). No source: 5 mm, range 1 mm to half the thickness.
         burger_dampratio: Damping ratio of the burger contacts (MuJoCo solref[1]); a patty
             does not bounce (no source: 1 = critically damped, range 0.7-2).
         blade_thickness: Blade thickness (m). A stiff one-piece stainless turner is 0.04 in
@@ -224,6 +226,7 @@ class PhysicsConfig:
 
     mu_grill: float = 0.5
     burger_modulus: float = 50e3
+    burger_edge_radius: float = 0.005
     burger_dampratio: float = 1.0
     blade_thickness: float = 0.001
     bevel_length: float = 0.005
@@ -237,7 +240,7 @@ class PhysicsConfig:
     kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
 
     def __post_init__(self):
-        for name in ("mu_grill", "burger_modulus", "burger_dampratio", "blade_thickness",
+        for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
                      "bevel_length", "edge_thickness", "mu_blade_grill", "steel_timeconst",
                      "timestep", "servo_rate_hz"):
             _positive(f"physics {name}", getattr(self, name))
@@ -369,6 +372,7 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
                   + _NO_SOURCE + " for meat on stainless"),
     "physics.mu_grill": (0.2, 1.0, "as burger.mu; sticky patty (paper) raises it; " + _NO_SOURCE),
     "physics.burger_modulus": (28e3, 147e3, "grilled pork/poultry E (Hindawi JFQ 2022, Table 4)"),
+    "physics.burger_edge_radius": (0.001, 0.0075, _NO_SOURCE + " (up to half the thickness)"),
     "physics.burger_dampratio": (0.7, 2.0, _NO_SOURCE),
     "physics.blade_thickness": (0.00045, 0.002, "1 mm (The Food Lab), 0.45 mm (softsolder.com); "
                                 "2 mm " + _NO_SOURCE),

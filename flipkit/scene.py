@@ -14,7 +14,8 @@ leading edge (x = +l/2) ground on the underside over ``bevel_length`` down to
 
 Contacts are explicit pairs only (every geom has contype = conaffinity = 0): blade-grill
 (steel on steel, ``mu_blade_grill``, stiff), burger-blade (``burger.mu``) and burger-grill
-(``mu_grill``) with the patty's softness (:meth:`PhysicsConfig.burger_timeconst`); condim 3,
+(``mu_grill``) with the patty's softness (:meth:`PhysicsConfig.burger_timeconst`); the
+burger is a convex disc with rounded rims (``burger_edge_radius``); condim 3,
 elliptic cones, ``noslip`` iterations against soft-contact creep. Links are capsules for
 rendering only.
 """
@@ -54,6 +55,21 @@ def blade_vertices(length: float, width: float, thickness: float, bevel: float,
         out += [(-l2, y, 0.0), (l2, y, 0.0), (-l2, y, -thickness), (l2 - bevel, y, -thickness),
                 (l2, y, -edge)]
     return np.array(out)
+
+
+def burger_vertices(diameter: float, thickness: float, edge_radius: float,
+                    n_around: int = 32, n_arc: int = 4) -> np.ndarray:
+    """Vertices (m, burger frame, axis z) of a disc with rounded rims: flat faces at
+    z = ±thickness/2, rims of radius ``edge_radius`` (clipped to half the thickness)."""
+    r, h2 = diameter / 2, thickness / 2
+    rho = min(edge_radius, h2)
+    prof = []  # (radius, z) around the rim, top to bottom
+    for zc, sgn in ((h2 - rho, 1.0), (-h2 + rho, -1.0)):
+        for a in np.linspace(0.0, np.pi / 2, n_arc + 1):
+            prof.append((r - rho + rho * np.sin(a), zc + sgn * rho * np.cos(a)))
+    prof = np.unique(np.round(prof, 12), axis=0)
+    phi = 2 * np.pi * np.arange(n_around) / n_around
+    return np.array([(rr * np.cos(f), rr * np.sin(f), z) for rr, z in prof for f in phi])
 
 
 @dataclass
@@ -172,7 +188,9 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
   <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
           noslip_iterations="{NOSLIP_ITERATIONS}"/>
   <visual><global offwidth="1280" offheight="960"/><quality shadowsize="2048"/></visual>
-  <asset><mesh name="blade" vertex="{_vec(verts)}"/></asset>
+  <asset><mesh name="blade" vertex="{_vec(verts)}"/>
+    <mesh name="burger" vertex="{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>
+  </asset>
   <worldbody>
     <light pos="0.6 -0.2 2.0" dir="0 0 -1" diffuse="0.8 0.8 0.8"/>
     <camera name="side" pos="{gx + 0.2:.3f} {gy - 1.6:.3f} 0.9" xyaxes="1 -0.1 0 0.05 0.4 1"/>
@@ -188,7 +206,7 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     <body name="burger" pos="{xy[0]:.9g} {xy[1]:.9g} {h_g + h2:.9g}">
       <freejoint name="burger"/>
       <inertial pos="0 0 0" mass="{mass:.9g}" diaginertia="{_vec(_disc_inertia(mass, r, 2 * h2))}"/>
-      <geom name="burger" type="cylinder" size="{r} {h2}" contype="0" conaffinity="0"
+      <geom name="burger" type="mesh" mesh="burger" contype="0" conaffinity="0"
             rgba="0.45 0.25 0.15 1"/>
       <geom type="cylinder" size="{r * 0.8:.4g} 0.0005" pos="0 0 {h2}" contype="0"
             conaffinity="0" rgba="0.3 0.15 0.08 1" mass="0"/>
@@ -218,7 +236,7 @@ def _disc_inertia(m: float, r: float, h: float) -> np.ndarray:
 
 def place_burger(scene: Scene, xy, q=None) -> None:
     """Put the burger upright on the grill at ``xy`` (m), at rest; the arm at ``q`` (rad)."""
-    d, h2 = scene.data, scene.model.geom_size[scene.geoms["burger"]][1]
+    d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
     if q is not None:
         d.qpos[:ARM_JOINTS] = q
     d.qpos[scene.burger_qpos] = [*np.asarray(xy, float)[:2], scene.grill_height + h2, 1, 0, 0, 0]
