@@ -35,3 +35,24 @@ def random_states(robot, seed, n=5):
     for _ in range(n):
         q = robot.q_home + rng.uniform(-0.6, 0.6, robot.nq)
         yield q, rng.uniform(-1.5, 1.5, robot.nq), rng.uniform(-5, 5, robot.nq)
+
+
+@pytest.fixture(scope="session")
+def flip_plan():
+    """One solved SQP flip plan at a Table I location, planned once per session (≈ 5 s).
+
+    ``FLIPKIT_TEST_PLAN=path.json`` reuses a plan file instead (e.g. while iterating on the
+    simulation side); the default plans it with the current planner.
+    """
+    from flipkit.plan import Plan
+    from flipkit.planner import plan_flip
+
+    path = os.environ.get("FLIPKIT_TEST_PLAN")
+    plan = Plan.load(path) if path else plan_flip((0.69, -0.16, 0.072))
+    assert plan.status == "solved", plan.failure
+    return plan
+
+
+@pytest.fixture(scope="session")
+def flip_plan_file(flip_plan, tmp_path_factory):
+    return flip_plan.to_json(tmp_path_factory.mktemp("flip_plan") / "plan.json")

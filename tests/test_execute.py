@@ -1,0 +1,113 @@
+"""Closed-loop execution in the MuJoCo cell: contact reaches the arm, modes differ, inputs
+are checked."""
+
+from dataclasses import replace
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from flipkit.burger_sim import SCOOP_OVERLAP, judge_scoop
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.execute import MODES, execute_plan
+
+
+def held(plan, q, burger_dx=0.0):
+    """``plan`` with every segment holding the configuration q at rest (gravity torques)."""
+    segs = []
+    for seg in plan.segments:
+        robot = plan.robot_for(seg.name)
+        n = seg.t.size
+        g = pin.computeGeneralizedGravity(robot.model, robot.data, np.asarray(q, float))
+        segs.append(replace(seg, q=np.tile(q, (n, 1)), qd=np.zeros((n, 6)),
+                            qdd=np.zeros((n, 6)), u=np.tile(g, (n, 1))))
+    return replace(plan, segments=segs)
+
+
+@pytest.fixture(scope="module")
+def feedforward(flip_plan):
+    return execute_plan(flip_plan, "feedforward")
+
+
+def test_motionless_arm_never_scoops(flip_plan):
+    plan = held(flip_plan, flip_plan.segments[0].q[0])
+    ex = execute_plan(plan, "feedforward", hold=0.0)
+    verdict = judge_scoop(ex.run, ex.bounds["scoop"])
+    assert not verdict.ok and verdict.overlap < SCOOP_OVERLAP
+    moved = np.linalg.norm(ex.run.burger_pos[-1, :2] - ex.run.burger_pos[0, :2])
+    assert moved < 1e-3  # nobody touched it
+    assert max(e["max_m"] for e in ex.errors.values()) < 1e-3  # holding still
+
+
+def test_blade_pressed_into_grill_pushes_back_and_arm_tracks(flip_plan):
+    """q_home holds the blade flat and level; the grill is raised so that the planned blade
+    underside is 2 mm below its surface."""
+    cell = flip_plan.cell()
+    plan = held(flip_plan, cell.robot.q_home)
+    from flipkit.robot import Robot
+
+    top = Robot(cell).placement(cell.robot.q_home).translation[2]
+    bottom = top - cell.physics.blade_thickness
+    offset = bottom + 0.002 - cell.grill.height
+    ex = execute_plan(plan, "feedforward", draw={"grill_offset_m": offset, "dx_m": 0.15},
+                      hold=0.0)
+    late = ex.run.t > ex.run.t[-1] - 0.5
+    force = ex.force_blade_grill[late]
+    assert force.min() > 1.0  # the grill pushes the blade up the whole time (N)
+    robot = ex.scene.robot
+    err = np.array([np.linalg.norm(robot.placement(a).translation
+                                   - robot.placement(b).translation)
+                    for a, b in zip(ex.q[late], ex.q_des[late])])
+    assert 1e-4 < err.max() < 0.004  # pushed off the plan by the grill, within a few mm
+    assert ex.run.spatula_pos[late, 2].min() > top  # lifted above the plan: it cannot sink
+
+
+def test_feedforward_tracks_closely_without_contact(flip_plan):
+    ex = execute_plan(flip_plan, "feedforward", draw={"grill_offset_m": -1.0}, hold=0.2)
+    assert max(e["max_m"] for e in ex.errors.values()) < 0.003
+    assert not ex.run.touch_spatula.any() and ex.force_blade_grill.max() == 0.0
+
+
+def test_position_mode_lags_feedforward(flip_plan, feedforward):
+    pos = execute_plan(flip_plan, "position", hold=0.0)
+    for seg in ("go_to_burger", "flip"):
+        assert pos.errors[seg]["max_m"] > feedforward.errors[seg]["max_m"] + 0.005
+    cell = flip_plan.cell()
+    late = replace(cell, physics=replace(cell.physics, latency_s=0.030))
+    slower = execute_plan(flip_plan, "position", cell=late, hold=0.0)
+    assert slower.errors["go_to_burger"]["max_m"] > pos.errors["go_to_burger"]["max_m"] + 0.005
+
+
+def test_run_layout_and_determinism(flip_plan, feedforward):
+    ex = feedforward
+    run = ex.run
+    T = sum(s.T for s in flip_plan.segments)
+    assert run.t[0] == 0.0 and run.t[-1] == pytest.approx(T + 1.0, abs=2e-3)
+    assert list(ex.bounds) == [s.name for s in flip_plan.segments]
+    assert ex.bounds["turn_back"][1] == pytest.approx(T)
+    assert run.spatula_pos.shape == (run.t.size, 3) and ex.qpos.shape[0] == run.t.size
+    assert np.all(np.abs(ex.u) <= ex.scene.robot.u_max + 1e-9)
+    again = execute_plan(flip_plan, "feedforward")
+    np.testing.assert_array_equal(again.run.burger_pos, run.burger_pos)
+
+
+def test_perturbation_draw_reaches_the_plant(flip_plan):
+    ex = execute_plan(flip_plan, "feedforward", hold=0.0,
+                      draw={"dx_m": 0.01, "dy_m": -0.02, "grill_offset_m": 0.001,
+                            "mu_factor": 1.1, "mass_factor": 0.9})
+    pb = np.asarray(flip_plan.burger["location"])
+    np.testing.assert_allclose(ex.run.burger_pos[0, :2], pb[:2] + [0.01, -0.02], atol=1e-9)
+    assert ex.run.grill_height == pytest.approx(flip_plan.grill_height + 0.001)
+    m = ex.scene.model
+    body = m.geom_bodyid[ex.scene.geoms["burger"]]
+    assert m.body_mass[body] == pytest.approx(0.9 * flip_plan.burger["mass"])
+
+
+def test_bad_inputs(flip_plan):
+    with pytest.raises(InvalidChoiceError) as exc:
+        execute_plan(flip_plan, "torque")
+    assert all(repr(m) in str(exc.value) for m in MODES)
+    with pytest.raises(ConfigError, match="perturbation keys"):
+        execute_plan(flip_plan, draw={"dz_m": 0.1})
+    with pytest.raises(ConfigError):
+        execute_plan(flip_plan, hold=-1.0)
