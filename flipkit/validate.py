@@ -1,29 +1,30 @@
 """Simulated execution of pickup-and-flip plans under perturbations (the paper's Table I trials).
 
-One trial (:func:`run_trial`): the arm tracks the plan segment by segment with the joint PD
-controller of :mod:`flipkit.tracking` — the plan's u as feed-forward, the plan's model as the
-controller's, and as the plant the same arm carrying the *perturbed* burger whenever the
-segment carries it (a payload mismatch per configuration). Each segment starts from the
-tracked end configuration of the previous one (the velocity restarts at the desired one).
-The tracked spatula poses then drive the blade in MuJoCo (:class:`flipkit.burger_sim.BurgerSim`)
-with the burger lying on the grill, misplaced and with perturbed physics
-(:class:`Perturbations`, drawn from ``np.random.default_rng(seed + trial)``), and the paper's
-judges (Sec. V) decide scoop, pickup and flip. A stage counts only if the previous ones
-succeeded, as in Table I.
+One trial (:func:`run_trial`): the plan is executed closed-loop in the MuJoCo cell
+(:func:`flipkit.execute.execute_plan`): the arm with its spatula is simulated with the
+burger lying on the grill, misplaced and with perturbed physics (:class:`Perturbations`,
+drawn from ``np.random.default_rng(seed + trial)``), the blade colliding with the grill and
+the burger; the joint controller is the job's ``mode`` (``"feedforward"``: plan torques plus
+PD; ``"position"``: the robot's own PD position control on servo-rate, delayed desired
+states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
+the previous ones succeeded, as in Table I.
+
+:func:`track_plan` (the older pinocchio-only tracking, whose poses drove the blade of
+:class:`flipkit.burger_sim.BurgerSim`) is kept for the figures that use it.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
 from . import targets as tg
 from .behaviors import CARRIES_BURGER
-from .burger_sim import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP, BurgerSim,
-                         judge_flip, judge_pickup, judge_scoop)
+from .burger_sim import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP, judge_flip,
+                         judge_pickup, judge_scoop)
 from .config import CellConfig
 from .errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from .plan import Plan
@@ -142,7 +143,8 @@ def run_trial(job: dict) -> dict:
 
     Args:
         job: ``plan_text`` (a solved flip plan file's text), ``trial`` (index), ``seed``,
-            ``perturbations`` (:class:`Perturbations` fields), ``rate_hz``.
+            ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
+            rate, Hz), ``mode`` (:data:`flipkit.execute.MODES`; default ``"feedforward"``).
 
     Returns:
         ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` ({stage: bool}, each
@@ -150,18 +152,18 @@ def run_trial(job: dict) -> dict:
         ``stage``, ``reason``, ``amount`` — scoop overlap fraction, pickup clearance above
         the grill (``on_grill``) or gap above the blade (``off_spatula``) m, flip contact
         fraction / up-axis z / height m / landing offset m — or ``None``),
-        ``perturbation`` (the draw) and ``tracking`` (see :func:`track_plan`).
+        ``perturbation`` (the draw), ``tracking`` (spatula position error per segment, see
+        :func:`track_plan`) and ``mode``.
     """
+    from .execute import execute_plan
+
     plan = plan_from_text(job["plan_text"])
+    mode = job.get("mode", "feedforward")
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
     cell, pb = plan.cell(), np.asarray(plan.burger["location"], float)
-    burger = replace(cell.burger, mass=cell.burger.mass * draw["mass_factor"],
-                     mu=cell.burger.mu * draw["mu_factor"])
-    t, p, R, bounds, errors = track_plan(plan, replace(cell, burger=burger), job["rate_hz"])
-    sim = BurgerSim(cell, grill_height=plan.grill_height + draw["grill_offset_m"], mu=burger.mu,
-                    mass=burger.mass, burger_xy=pb[:2] + [draw["dx_m"], draw["dy_m"]])
-    run = sim.simulate(t, p, R, burger_start="on_grill", hold=HOLD_S)
+    ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"])
+    run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], tg.landing_spot(cell, pb))
     ok = {"scoop": scoop.ok}
@@ -169,7 +171,7 @@ def run_trial(job: dict) -> dict:
     ok["flip"] = ok["pickup"] and flip.ok
     return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, flip, run),
             "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
-            "perturbation": draw, "tracking": errors}
+            "perturbation": draw, "tracking": errors, "mode": mode}
 
 
 def merge_tracking(errors: list) -> dict:
@@ -205,10 +207,10 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
 
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
-               rate_hz: float = TRACK_RATE_HZ) -> list:
+               rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward") -> list:
     """The :func:`run_trial` jobs of one plan."""
     return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
-             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz)}
+             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode}
             for i in range(trials)]
 
 
@@ -244,7 +246,7 @@ def plan_location(job: dict) -> dict:
 
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
-             rate_hz: float = TRACK_RATE_HZ) -> dict:
+             rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward") -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -253,29 +255,33 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             file (``None``: no plan, every trial fails at stage ``plan``).
         trials: Trials per location (≥ 1). seed: Trial i draws from
             ``np.random.default_rng(seed + i)``.
-        perturbations, rate_hz: See :class:`Perturbations`, :func:`track_plan`.
+        perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
+        mode: Joint controller, one of :data:`flipkit.execute.MODES`.
         executor, cache_dir, progress: See :func:`flipkit.sweep.run_sweep`.
 
     Returns:
-        ``{"seed", "trials", "perturbations", "rate_hz", "locations": [location_entry ...],
+        ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
         "trials", "success": {stage: count}, "independent": {stage: count}}}``.
     """
+    from .execute import MODES
     from .sweep import run_sweep
 
+    if mode not in MODES:
+        raise InvalidChoiceError("execution mode", mode, MODES)
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
         if text is not None:
-            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz)
+            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode)
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
-            "rate_hz": float(rate_hz), "locations": entries,
+            "rate_hz": float(rate_hz), "mode": mode, "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
                         "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},
