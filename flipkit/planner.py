@@ -192,7 +192,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
-              solver: str = "sqp", options: SegmentOptions = SegmentOptions()) -> Plan:
+              solver: str = "sqp", land=None, options: SegmentOptions = SegmentOptions()
+              ) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -201,6 +202,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         location: Burger location p^b (m), on the grill (:func:`~flipkit.targets.check_location`).
         q_start: Start configuration (rad), default q_home.
         qd_start: Start joint velocities (rad/s), default rest.
+        land: Landing spot (x, y) (m) on the grill; default where the burger was picked up.
+            The flipped burger's centre must land within ``options.r_land`` of it.
         cell, solver, options: As :func:`plan_translate`.
 
     Returns:
@@ -216,6 +219,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
     pb = tg.check_location(cell, location)
+    spot = None if land is None else tg.check_spot(cell, land)
     models = models_for(cell)
     robot = models.bare
     q = robot.q_home.copy() if q_start is None else _joint_vector(
@@ -225,7 +229,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     segments, failure = [], None
     for name in tg.SUBBEHAVIORS:
         try:
-            nlp = build_segment(name, models, q, qd, location=pb, options=options)
+            nlp = build_segment(name, models, q, qd, location=pb, land=spot, options=options)
         except FlipkitError as exc:
             if not segments:
                 raise

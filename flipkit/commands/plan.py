@@ -63,6 +63,10 @@ def register(subparsers) -> None:
                    help="burger location X Y Z (m), on the grill (z = grill height)")
     f.add_argument("--start-q", nargs="+", metavar="Q",
                    help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+    f.add_argument("--land", nargs="+", metavar="X",
+                   help="landing spot X Y (m) on the grill; default where the burger lies")
+    f.add_argument("--r-land", default="0.02", metavar="M",
+                   help="radius (m) of the landing disc about the spot (default 0.02)")
     common(f)
     f.set_defaults(run=run_flip)
 
@@ -147,6 +151,13 @@ def _report(plan, path: str | None) -> int:
           f"T {sum(s.T for s in segs):.3f} s, solve {solve:.2f} s "
           f"({segs[0].solver.name}), {sum(s.solver.iterations for s in segs)} iterations, "
           f"max violation {max(s.solver.max_violation for s in segs):.1e}{where}")
+    for s in segs:
+        if s.landing:
+            land = s.landing
+            print(f"  landing: release at node {s.release['node']} ({s.release['time']:.3f} s), "
+                  f"flight {land['time_of_flight']:.3f} s, lands {1e3 * land['offset']:.1f} mm "
+                  f"from ({land['target'][0]:.3f}, {land['target'][1]:.3f}) m, top face "
+                  f"{land['tilt_deg']:.1f} deg from up")
     if plan.status == "solved":
         return 0
     print(f"flipkit: error: {plan.failure}", file=sys.stderr)
@@ -166,12 +177,15 @@ def run_translate(args: argparse.Namespace) -> int:
 
 def run_flip(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
+    from ..behaviors import SegmentOptions
     from ..planner import plan_flip
 
     _quiet()
     location = _numbers("--burger", args.burger, 3)
     q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
-    plan = plan_flip(location, q_start, solver=args.solver)
+    land = None if args.land is None else _numbers("--land", args.land, 2)
+    options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
+    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options)
     plan.to_json(args.json)
     return _report(plan, args.json)
 

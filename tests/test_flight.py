@@ -1,0 +1,131 @@
+"""Release, flight and landing: the closed-form flight model, its derivatives through the
+collocation blocks (against central finite differences, seeded), its independent
+recomputation in verify, and the landing recorded in a solved flip plan."""
+
+import math
+
+import numpy as np
+import pytest
+from conftest import central_fd
+
+from flipkit.behaviors import SegmentOptions, build_segment
+from flipkit.collocation import Evaluation
+from flipkit.config import CellConfig
+from flipkit.constraints.flight import FlightClearance, Landing
+from flipkit.errors import ConfigError, UnreachableError
+from flipkit.flight import predict_landing
+from flipkit.planner import models_for
+from flipkit.verify import verify_plan
+from flipkit.verify_flight import recompute_landing
+
+G = (0.0, 0.0, -9.81)
+
+
+def test_drop_from_rest_lands_below_after_free_fall_time():
+    h, hg, z = 0.015, 0.072, 0.3
+    out = predict_landing([0.7, -0.1, z - h / 2], np.zeros(3), np.eye(3), np.zeros(3),
+                          thickness=h, grill_height=hg, gravity=G, target=(0.7, -0.1))
+    assert out["time_of_flight"] == pytest.approx(math.sqrt(2 * (z - hg - h / 2) / 9.81), rel=1e-9)
+    assert out["offset"] == pytest.approx(0.0, abs=1e-5)
+    assert out["tilt_deg"] == pytest.approx(0.0, abs=0.2)
+
+
+def test_spin_half_turn_in_flight_lands_upside_down_downrange():
+    # thrown up at 1 m/s and 0.5 m/s along x, spinning about x: half a turn in the flight time
+    h, hg = 0.015, 0.072
+    p, v = np.array([0.6, 0.0, 0.2]), np.array([0.5, 0.0, 1.0])
+    c0z = p[2] + h / 2
+    tf = (1.0 + math.sqrt(1.0 + 2 * 9.81 * (c0z - hg - h / 2))) / 9.81
+    w = np.array([math.pi / tf, 0.0, 0.0])
+    out = predict_landing(p, v, np.eye(3), w, thickness=h, grill_height=hg, gravity=G,
+                          target=(0.6, 0.0))
+    assert out["time_of_flight"] == pytest.approx(tf, rel=1e-9)
+    assert out["tilt_deg"] == pytest.approx(180.0, abs=0.2)
+    # the centre starts h/2 above the blade and turns with it: ω × (h/2 ẑ) adds −ω h/2 along y
+    assert out["point"][0] == pytest.approx(0.6 + 0.5 * tf, abs=1e-9)
+    assert out["point"][1] == pytest.approx(-w[0] * h / 2 * tf, abs=1e-9)
+
+
+def test_flight_model_rejects_sideways_gravity():
+    with pytest.raises(ConfigError, match="gravity along -z"):
+        predict_landing(np.zeros(3), np.zeros(3), np.eye(3), np.zeros(3), thickness=0.01,
+                        grill_height=0.0, gravity=(1.0, 0.0, -9.81))
+
+
+@pytest.fixture(scope="module")
+def flip_nlp():
+    """A flip NLP at a pickup end state, evaluated at a moving point of its initial guess."""
+    cell = CellConfig()
+    models = models_for(cell)
+    from flipkit.ik import solve_pose
+    from flipkit.targets import pickup_end
+
+    pb = np.array([0.69, -0.16, 0.072])
+    pose = pickup_end(cell, pb)
+    q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
+    return build_segment("flip", models, q0, np.zeros(6), location=pb)
+
+
+@pytest.mark.parametrize("block_type", [Landing, FlightClearance])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_flight_block_jacobians_match_finite_differences(flip_nlp, block_type, seed):
+    nlp = flip_nlp
+    block = next(b for b in nlp.blocks if isinstance(b, block_type))
+    rng = np.random.default_rng(seed)
+    x = nlp.x0 + 0.05 * rng.standard_normal(nlp.n) * (np.arange(nlp.n) < nlp.layout.alpha_start)
+    x[nlp.layout.T_index] = 0.5
+    vals, entries = block.evaluate(Evaluation(nlp.layout, nlp.robot, x))
+    J = np.zeros((block.m, nlp.n))
+    np.add.at(J, (block.rows, block.cols), entries)
+    cols = np.unique(block.cols)
+    fd = central_fd(lambda z: block.evaluate(Evaluation(nlp.layout, nlp.robot,
+                                                        _set(x, cols, z)))[0], x[cols])
+    np.testing.assert_allclose(J[:, cols], fd, atol=1e-6, rtol=1e-6)
+    assert np.all(np.isfinite(vals))
+
+
+def _set(x, cols, z):
+    y = x.copy()
+    y[cols] = z
+    return y
+
+
+def test_release_node_and_options_are_validated():
+    assert SegmentOptions().release_node() == 14  # ⌈0.7 · 20⌉
+    with pytest.raises(ConfigError, match="r_land"):
+        SegmentOptions(r_land=0.0)
+    with pytest.raises(ConfigError, match="release_fraction"):
+        SegmentOptions(release_fraction=0.95)
+
+
+def test_landing_spot_off_the_grill_is_refused(flip_nlp):
+    from flipkit.planner import plan_flip
+
+    with pytest.raises(UnreachableError, match="landing spot"):
+        plan_flip((0.69, -0.16, 0.072), land=(1.5, 0.0))
+
+
+def test_solved_flip_records_a_landing_that_verify_recomputes(flip_plan):
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    land = flip.landing
+    assert flip.release["node"] == 14 and land["r_land"] == 0.02
+    assert land["offset"] <= 0.02 + 1e-6 and land["tilt_deg"] >= 150.0 - 1e-6
+    np.testing.assert_allclose(land["target"], flip_plan.burger["location"][:2])
+    cell = flip_plan.cell()
+    again = recompute_landing(flip_plan.robot_for("flip", cell), flip, cell)
+    np.testing.assert_allclose(again["point"], land["point"], atol=1e-6)
+    assert again["tilt_deg"] == pytest.approx(land["tilt_deg"], abs=1e-4)
+    assert again["time_of_flight"] == pytest.approx(land["time_of_flight"], abs=1e-6)
+    assert verify_plan(flip_plan).ok
+
+
+def test_tampered_landing_record_fails_verify(flip_plan):
+    import copy
+
+    plan = copy.deepcopy(flip_plan)
+    flip = next(s for s in plan.segments if s.name == "flip")
+    flip.landing["point"][0] += 0.01  # claims a landing 1 cm off what the arrays give
+    report = verify_plan(plan)
+    assert not report.ok and report.worst()[0] == "landing"
+    flip.landing, flip.release = None, None  # a flip without its release fails too
+    assert verify_plan(plan).groups["landing"].ok is False
