@@ -12,7 +12,7 @@ import sys
 
 from .errors import FlipkitError
 
-COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate")
+COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate")
 
 
 def build_parser() -> argparse.ArgumentParser:

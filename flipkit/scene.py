@@ -187,8 +187,13 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
           noslip_iterations="{NOSLIP_ITERATIONS}"/>
-  <visual><global offwidth="1280" offheight="960"/><quality shadowsize="2048"/></visual>
-  <asset><mesh name="blade" vertex="{_vec(verts)}"/>
+  <visual><global offwidth="1280" offheight="960"/><quality shadowsize="2048"/>
+    <headlight ambient="0.35 0.35 0.35" diffuse="0.5 0.5 0.5"/><rgba haze="0.85 0.88 0.92 1"/>
+  </visual>
+  <asset>
+    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.9 0.95" rgb2="0.4 0.5 0.6"
+             width="32" height="32"/>
+    <mesh name="blade" vertex="{_vec(verts)}"/>
     <mesh name="burger" vertex="{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>
   </asset>
   <worldbody>

@@ -1,6 +1,7 @@
 import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+os.environ.setdefault("MUJOCO_GL", "osmesa")  # offscreen rendering (flipkit.animate)
 
 import numpy as np
 import pytest

@@ -17,11 +17,11 @@ def register(subparsers) -> None:
     """Add the ``validate`` sub-command to the ``flipkit`` parser."""
     parser = subparsers.add_parser(
         "validate", help="simulate a plan's execution K times under perturbations",
-        description="Track the plan with the joint PD controller (plan torques as "
-                    "feed-forward, burger payload mismatch), drive the blade along the tracked "
-                    "spatula poses in MuJoCo with a perturbed burger (placement sigma 5 mm, "
-                    "grill height +-2 mm, friction x U(0.8, 1.2), mass x U(0.9, 1.1)), and "
-                    "judge scoop, pickup and flip with the paper's criteria.")
+        description="Execute the plan closed-loop in the MuJoCo cell (arm, spatula blade "
+                    "colliding with the grill, burger) with a perturbed burger (placement "
+                    "sigma 5 mm, grill height +-2 mm, friction x U(0.8, 1.2), mass x "
+                    "U(0.9, 1.1)) under the chosen joint controller, and judge scoop, pickup "
+                    "and flip with the paper's criteria.")
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--plan", metavar="PLAN.json", help="a solved flip plan file")
     what.add_argument("--locations", choices=("table1",),
@@ -36,6 +36,10 @@ def register(subparsers) -> None:
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz, default 1000)")
+    parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
+                        help="joint controller: plan torques + PD (feedforward, default) or "
+                             "the robot's PD position control on servo-rate, delayed desired "
+                             "states with its own gravity compensation (position)")
     add_sweep_arguments(parser)
     parser.add_argument("--json", required=True, metavar="OUT.json", help="output file")
     parser.set_defaults(run=run)
@@ -67,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--trials must be at least 1, got {args.trials}")
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ConfigError(f"--rate must be a positive number of Hz, got {args.rate}")
-    common = dict(progress=not args.no_progress, rate_hz=args.rate)
+    common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode)
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
@@ -79,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
     write_json(args.json, out)
     print(format_table(out))
     total = out["summary"]
-    print(f"flipkit validate: {total['trials']} trials at {total['locations']} locations, "
+    print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
+          f"{total['locations']} locations, "
           f"success {total['success']}; wrote {args.json}")
     return 0
