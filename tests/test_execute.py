@@ -111,3 +111,14 @@ def test_bad_inputs(flip_plan):
         execute_plan(flip_plan, draw={"dz_m": 0.1})
     with pytest.raises(ConfigError):
         execute_plan(flip_plan, hold=-1.0)
+
+
+def test_validate_checks_the_mode_and_records_it(flip_plan_file):
+    from flipkit.validate import Perturbations, run_trial, trial_jobs, validate
+
+    with pytest.raises(InvalidChoiceError, match="'feedforward', 'position'"):
+        validate([((0.69, -0.16, 0.072), {}, None)], 1, mode="servo")
+    job = trial_jobs(flip_plan_file.read_text(), 1, 0, Perturbations(), mode="position")[0]
+    out = run_trial(job)
+    assert out["mode"] == "position" and set(out["ok"]) == {"scoop", "pickup", "flip"}
+    assert out["tracking"]["go_to_burger"]["max_m"] > 0.005  # the position controller lags
