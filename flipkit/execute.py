@@ -22,7 +22,7 @@ draw; the plan's feed-forward ignores it. After the plan the last desired state 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -104,7 +104,7 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 
 
 def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
-                 cell: CellConfig | None = None, hold: float = HOLD_S,
+                 cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0) -> Execution:
     """Execute a flip plan closed-loop in the MuJoCo cell with the burger on the grill.
 
@@ -116,6 +116,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
             friction), ``mass_factor`` (burger mass); ``None`` = the nominal cell.
         cell: Physics and geometry; default the plan's cell (``plan.cell()``, whose
             ``physics`` is the default :class:`~flipkit.config.PhysicsConfig`).
+        physics: A :class:`~flipkit.config.PhysicsConfig` replacing ``cell.physics``.
         hold: Time (s) the last desired state is held after the plan.
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
 
@@ -126,6 +127,8 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     from .robot import Robot
 
     cell = cell or plan.cell()
+    if physics is not None:
+        cell = replace(cell, physics=physics)
     ph, bg = cell.physics, cell.burger
     robot = Robot(cell, with_burger=False)  # the plant's arm and position mode's own model
     scene = build_scene(robot, cell, grill_offset=d_["grill_offset_m"],

@@ -73,8 +73,8 @@ def test_position_mode_lags_feedforward(flip_plan, feedforward):
     for seg in ("go_to_burger", "flip"):
         assert pos.errors[seg]["max_m"] > feedforward.errors[seg]["max_m"] + 0.005
     cell = flip_plan.cell()
-    late = replace(cell, physics=replace(cell.physics, latency_s=0.030))
-    slower = execute_plan(flip_plan, "position", cell=late, hold=0.0)
+    slower = execute_plan(flip_plan, "position", physics=replace(cell.physics, latency_s=0.030),
+                          hold=0.0)
     assert slower.errors["go_to_burger"]["max_m"] > pos.errors["go_to_burger"]["max_m"] + 0.005
 
 
