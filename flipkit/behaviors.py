@@ -63,6 +63,9 @@ class SegmentOptions:
             must land (:class:`~flipkit.constraints.flight.Landing`).
         release_fraction: Flip: the release node is ⌈release_fraction · N⌉; the cone holds up
             to it, the flying burger clears the blade after it.
+        landing: Flip: impose the release, flight and landing (default). ``False`` gives the
+            paper's flip (26) alone, cone on i ≤ 0.6 N — a baseline whose burgers miss
+            (``flipkit verify`` then fails its ``landing`` group).
     """
 
     N: int = 20
@@ -70,6 +73,7 @@ class SegmentOptions:
     cone: str = "physical"
     r_land: float = R_LAND
     release_fraction: float = RELEASE_FRACTION
+    landing: bool = True
 
     def __post_init__(self):
         if self.epsilon <= 0 or not np.isfinite(self.epsilon):
@@ -237,18 +241,19 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         elif name == "flip":
             # Contact up to the release node r (the paper's cone on i ≤ 0.6 N, extended to r),
             # ballistic flight after it (flipkit.constraints.flight explains the choice).
-            r = options.release_node()
+            r = options.release_node() if options.landing else 0
             cone_nodes = [i for i in all_nodes if i <= max(r, tg.FLIP_CONE_FRACTION * L.N)]
             spot = tg.landing_spot(cell, pb) if land is None else tg.check_spot(cell, land)
             bg = cell.burger
             margin = np.full(L.N - r, FLIGHT_MARGIN)
             margin[0] = 0.0  # the burger has only just left the blade at node r + 1
-            blocks += [
-                Landing(L, r, spot, options.r_land, thickness=bg.thickness, grill_height=hg,
-                        gravity=cell.gravity),
-                FlightClearance(L, r, margin, thickness=bg.thickness, diameter=bg.diameter,
-                                gravity=cell.gravity),
-            ]
+            if options.landing:
+                blocks += [
+                    Landing(L, r, spot, options.r_land, thickness=bg.thickness,
+                            grill_height=hg, gravity=cell.gravity),
+                    FlightClearance(L, r, margin, thickness=bg.thickness,
+                                    diameter=bg.diameter, gravity=cell.gravity),
+                ]
             lo_n, hi_n = tg.FLIP_NORMAL_BOUNDS
             lo_x, hi_x = tg.FLIP_XAXIS_BOUNDS
             band = tg.FLIP_HEIGHT_BAND
