@@ -8,9 +8,11 @@ wrong shape, non-finite number, unknown name) into a one-line
 :class:`~flipkit.errors.PlanFileError` naming the file and the key path, e.g.
 ``plan.json: segments[2].q: expected shape (21, 6), got (20, 6)``.
 
-Extension of the format (optional; readers that do not know it ignore it):
-``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a ``translate`` segment,
-blade-centre position (m) and rpy (rad), checked by :mod:`flipkit.verify`.
+The format is documented in ``docs/plan-format.md`` (JSON Schema beside it). Beyond
+DESIGN.md's seed: ``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a
+``translate`` segment (optional) — and, on a flip segment, ``release`` (node, time) and the
+predicted ``landing`` (target, r_land, point, offset, tilt_deg, time_of_flight), checked by
+:mod:`flipkit.verify`.
 """
 
 from __future__ import annotations
