@@ -204,10 +204,20 @@ class PhysicsConfig:
             0.6-0.8, kinetic 0.4-0.6 (enersection.io, "Understanding the friction coefficient
             of steel on steel"); an oiled griddle is lower (no number found). 0.3, range
             0.1-0.6.
-        steel_timeconst: MuJoCo solref time constant of the blade-grill contact (s). Steel on
-            steel is far stiffer than any step can integrate; the compliance that matters is
-            the arm's servo. The smallest stable value, 2 timesteps (MuJoCo XML reference:
-            solref timeconst at least twice the timestep): 1 ms. Range 1-10 ms (ours).
+        blade_modulus: Young's modulus E of the blade's stainless steel (Pa). AISI 304:
+            193 GPa (Alloys International, "Stainless Steel 304 Material Data Sheet",
+            https://alloysintl.com/?p=6124; APAC Infrastructure, "Material Specifications -
+            304 Stainless Steel"), 200 GPa (MakeItFrom, "AISI 304 Stainless Steel",
+            http://www.makeitfrom.com/material-data/?for=AISI-304-SUS304-1.4301-S30400-
+            Stainless-Steel). 193 GPa, range 193-200 GPa.
+        blade_dampratio: Damping ratio of the blade's flex against the grill. Steel's own
+            structural damping is far below 1 (a struck blade rings); the squeezed oil film
+            and the burger residue on a griddle add an unknown amount. No source: 1
+            (critically damped: a pressed blade does not chatter), range 0.3-2 (ours).
+        blade_tip_mass: Effective mass (kg) the blade tip presents along the grill normal,
+            1/(J M⁻¹ Jᵀ) of the arm with its spatula at the tip, vertical row: measured on the
+            scoops of the Table I plans 0.34-0.75 kg (the wrist's small inertia). 0.5 kg;
+            it only sets the damping b = 2 ζ √(k m).
         timestep: MuJoCo integration step (s).
         servo_rate_hz: Rate at which the robot's controller receives desired (q, qd) in
             ``position`` mode (Hz). Real-time client interface: CB-series 125 Hz, e-Series
@@ -232,7 +242,9 @@ class PhysicsConfig:
     bevel_length: float = 0.005
     edge_thickness: float = 0.0002
     mu_blade_grill: float = 0.3
-    steel_timeconst: float = 0.001
+    blade_modulus: float = 193e9
+    blade_dampratio: float = 1.0
+    blade_tip_mass: float = 0.5
     timestep: float = 0.0005
     servo_rate_hz: float = 125.0
     latency_s: float = 0.008
@@ -241,7 +253,8 @@ class PhysicsConfig:
 
     def __post_init__(self):
         for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
-                     "bevel_length", "edge_thickness", "mu_blade_grill", "steel_timeconst",
+                     "bevel_length", "edge_thickness", "mu_blade_grill", "blade_modulus",
+                     "blade_dampratio", "blade_tip_mass",
                      "timestep", "servo_rate_hz"):
             _positive(f"physics {name}", getattr(self, name))
         if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
@@ -249,13 +262,31 @@ class PhysicsConfig:
         if self.edge_thickness >= self.blade_thickness:
             raise ConfigError("physics edge_thickness must be below blade_thickness, got "
                               f"{self.edge_thickness} >= {self.blade_thickness}")
-        if self.steel_timeconst < 2 * self.timestep - 1e-12:
-            raise ConfigError(f"physics steel_timeconst must be >= 2 timesteps "
-                              f"({2 * self.timestep} s), got {self.steel_timeconst}")
         for name in ("kp", "kd"):
             g = _finite(f"physics {name}", getattr(self, name))
             if g.ndim != 1 or np.any(g < 0):
                 raise ConfigError(f"physics {name} must be non-negative gains, got {g}")
+
+    def blade_stiffness(self, spatula: "SpatulaConfig") -> float:
+        """Stiffness (N/m) of the blade tip against the grill: the blade's flex.
+
+        A turner's blade is a thin steel plate cantilevered from the neck (where it joins the
+        handle, the blade's back edge x = −l/2) to the tip (x = +l/2), so the cantilever
+        length L is the blade length ``spatula.length``; a force at the tip meets
+        k = 3 E I / L³ with I = w t³ / 12 (w ``spatula.width``, t :attr:`blade_thickness`).
+        Default 1 mm × 12 cm × 16 cm blade: k = 1.41 kN/m (3 mm of press: 4.2 N). In series
+        with it, the grill plate's steel (Hertzian, MN/m) and the handle (a 16 mm steel rod
+        over the 12 cm from the flange to the neck, loaded at the tip 16 cm further:
+        ≈ 100 kN/m) add about 1 % of compliance and are left out.
+        """
+        inertia = spatula.width * self.blade_thickness**3 / 12
+        return 3 * self.blade_modulus * inertia / spatula.length**3
+
+    def blade_damping(self, spatula: "SpatulaConfig") -> float:
+        """Damping (N s/m) of the blade-tip contact: b = 2 ζ √(k m) with ζ
+        :attr:`blade_dampratio`, k :meth:`blade_stiffness`, m :attr:`blade_tip_mass`."""
+        return 2 * self.blade_dampratio * math.sqrt(self.blade_stiffness(spatula)
+                                                    * self.blade_tip_mass)
 
     def burger_timeconst(self, burger: "BurgerConfig", mass: float | None = None) -> float:
         """MuJoCo solref time constant (s) of the burger's contacts, from the patty stiffness.
@@ -380,7 +411,11 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
     "physics.edge_thickness": (0.0001, 0.0005, _NO_SOURCE),
     "physics.mu_blade_grill": (0.1, 0.6, "dry steel-steel kinetic 0.4-0.6 (enersection.io); "
                                "oiled " + _NO_SOURCE),
-    "physics.steel_timeconst": (0.001, 0.010, "MuJoCo floor 2 timesteps; " + _NO_SOURCE),
+    "physics.blade_modulus": (193e9, 200e9, "AISI 304 stainless: 193 GPa (alloysintl.com, "
+                              "apacinfrastructure.com.au), 200 GPa (makeitfrom.com)"),
+    "physics.blade_dampratio": (0.3, 2.0, _NO_SOURCE),
+    "physics.blade_tip_mass": (0.34, 0.75, "measured: arm's 1/(J M^-1 J^T) at the blade tip "
+                               "over the Table I scoops"),
     "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.latency_s": (0.002, 0.020, _NO_SOURCE + " (UR10 Performance Analysis, DTU 2014, "

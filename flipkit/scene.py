@@ -13,11 +13,28 @@ leading edge (x = +l/2) ground on the underside over ``bevel_length`` down to
 ``edge_thickness``, so the planned tip point (l/2, 0, 0) is the top of the edge.
 
 Contacts are explicit pairs only (every geom has contype = conaffinity = 0): blade-grill
-(steel on steel, ``mu_blade_grill``, stiff), burger-blade (``burger.mu``) and burger-grill
+(steel on steel, ``mu_blade_grill``; compliant: the blade's flex, below), burger-blade (``burger.mu``) and burger-grill
 (``mu_grill``) with the patty's softness (:meth:`PhysicsConfig.burger_timeconst`); the
 burger is a convex disc with rounded rims (``burger_edge_radius``); condim 3,
 elliptic cones, ``noslip`` iterations against soft-contact creep. Links are capsules for
 rendering only.
+
+Blade-grill compliance. A real turner's tip pressed onto the grill is held by the thin blade
+flexing as a cantilever from its neck, not by the grill's steel: the pair is a spring-damper
+of the physical stiffness k (:meth:`PhysicsConfig.blade_stiffness`, N/m) and damping b
+(:meth:`PhysicsConfig.blade_damping`, N s/m); the rigid blade's penetration of the grill
+stands for the tip's flex. MuJoCo's direct form ``solref = (−s, −c)`` is *not* in N/m: with a
+constant impedance d (``solimp = d d …``) the solver gives (MuJoCo Computation chapter,
+soft constraints: a₁ + d (B v + K r) = (1 − d) a₀, K = s/d², B = c/d, regulariser
+R = (1 − d)/d · D) a contact force f = [A F + d (K d x + B ẋ)] / (A + R), with x the
+penetration, A the true inverse inertia along the normal, F the load pushing in and D the
+model's approximate inverse inertia (``efc_diagApprox``: the blade body's
+``body_invweight0``). For small d (R ≫ A) this is f = (s x + c ẋ)/((1 − d) D): so s and c are
+set to k (1 − d) D / n and b (1 − d) D / n after compiling, d = :data:`BLADE_IMPEDANCE`, with
+n = :data:`BLADE_EDGE_CONTACTS` contact points sharing the edge's load; the static
+force is exactly k x whatever A is (tests/test_scene.py), and the instantaneous share of the
+push the constraint takes is A/(A + R) < 0.1 %. Friction on this pair stays Coulomb through
+the ``noslip`` iterations.
 """
 
 from __future__ import annotations
@@ -33,6 +50,14 @@ from .robot import Robot
 NOSLIP_ITERATIONS = 10  # post-solve iterations: static friction holds without creep
 ARM_JOINTS = 6
 LINK_RADIUS = 0.045  # m, capsule visuals
+# Constant impedance of the blade-grill contact (module docstring): small, so that the contact
+# is the blade's spring-damper and not MuJoCo's stiff-constraint blend; with D ≈ 33 /kg and
+# A ≈ 1.3-2.9 /kg at the scoops, A/R = A d/((1 − d) D) ≈ 0.1 %.
+BLADE_IMPEDANCE = 0.01
+# MuJoCo's convex collider puts one blade-grill contact at each end of the leading edge when the
+# edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
+# spring-damper, so that the pressed edge meets k and b in all.
+BLADE_EDGE_CONTACTS = 2
 
 
 def _vec(v) -> str:
@@ -82,6 +107,8 @@ class Scene:
         blade_site: Site id of the spatula frame (top-face centre). grill_height: Actual
             surface height (m). geoms: ``{"blade", "grill", "burger"}`` geom ids.
         burger_qpos, burger_qvel: Slices of the burger's free joint in qpos / qvel.
+        blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
+            (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
     """
 
     model: mujoco.MjModel
@@ -91,6 +118,7 @@ class Scene:
     blade_site: int
     grill_height: float
     geoms: dict
+    blade_contact: dict
 
     burger_qpos = slice(ARM_JOINTS, ARM_JOINTS + 7)  # class constants, not fields
     burger_qvel = slice(ARM_JOINTS, ARM_JOINTS + 6)
@@ -179,9 +207,11 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     tx, ty, tsx, tsy = np.mean(tb.x_range), np.mean(tb.y_range), np.ptp(tb.x_range) / 2, \
         np.ptp(tb.y_range) / 2
 
-    def pair(g1, g2, f, solref):
-        return (f'<pair geom1="{g1}" geom2="{g2}" condim="3" friction="{f} {f} 0.001 0.0001 '
-                f'0.0001" solref="{solref[0]:.6g} {solref[1]:.6g}"/>')
+    def pair(g1, g2, f, solref, imp=None):
+        solimp = "" if imp is None else f' solimp="{imp} {imp} 0.001 0.5 2"'
+        return (f'<pair name="{g1}_{g2}" geom1="{g1}" geom2="{g2}" condim="3" '
+                f'friction="{f} {f} 0.001 0.0001 0.0001" '
+                f'solref="{solref[0]:.6g} {solref[1]:.6g}"{solimp}/>')
 
     xml = f"""<mujoco model="flipkit_cell">
   <compiler angle="radian" inertiafromgeom="false"/>
@@ -218,19 +248,37 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     </body>
   </worldbody>
   <contact>
-    {pair("blade", "grill", ph.mu_blade_grill, (ph.steel_timeconst, 1.0))}
+    {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
     {pair("burger", "blade", mu, (tau_b, ph.burger_dampratio))}
     {pair("burger", "grill", ph.mu_grill, (tau_b, ph.burger_dampratio))}
   </contact>
 </mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
+    contact = _blade_contact(model, cell)
+    pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "blade_grill")
+    model.pair_solref[pid] = contact["solref"]
+    xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
     data = mujoco.MjData(model)
     gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     scene = Scene(model, data, xml, robot,
                   mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
-                  {n: gid(n) for n in ("blade", "grill", "burger")})
+                  {n: gid(n) for n in ("blade", "grill", "burger")}, contact)
     mujoco.mj_forward(model, data)
     return scene
+
+
+def _blade_contact(model: mujoco.MjModel, cell: CellConfig) -> dict:
+    """The blade-grill pair's direct-form solref (−s, −c) for the physical stiffness and
+    damping of the blade (module docstring): s = k (1 − d) D / n, c = b (1 − d) D / n
+    (n :data:`BLADE_EDGE_CONTACTS` contact points on the leading edge), D the blade
+    body's translational ``body_invweight0`` (the contact rows' ``efc_diagApprox``; the grill
+    is the world's, weight 0)."""
+    ph, sp = cell.physics, cell.spatula
+    k, b = ph.blade_stiffness(sp), ph.blade_damping(sp)
+    blade = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "spatula")
+    scale = (1.0 - BLADE_IMPEDANCE) * float(model.body_invweight0[blade, 0]) / BLADE_EDGE_CONTACTS
+    return {"stiffness": k, "damping": b, "impedance": BLADE_IMPEDANCE,
+            "solref": (-k * scale, -b * scale)}
 
 
 def _disc_inertia(m: float, r: float, h: float) -> np.ndarray:

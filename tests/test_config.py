@@ -52,3 +52,21 @@ def test_configs_are_frozen():
 def test_tool_frame_must_exist():
     with pytest.raises(ConfigError, match="tool0"):
         Robot(CellConfig(robot=RobotConfig(tool_frame="flange")))
+
+
+def test_blade_stiffness_is_the_cantilever_formula():
+    from flipkit.config import PHYSICAL_RANGES, with_parameter
+
+    cell = CellConfig()
+    ph, sp = cell.physics, cell.spatula
+    k = ph.blade_stiffness(sp)
+    inertia = sp.width * ph.blade_thickness**3 / 12
+    assert k == pytest.approx(3 * ph.blade_modulus * inertia / sp.length**3)
+    assert k == pytest.approx(1413.6, rel=1e-3)  # 1 mm × 12 cm × 16 cm stainless blade
+    assert ph.blade_damping(sp) == pytest.approx(2 * np.sqrt(k * ph.blade_tip_mass))
+    thin = with_parameter(cell, "physics.blade_thickness", 0.00045)
+    assert thin.physics.blade_stiffness(sp) == pytest.approx(k * 0.45**3)
+    for name in ("physics.blade_modulus", "physics.blade_dampratio", "physics.blade_tip_mass"):
+        lo, hi, source = PHYSICAL_RANGES[name]
+        assert lo < hi and source
+    assert "physics.steel_timeconst" not in PHYSICAL_RANGES

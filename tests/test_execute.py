@@ -122,3 +122,26 @@ def test_validate_checks_the_mode_and_records_it(flip_plan_file):
     out = run_trial(job)
     assert out["mode"] == "position" and set(out["ok"]) == {"scoop", "pickup", "flip"}
     assert out["tracking"]["go_to_burger"]["max_m"] > 0.005  # the position controller lags
+
+
+def test_pressed_blade_is_the_blades_spring_and_does_not_bounce(flip_plan):
+    """The scoop's first configuration held (tip commanded 3 mm into the grill): the blade
+    stays on the grill, and the steady force is the blade's stiffness times its flex (the
+    penetration), at most k × 3 mm (the arm's PD yields the rest)."""
+    scoop = next(s for s in flip_plan.segments if s.name == "scoop")
+    plan = held(flip_plan, scoop.q[0])
+    ex = execute_plan(plan, "feedforward", draw={"dx_m": 0.2}, hold=0.0)  # burger out of the way
+    late = ex.run.t > 0.5
+    force = ex.force_blade_grill[late]
+    assert np.mean(force > 0) >= 0.95
+    k = ex.scene.blade_contact["stiffness"]
+    cell = flip_plan.cell()
+    assert k == pytest.approx(cell.physics.blade_stiffness(cell.spatula))
+    m, d, g = ex.scene.model, ex.scene.data, ex.scene.geoms
+    flex = [-d.contact[i].dist for i in range(d.ncon)
+            if set(d.contact[i].geom) == {g["blade"], g["grill"]}]
+    assert flex, "no blade-grill contact at the end of the press"
+    f_end = force[-1]
+    assert f_end == pytest.approx(k * np.mean(flex) * len(flex) / 2, rel=0.1)
+    assert 0.2 * k * 0.003 < f_end <= 1.05 * k * 0.003
+    assert np.ptp(force) < 0.3 * force.mean()  # steady, no chatter
