@@ -138,6 +138,18 @@ def _failure(scoop, pickup, flip, run) -> dict | None:
             "amount": miss}
 
 
+def landing_target(plan: Plan) -> np.ndarray:
+    """Where the flip should land the burger (x, y) (m): the flip segment's planned
+    ``landing["target"]`` when the plan has one (``flipkit plan flip --land X Y`` lands
+    elsewhere than the default), else :func:`flipkit.targets.landing_spot` of the burger."""
+    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    landing = getattr(flip, "landing", None)
+    if landing is not None:
+        return np.asarray(landing["target"], float)
+    return np.asarray(tg.landing_spot(plan.cell(), np.asarray(plan.burger["location"], float)),
+                      float)[:2]
+
+
 def run_trial(job: dict) -> dict:
     """One simulated execution (the sweep worker).
 
@@ -161,11 +173,11 @@ def run_trial(job: dict) -> dict:
     mode = job.get("mode", "feedforward")
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
-    cell, pb = plan.cell(), np.asarray(plan.burger["location"], float)
+    cell = plan.cell()
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"])
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
-    flip = judge_flip(run, bounds["flip"], tg.landing_spot(cell, pb))
+    flip = judge_flip(run, bounds["flip"], landing_target(plan))
     ok = {"scoop": scoop.ok}
     ok["pickup"] = ok["scoop"] and pickup.ok
     ok["flip"] = ok["pickup"] and flip.ok
@@ -346,5 +358,5 @@ def validate_locations(locations, trials: int, solver: str = "sqp", seed: int = 
 
 
 __all__ = ["Perturbations", "TRACK_RATE_HZ", "HOLD_S", "STAGES", "plan_from_text", "track_plan",
-           "run_trial", "merge_tracking", "location_entry", "trial_jobs", "trial_key",
+           "landing_target", "run_trial", "merge_tracking", "location_entry", "trial_jobs", "trial_key",
            "plan_location", "validate", "validate_plan_file", "validate_locations"]

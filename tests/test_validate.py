@@ -1,4 +1,4 @@
-"""``flipkit validate`` on one IPOPT plan with two trials: schema, seeded determinism,
+"""``flipkit validate`` on one plan (the session's SQP flip plan) with two trials: schema, seeded determinism,
 perturbations, and one-line errors (exit 2) on bad input."""
 
 import json
@@ -9,19 +9,16 @@ import pytest
 from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
-from flipkit.planner import plan_flip
 from flipkit.targets import SUBBEHAVIORS
 from flipkit.validate import STAGES, Perturbations, run_trial, track_plan, trial_jobs
 
-LOCATION = TABLE1_LOCATIONS[1]
+LOCATION = TABLE1_LOCATIONS[5]  # where conftest's flip_plan is planned
 TRIALS = 2
 
 
 @pytest.fixture(scope="module")
-def plan_file(tmp_path_factory):
-    plan = plan_flip(LOCATION, solver="ipopt")
-    assert plan.status == "solved", plan.failure
-    return plan.to_json(tmp_path_factory.mktemp("validate") / "plan.json")
+def plan_file(flip_plan_file):
+    return flip_plan_file
 
 
 def validate(plan_file, out, seed, *extra):
@@ -39,7 +36,7 @@ def result(plan_file):
 def test_schema(result):
     assert result["trials"] == TRIALS and result["seed"] == 3
     (entry,) = result["locations"]
-    assert entry["location"] == pytest.approx(list(LOCATION))
+    assert entry["location"] == pytest.approx(list(LOCATION))  # the flip_plan fixture's
     assert entry["trials"] == TRIALS and set(entry["success"]) == set(STAGES)
     s = entry["success"]
     assert TRIALS >= s["scoop"] >= s["pickup"] >= s["flip"] >= 0  # cumulative stages
@@ -118,3 +115,32 @@ def test_bad_input_exits_2(plan_file, failed_plan, tmp_path, capsys, case, messa
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and message in err
     assert not out.exists()
+
+
+def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
+    """A plan from ``plan flip --land X Y`` records its own target: the judge uses it, and
+    falls back to the pickup spot for a plan without one."""
+    from dataclasses import replace
+
+    from flipkit import targets as tg
+    from flipkit.validate import landing_target, plan_from_text
+
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    assert flip.landing is not None
+    assert landing_target(flip_plan) == pytest.approx(flip.landing["target"])
+    far = [0.30, 0.60]  # on the table, nowhere near where this flip lands
+    moved = replace(flip, landing={**flip.landing, "target": far})
+    plan = replace(flip_plan, segments=[moved if s.name == "flip" else s
+                                        for s in flip_plan.segments])
+    path = plan.to_json(tmp_path / "moved.json")
+    assert landing_target(plan_from_text(path.read_text())) == pytest.approx(far)
+    bare = replace(flip_plan, segments=[replace(s, landing=None, release=None)
+                                        if s.name == "flip" else s for s in flip_plan.segments])
+    pb = flip_plan.burger["location"]
+    assert landing_target(bare) == pytest.approx(tg.landing_spot(flip_plan.cell(), pb))
+    none = Perturbations(0.0, 0.0, (1.0, 1.0), (1.0, 1.0))
+    job = trial_jobs(path.read_text(), 1, 0, none)[0]
+    res = run_trial(job)
+    if res["ok"]["pickup"]:  # the flip itself is judged: it lands ~0.4 m from the far target
+        assert not res["ok"]["flip"]
+        assert res["failure"]["reason"] == "missed_spot" and res["failure"]["amount"] > 0.2
