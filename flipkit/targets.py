@@ -47,19 +47,19 @@ def check_location(cell: CellConfig, location) -> np.ndarray:
     return loc
 
 
-def scoop_ready(cell: CellConfig, pb) -> Pose:
+def scoop_ready(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
     """End of go-to-burger / start of scoop (eqs. 22–23): tip at the burger's near edge,
-    pressed :data:`SCOOP_PRESS` into the grill."""
+    pressed ``press`` (m) into the grill (0: on its surface, the paper's eq. 24)."""
     d, l, oy = cell.burger.diameter, cell.spatula.length, SCOOP_PITCH
-    z = cell.grill.height - SCOOP_PRESS  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+    z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
     return Pose((pb[0] - d / 2 - l / 2 * math.cos(oy), pb[1], z + l / 2 * math.sin(oy)),
                 (0.0, oy, 0.0))
 
 
-def scoop_end(cell: CellConfig, pb) -> Pose:
-    """End of scoop (eq. 23): blade flat, centred under the burger, pressed
-    :data:`SCOOP_PRESS` into the grill."""
-    z = cell.grill.height - SCOOP_PRESS  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
+    """End of scoop (eq. 23): blade flat, centred under the burger, pressed ``press`` (m)
+    into the grill."""
+    z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
     return Pose((float(pb[0]), float(pb[1]), z), (0.0, 0.0, 0.0))
 
 

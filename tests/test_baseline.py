@@ -54,7 +54,7 @@ def test_endpoints_and_continuity(benign, cell, bare):
     pb = np.array(BENIGN)
     tr = {t.name: t for t in benign.trajectories}
     home = bare.placement(bare.q_home)
-    ends = {"go_to_burger": tg.scoop_ready(cell, pb), "scoop": tg.scoop_end(cell, pb),
+    ends = {"go_to_burger": tg.scoop_ready(cell, pb, 0.0), "scoop": tg.scoop_end(cell, pb, 0.0),
             "pickup": tg.pickup_end(cell, pb),
             "turn_back": tg.Pose(tuple(home.translation), tuple(rpy(home.rotation)))}
     for name, pose in ends.items():

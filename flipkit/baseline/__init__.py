@@ -3,7 +3,11 @@ Sec. I): optimise the spatula trajectory of each subbehaviour in task space
 (:mod:`.ee_opt`), track it with placo IK at a controller rate (:mod:`.ik_track`) and
 classify what goes wrong (:mod:`.classify`).
 
-Durations are the upper bounds of :data:`flipkit.behaviors.T_BOUNDS`. Each subbehaviour's
+Durations are :data:`BASELINE_T` (s): the upper duration bounds collocation had before its
+chain was shortened from 4.0 s to 3.4 s. At the shorter bounds this baseline's go-to-burger
+already exceeds the joint acceleration limit (24 vs 20 rad/s² at Table I location 6, measured),
+so every location would fail there and say nothing about the flip; freeing the baseline's
+durations within collocation's bounds is issue 14's work. Each subbehaviour's
 end-effector QP starts at the previous one's end state (position, velocity, orientation);
 the IK continues from the previous IK configuration, except after a failed subbehaviour,
 where it restarts from an exact single-pose IK solution of the planned start pose
@@ -16,13 +20,15 @@ from __future__ import annotations
 import numpy as np
 
 from .. import targets as tg
-from ..behaviors import T_BOUNDS, Models
+from ..behaviors import Models
 from ..config import CellConfig
 from ..errors import ConfigError, NoSolutionFound, UnreachableError
 from ..ik import solve_pose
 from ..orientation import rpy
 from .classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
 from .ee_opt import EEState, EETrajectory, plan_segment
+
+BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
 from .ik_track import IKTrack, PlacoTracker
 
 
@@ -64,7 +70,7 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     result = BaselineResult(tuple(float(x) for x in pb), [])
     for name in tg.SUBBEHAVIORS:
         try:
-            traj = plan_segment(name, cell, pb, start, T_BOUNDS[name][1], home=home, rate=rate)
+            traj = plan_segment(name, cell, pb, start, BASELINE_T[name], home=home, rate=rate)
         except NoSolutionFound as exc:
             result.segments.append(SegmentVerdict(name, "failed", "ee_infeasible",
                                                   detail=f"end-effector QP: {exc.status}"))

@@ -180,7 +180,9 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
         if value.shape != (3,) or not np.all(np.isfinite(value)):
             raise ConfigError(f"start.{field_name} must be 3 finite numbers, got {value.tolist()}")
     pb = tg.check_location(cell, location)
-    ends = {"go_to_burger": tg.scoop_ready(cell, pb), "scoop": tg.scoop_end(cell, pb),
+    # the paper's scoop (eq. 24): tip on the grill's surface, not pressed into it as
+    # collocation's is (behaviors.SCOOP_PRESS, for the simulated grill contact)
+    ends = {"go_to_burger": tg.scoop_ready(cell, pb, 0.0), "scoop": tg.scoop_end(cell, pb, 0.0),
             "pickup": tg.pickup_end(cell, pb), "flip": tg.Pose((np.nan,) * 3, FLIP_END_RPY),
             "turn_back": home}
     goal = ends[name]
@@ -199,7 +201,7 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
     edges = np.array([[sp.length / 2, 0, 0], [-sp.length / 2, 0, 0],
                       [0, sp.width / 2, 0], [0, -sp.width / 2, 0]]).T
     h_clear = min(hg, pb[2])
-    z_tip = pb[2] + sp.length / 2 * np.sin(o[:, 1])  # tip on the grill (at the burger's z)
+    z_tip = hg + sp.length / 2 * np.sin(o[:, 1])  # tip on the grill (targets use h_g too)
     values = {"p0": start.p, "v0": start.v, "p_end": goal.p if name != "flip" else np.zeros(3),
               "p_min": lim.p_min, "p_max": lim.p_max, "v_max": np.full(3, lim.v_max),
               "a_max": np.full(3, lim.a_max), "z_clear": h_clear - np.min(R[:, 2] @ edges, axis=1),
