@@ -164,7 +164,7 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
 
 
 def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
-                  goal: tg.Pose | None = None, land=None,
+                  goal: tg.Pose | None = None, land=None, on_blade=(0.0, 0.0),
                   options: SegmentOptions = SegmentOptions()) -> NLP:
     """The NLP of one behaviour segment.
 
@@ -176,6 +176,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         goal: End pose for ``translate``.
         land: Flip: landing spot (x, y) (m); default where the burger was picked up
             (:func:`~flipkit.targets.landing_spot`).
+        on_blade: Flip: where the burger's centre sits on the blade (x, y) in the blade frame
+            (m), for its release state; default the blade centre.
         options: Transcription options.
     """
     if name not in BEHAVIORS:
@@ -251,9 +253,10 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
             if options.landing:
                 blocks += [
                     Landing(L, r, spot, options.r_land, thickness=bg.thickness,
-                            grill_height=hg, gravity=cell.gravity),
+                            grill_height=hg, gravity=cell.gravity, on_blade=on_blade),
                     FlightClearance(L, r, margin, thickness=bg.thickness,
-                                    diameter=bg.diameter, gravity=cell.gravity),
+                                    diameter=bg.diameter, gravity=cell.gravity,
+                                    on_blade=on_blade),
                 ]
             lo_n, hi_n = tg.FLIP_NORMAL_BOUNDS
             lo_x, hi_x = tg.FLIP_XAXIS_BOUNDS

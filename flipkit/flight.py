@@ -9,9 +9,11 @@ gyroscopic precession of a disc turning about a principal axis is zero). It land
 centre is half a thickness above the grill, which is where a burger lying on its other side
 has its centre.
 
-Release state at the blade pose (p, R), velocity v and angular velocity ω (world frame):
+Release state at the blade pose (p, R), velocity v and angular velocity ω (world frame), the
+burger's centre over the blade point b = (b_x, b_y, 0) (the blade centre unless the burger
+was measured elsewhere on the blade, e.g. after a scoop that dragged it forward):
 
-    c₀ = p + (h/2) R ẑ,   ċ₀ = v + ω × (h/2) R ẑ,   n₀ = R ẑ  (top-face normal)
+    c₀ = p + R (b + (h/2) ẑ),   ċ₀ = v + ω × R (b + (h/2) ẑ),   n₀ = R ẑ  (top-face normal)
 
 Flight, with τ the time since release and g = |gravity| along −z:
 
@@ -45,11 +47,13 @@ def _skew(w):
                       ca.horzcat(-w[1], w[0], 0))
 
 
-def _release(p, v, R, w, delta, h):
-    """Centre, centre velocity and top-face normal at release (SX)."""
-    n0 = ((ca.SX.eye(3) + _skew(delta)) @ R)[:, 2]
-    c0 = p + h / 2 * n0
-    return c0, v + ca.cross(w, h / 2 * n0), n0
+def _release(p, v, R, w, delta, h, bx, by):
+    """Centre, centre velocity and top-face normal at release (SX); the burger's centre
+    lies over the blade point (bx, by) of the blade frame."""
+    Rd = (ca.SX.eye(3) + _skew(delta)) @ R
+    n0 = Rd[:, 2]
+    arm = Rd @ ca.vertcat(bx, by, h / 2)
+    return p + arm, v + ca.cross(w, arm), n0
 
 
 def _rotate(n, w, tau):
@@ -64,13 +68,14 @@ def landing_function() -> ca.Function:
     """CasADi function ``(x, R, par) → (y, dy/dx)``.
 
     ``x`` = (p, v, δ, ω) (12), ``R`` the 3×3 blade rotation, ``par`` = (h, g, z_land, target x,
-    target y). ``y`` = (distance of the landing point from the target (m), z of the top-face
-    normal at landing (cos of its angle from +z), time of flight (s), landing x, landing y).
+    target y, bx, by) with (bx, by) where the burger's centre sits on the blade (blade frame,
+    m). ``y`` = (distance of the landing point from the target (m), z of the top-face normal
+    at landing (cos of its angle from +z), time of flight (s), landing x, landing y).
     """
-    x, R, par = ca.SX.sym("x", 12), ca.SX.sym("R", 3, 3), ca.SX.sym("par", 5)
+    x, R, par = ca.SX.sym("x", 12), ca.SX.sym("R", 3, 3), ca.SX.sym("par", 7)
     p, v, delta, w = x[0:3], x[3:6], x[6:9], x[9:12]
     h, g, z_land = par[0], par[1], par[2]
-    c0, cd, n0 = _release(p, v, R, w, delta, h)
+    c0, cd, n0 = _release(p, v, R, w, delta, h, par[5], par[6])
     tf = (cd[2] + ca.sqrt(cd[2] ** 2 + 2 * g * (c0[2] - z_land))) / g
     land = c0[0:2] + cd[0:2] * tf
     dist = ca.sqrt(ca.sumsqr(land - par[3:5]) + _SMOOTH**2)
@@ -84,16 +89,16 @@ def clearance_function() -> ca.Function:
     """CasADi function ``(x, R_r, R_i, par) → (d, ∂d/∂x)``: clearance of the flying burger.
 
     ``x`` = (p_r, v_r, δ_r, ω_r, τ, p_i, δ_i) (19): the release state, the time since release
-    τ (s) and a blade pose (p_i, R_i) at that time. ``par`` = (h, radius, g). ``d`` (m) is the
+    τ (s) and a blade pose (p_i, R_i) at that time. ``par`` = (h, radius, g, bx, by). ``d`` (m) is the
     height of the burger's lowest point above the blade plane, along the blade normal (on the
     carrying side): (c(τ) − p_i)·n_i − e, with e = r √(1 − (n·n_i)²) + (h/2) |n·n_i| the
     disc's half extent along n_i (smoothed). d ≥ 0 means the blade's plane separates the blade
     from the burger — sufficient for no contact, whatever the blade's outline.
     """
     x = ca.SX.sym("x", 19)
-    Rr, Ri, par = ca.SX.sym("Rr", 3, 3), ca.SX.sym("Ri", 3, 3), ca.SX.sym("par", 3)
+    Rr, Ri, par = ca.SX.sym("Rr", 3, 3), ca.SX.sym("Ri", 3, 3), ca.SX.sym("par", 5)
     h, rad, g = par[0], par[1], par[2]
-    c0, cd, n0 = _release(x[0:3], x[3:6], Rr, x[9:12], x[6:9], h)
+    c0, cd, n0 = _release(x[0:3], x[3:6], Rr, x[9:12], x[6:9], h, par[3], par[4])
     tau = x[12]
     c = c0 + cd * tau + ca.vertcat(0, 0, -g / 2 * tau**2)
     n = _rotate(n0, x[9:12], tau)
@@ -113,8 +118,9 @@ def gravity_magnitude(gravity) -> float:
 
 
 def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravity,
-                    target=(0.0, 0.0)) -> dict:
-    """Landing of a burger released from the blade state (p, R, v, ω) (world, SI).
+                    target=(0.0, 0.0), on_blade=(0.0, 0.0)) -> dict:
+    """Landing of a burger released from the blade state (p, R, v, ω) (world, SI), its
+    centre over the blade point ``on_blade`` (x, y) (blade frame, m).
 
     Returns:
         ``point`` (x, y, z of the centre at landing, m), ``offset`` (distance from ``target``,
@@ -124,7 +130,8 @@ def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravit
     z_land = grill_height + thickness / 2
     x = np.concatenate([p, v, np.zeros(3), w])
     y = np.asarray(landing_function()(x, np.asarray(R, float),
-                                      [thickness, g, z_land, *np.asarray(target, float)[:2]])[0])
+                                      [thickness, g, z_land, *np.asarray(target, float)[:2],
+                                       *np.asarray(on_blade, float)[:2]])[0])
     y = y.ravel()
     return {"point": [float(y[3]), float(y[4]), float(z_land)], "offset": float(y[0]),
             "tilt_deg": math.degrees(math.acos(float(np.clip(y[1], -1, 1)))),

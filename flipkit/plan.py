@@ -149,7 +149,8 @@ class Segment:
         landing: Flip only: the predicted landing — ``target`` (x, y) and ``r_land`` (m), the
             ``point`` (x, y, z) of the burger's centre at landing (m), its ``offset`` from the
             target (m), ``tilt_deg`` (angle of the top face's normal from +z, deg) and
-            ``time_of_flight`` (s) (:func:`flipkit.flight.predict_landing`).
+            ``time_of_flight`` (s) (:func:`flipkit.flight.predict_landing`), and
+            ``burger_on_blade`` (x, y) (m, blade frame), where the flight starts from.
     """
 
     name: str
@@ -210,7 +211,10 @@ class Segment:
                 "target": _array("landing.target", f["target"], (2,)).tolist(),
                 "r_land": _number("landing.r_land", f["r_land"], positive=True),
                 "point": _array("landing.point", f["point"], (3,)).tolist(),
-                **{k: _number(f"landing.{k}", f[k]) for k in _LANDING_KEYS[3:]}}
+                **{k: _number(f"landing.{k}", f[k]) for k in _LANDING_KEYS[3:]},
+                "burger_on_blade": _array("landing.burger_on_blade",
+                                          self.landing.get("burger_on_blade", (0.0, 0.0)),
+                                          (2,)).tolist()}
 
     @property
     def N(self) -> int:

@@ -17,6 +17,7 @@ before anything is solved.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -192,8 +193,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
-              solver: str = "sqp", land=None, options: SegmentOptions = SegmentOptions()
-              ) -> Plan:
+              solver: str = "sqp", land=None, on_blade=(0.0, 0.0),
+              options: SegmentOptions = SegmentOptions()) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -204,6 +205,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         qd_start: Start joint velocities (rad/s), default rest.
         land: Landing spot (x, y) (m) on the grill; default where the burger was picked up.
             The flipped burger's centre must land within ``options.r_land`` of it.
+        on_blade: Where the burger's centre will sit on the blade (x, y) (blade frame, m)
+            when it is released; default the blade centre.
         cell, solver, options: As :func:`plan_translate`.
 
     Returns:
@@ -220,16 +223,34 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         raise InvalidChoiceError("solver", solver, SOLVERS)
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
+    on_blade = _on_blade(on_blade, cell)
     models = models_for(cell)
     robot = models.bare
     q = robot.q_home.copy() if q_start is None else _joint_vector(
         "start configuration", q_start, robot.q_min, robot.q_max, "rad")
     qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
-    segments, failure = [], None
-    for name in tg.SUBBEHAVIORS:
+    return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0)
+
+
+def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
+    """(x, y) (m) of the burger's centre on the blade, on the blade, or ConfigError."""
+    xy = np.asarray(on_blade, dtype=float).ravel()
+    sp = cell.spatula
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or abs(xy[0]) > sp.length / 2 or abs(
+            xy[1]) > sp.width / 2:
+        raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
+                          f", ±{sp.width / 2} m, got {on_blade!r}")
+    return xy
+
+
+def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0) -> Plan:
+    """Solve the subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
+    segments, failure = list(done), None
+    for name in tg.SUBBEHAVIORS[len(done):]:
         try:
-            nlp = build_segment(name, models, q, qd, location=pb, land=spot, options=options)
+            nlp = build_segment(name, models, q, qd, location=pb, land=spot, on_blade=on_blade,
+                                options=options)
         except FlipkitError as exc:
             if not segments:
                 raise
@@ -245,6 +266,39 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     plan = Plan.from_segments("flip", cell, segments, location=pb, cone=options.cone,
                               status="failed")
     return _finish(plan, failure, t0)
+
+
+def replan_flip(plan: Plan, on_blade, *, solver: str = "sqp",
+                options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
+    ``on_blade`` on the blade after the scoop (sense, plan, act).
+
+    The scoop ends at rest with the blade flat on the grill and the burger on it, so the cell
+    can measure where the burger lies on the blade (a scoop drags it forward, by 2–7 cm in
+    simulation) and wait there while this runs. Go to burger and scoop are kept; the rest is
+    solved again from the scoop's end state with the release state of a burger at
+    ``on_blade``, to the plan's landing target; the result is checked like any plan.
+
+    Args:
+        plan: A solved flip plan. on_blade: (x, y) of the burger's centre in the blade frame
+            (m). solver, options: As :func:`plan_flip` (``r_land`` from the plan's landing).
+
+    Raises:
+        ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
+    """
+    t0 = time.perf_counter()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    if plan.behavior != "flip" or plan.status != "solved":
+        raise ConfigError("replan_flip needs a solved flip plan")
+    cell = plan.cell()
+    flip = next(s for s in plan.segments if s.name == "flip")
+    on_blade = _on_blade(on_blade, cell)
+    options = replace(options, r_land=flip.landing["r_land"], cone=plan.cone)
+    done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop")]
+    return _chain(np.asarray(plan.burger["location"], float), done[-1].q[-1], done[-1].qd[-1],
+                  done, models_for(cell), cell, solver, np.asarray(flip.landing["target"]),
+                  on_blade, options, t0)
 
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "sqp",

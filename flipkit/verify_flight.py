@@ -42,7 +42,8 @@ def recompute_landing(robot, seg, cell) -> dict | None:
     _, _, _, Jw = robot.pose_jacobians(seg.q[r])
     w = Jw @ seg.qd[r]
     h, g = cell.burger.thickness, np.asarray(cell.gravity, float)
-    arm = st.R[:, 2] * h / 2
+    bx, by = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
+    arm = st.R @ np.array([bx, by, h / 2])
     c0, v0 = st.p + arm, st.v + np.cross(w, arm)
     z_land = cell.grill.height + h / 2
 

@@ -44,18 +44,20 @@ class Landing(Block):
         layout: Variable layout. release: Release node r.
         target: Landing spot (x, y) (m). r_land: Allowed distance (m).
         thickness: Burger thickness h (m). grill_height: h_g (m). gravity: (3,) m/s².
+        on_blade: Where the burger's centre sits on the blade (x, y), blade frame (m).
     """
 
     def __init__(self, layout, release: int, target, r_land: float, *, thickness: float,
-                 grill_height: float, gravity):
+                 grill_height: float, gravity, on_blade=(0.0, 0.0)):
         super().__init__("landing", layout)
         if not (math.isfinite(r_land) and r_land > 0):
             raise ConfigError(f"r_land must be a positive distance (m), got {r_land!r}")
         if not 0 < release < layout.N:
             raise ConfigError(f"release node must be inside the segment, got {release}")
         self.release = int(release)
+        self.on_blade = [float(v) for v in np.asarray(on_blade, float)[:2]]
         self.par = [thickness, gravity_magnitude(gravity), grill_height + thickness / 2,
-                    *np.asarray(target, float)[:2]]
+                    *np.asarray(target, float)[:2], *self.on_blade]
         self._add(0, 2, np.concatenate([layout.iq(release), layout.iqd(release)]))
         self.m = 2
         self._finish([-np.inf, -np.inf], [r_land, math.cos(math.radians(TILT_MIN_DEG))],
@@ -71,9 +73,11 @@ class Landing(Block):
         w, _ = robot.angular_velocity_jacobian(*ev.node(r)[:2])
         h, g = self.par[0], self.par[1]
         pred = predict_landing(st.p, st.v, st.R, w, thickness=h, grill_height=self.par[2] - h / 2,
-                               gravity=(0.0, 0.0, -g), target=self.par[3:5])
+                               gravity=(0.0, 0.0, -g), target=self.par[3:5],
+                               on_blade=self.on_blade)
         return ({"node": r, "time": float(self.layout.s[r] * ev.T)},
-                {"target": [float(v) for v in self.par[3:5]], "r_land": float(self.hi[0]), **pred})
+                {"target": [float(v) for v in self.par[3:5]], "r_land": float(self.hi[0]),
+                 **pred, "burger_on_blade": list(self.on_blade)})
 
     def evaluate(self, ev):
         x, R, dq, dqd = _release_inputs(ev, self.release)
@@ -90,14 +94,16 @@ class FlightClearance(Block):
         layout: Variable layout. release: Release node r. margin: Clearance (m) per node
             after the release (scalar or N − r values).
         thickness, diameter: Burger size (m). gravity: (3,) m/s².
+        on_blade: Where the burger's centre sits on the blade (x, y), blade frame (m).
     """
 
     def __init__(self, layout, release: int, margin, *, thickness: float, diameter: float,
-                 gravity):
+                 gravity, on_blade=(0.0, 0.0)):
         super().__init__("flight_clearance", layout)
         self.release = int(release)
         self.nodes = list(range(self.release + 1, layout.N + 1))
-        self.par = [thickness, diameter / 2, gravity_magnitude(gravity)]
+        self.par = [thickness, diameter / 2, gravity_magnitude(gravity),
+                    *np.asarray(on_blade, float)[:2]]
         r = self.release
         for k, i in enumerate(self.nodes):
             self._add(k, 1, np.concatenate([layout.iq(r), layout.iqd(r), layout.iq(i),
