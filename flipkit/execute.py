@@ -31,7 +31,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .burger_sim import BurgerRun
 from .config import CellConfig
-from .errors import ConfigError, InvalidChoiceError
+from .errors import ConfigError, FlipkitError, InvalidChoiceError
 from .scene import ARM_JOINTS, Scene, build_scene, place_burger
 
 MODES = ("feedforward", "position")
@@ -53,6 +53,11 @@ class Execution:
         u: Applied joint torques (N·m), N×6. qpos: Full MuJoCo qpos (arm and burger), N×nq,
             to replay the run (rendering). force_blade_grill: Blade-grill normal force (N), N.
         mode: The controller. scene: The compiled cell.
+        plan: The plan executed (the replanned one when ``replan`` was given).
+        sensed_on_blade: The burger's centre on the blade (x, y) (m) measured after the scoop
+            and handed to ``replan`` (clipped to the blade); ``None`` open loop.
+        replan_failure: Why the replan failed (the original, verified plan then ran on), or
+            ``None``.
     """
 
     run: BurgerRun
@@ -65,6 +70,9 @@ class Execution:
     force_blade_grill: np.ndarray
     mode: str
     scene: Scene
+    plan: object = None
+    sensed_on_blade: list | None = None
+    replan_failure: str | None = None
 
 
 def _desired(plan, t: np.ndarray):
@@ -105,7 +113,7 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 
 def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
-                 rate_hz: float = 1000.0) -> Execution:
+                 rate_hz: float = 1000.0, replan=None) -> Execution:
     """Execute a flip plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
@@ -119,9 +127,18 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         physics: A :class:`~flipkit.config.PhysicsConfig` replacing ``cell.physics``.
         hold: Time (s) the last desired state is held after the plan.
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
+        replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
+            ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
+            rest, blade flat on the grill) with the burger's centre measured in the blade
+            frame (x, y) (m), e.g. :func:`flipkit.planner.replan_flip`; the rest of the run
+            follows the returned plan, which must keep go to burger and scoop and be solved
+            (verified): a controller never receives an unverified trajectory. If the replan
+            raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
+            runs on (``replan_failure`` says why). The arm waits at rest while a real cell
+            replans; the simulation does not model that pause (nothing moves during it).
 
     Returns:
-        The :class:`Execution`.
+        The :class:`Execution`; ``execution.plan`` is the plan finally executed.
     """
     d_ = _check(plan, mode, draw, hold, rate_hz)
     from .robot import Robot
@@ -136,22 +153,28 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     m, d = scene.model, scene.data
     sub = max(1, int(round(1.0 / (rate_hz * m.opt.timestep))))
     dt = sub * m.opt.timestep
-    T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments)
-    t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
-    q_des, qd_des, u_ff, bounds = _desired(plan, t)
-    if mode == "position":  # servo-rate samples, arriving latency_s late, zero-order hold
-        ts = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
-            / ph.servo_rate_hz
-        q_cmd, qd_cmd, _, _ = _desired(plan, ts)
-    else:
-        q_cmd, qd_cmd = q_des, qd_des
+
+    def references(plan):
+        T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments)
+        t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
+        q_des, qd_des, u_ff, bounds = _desired(plan, t)
+        if mode == "position":  # servo-rate samples, arriving latency_s late, zero-order hold
+            ts = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
+                / ph.servo_rate_hz
+            q_cmd, qd_cmd, _, _ = _desired(plan, ts)
+        else:
+            q_cmd, qd_cmd = q_des, qd_des
+        return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
+
+    t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
+    t_sense = bounds["scoop"][1] if replan is not None else np.inf
     kp, kd, umax = np.asarray(ph.kp), np.asarray(ph.kd), robot.u_max
 
     pb = np.asarray(plan.burger["location"], float)
     place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=q_des[0])
     d.qvel[:ARM_JOINTS] = qd_des[0]
     mujoco.mj_forward(m, d)
-    N = len(t)
+    N = len(t) if replan is None else 2 * len(t)  # room for a longer replanned tail
     rec = {k: np.zeros((N, 3)) for k in ("bp", "sp")}
     rec.update({k: np.zeros((N, 3, 3)) for k in ("br", "sr")})
     rec.update({k: np.zeros(N) for k in ("fs", "fg", "fbg")})
@@ -159,7 +182,28 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = m.geom_bodyid[scene.geoms["burger"]]
     f6 = np.zeros(6)
-    for k in range(N):
+    sensed, replan_failure = None, None
+    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    k = -1
+    while k + 1 < len(t):
+        k += 1
+        if t[k] >= t_sense - 1e-9 and sensed is None:  # the scoop has ended: sense and replan
+            mujoco.mj_kinematics(m, d)
+            p_b, R_b = scene.blade_pose()
+            sensed = ((d.xpos[burger_body] - p_b) @ R_b)[:2]
+            try:
+                new = replan(plan, np.clip(sensed, -half, half))
+            except FlipkitError as exc:  # keep the verified plan under way
+                replan_failure = str(exc)
+                continue
+            if new.status != "solved":
+                replan_failure = new.failure or "replanned plan not solved"
+                continue
+            plan = new
+            t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
+            if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
+                raise ConfigError("the replanned run does not extend the executed one")
+            t = t2
         q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
         ff = u_ff[k] if mode == "feedforward" else pin.computeGeneralizedGravity(
             robot.model, robot.data, q)
@@ -168,11 +212,15 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         _record(scene, rec, k, burger_body, f6)
         d.qfrc_applied[:ARM_JOINTS] = u
         mujoco.mj_step(m, d, nstep=sub)
+    n = len(t)
+    rec = {key: val[:n] for key, val in rec.items()}
+    qa, ua, qpos = qa[:n], ua[:n], qpos[:n]
     run = BurgerRun(t, rec["bp"], rec["br"], rec["sp"], rec["sr"], rec["ts"], rec["tg"],
                     rec["fs"], rec["fg"], bg.diameter, bg.thickness, cell.spatula.length,
                     cell.spatula.width, scene.grill_height)
     errors = _errors(robot, t, qa, q_des, bounds)
-    return Execution(run, bounds, errors, qa, q_des, ua, qpos, rec["fbg"], mode, scene)
+    return Execution(run, bounds, errors, qa, q_des, ua, qpos, rec["fbg"], mode, scene, plan,
+                     None if sensed is None else [float(v) for v in sensed], replan_failure)
 
 
 def _record(scene: Scene, rec: dict, k: int, burger_body: int, f6: np.ndarray) -> None:

@@ -174,16 +174,32 @@ def run_trial(job: dict) -> dict:
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
     cell = plan.cell()
-    ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"])
+    replan = None
+    if job.get("replan", False):
+        from .planner import replan_flip
+
+        replan = replan_flip
+    ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
+                      replan=replan)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
-    flip = judge_flip(run, bounds["flip"], landing_target(plan))
+    flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
     ok = {"scoop": scoop.ok}
     ok["pickup"] = ok["scoop"] and pickup.ok
     ok["flip"] = ok["pickup"] and flip.ok
     return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, flip, run),
             "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
-            "perturbation": draw, "tracking": errors, "mode": mode}
+            "perturbation": draw, "tracking": errors, "mode": mode,
+            "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
+            "predicted_landing_xy": _predicted(ex.plan),
+            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
+            if replan is not None else None}
+
+
+def _predicted(plan) -> list | None:
+    """The plan's predicted landing point (x, y) (m), or ``None`` without one."""
+    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    return None if flip is None or not flip.landing else [float(v) for v in flip.landing["point"][:2]]
 
 
 def merge_tracking(errors: list) -> dict:
@@ -202,28 +218,34 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
     trial then fails at stage ``plan``).
 
     ``success`` counts cumulative stages (a pickup counts only after a successful scoop, as
-    in the paper's Table I); ``independent`` counts each judge's passes on its own.
+    in the paper's Table I); ``independent`` counts each judge's passes on its own;
+    ``landings`` lists each trial's final burger position (x, y) (m), whether it flipped, the
+    executed plan's predicted landing and, with ``replan``, what was sensed.
     """
     if not results:
         fails = [{"trial": i, "stage": "plan", "reason": plan_info.get("reason"),
                   "amount": None} for i in range(trials)]
         return {"location": list(location), "plan": plan_info, "trials": trials,
                 "success": dict.fromkeys(STAGES, 0), "independent": dict.fromkeys(STAGES, 0),
-                "failures": fails, "tracking": {}}
+                "failures": fails, "tracking": {}, "landings": []}
     return {"location": list(location), "plan": plan_info, "trials": trials,
             "success": {s: sum(r["ok"][s] for r in results) for s in STAGES},
             "independent": {s: sum(r["independent"][s] for r in results) for s in STAGES},
             "failures": [{"trial": r["trial"], **r["failure"], "perturbation": r["perturbation"]}
                          for r in results if r["failure"]],
-            "tracking": merge_tracking([r["tracking"] for r in results])}
+            "tracking": merge_tracking([r["tracking"] for r in results]),
+            "landings": [{"trial": r["trial"], "flipped": r["ok"]["flip"],
+                          "xy": r.get("landing_xy"), "predicted_xy": r.get("predicted_landing_xy"),
+                          "replan": r.get("replan")} for r in results]}
 
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
-               rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward") -> list:
+               rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+               replan: bool = False) -> list:
     """The :func:`run_trial` jobs of one plan."""
     return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
-             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode}
-            for i in range(trials)]
+             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
+             "replan": bool(replan)} for i in range(trials)]
 
 
 def trial_key(job: dict) -> dict:
@@ -258,7 +280,8 @@ def plan_location(job: dict) -> dict:
 
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
-             rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward") -> dict:
+             rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+             replan: bool = False) -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -269,6 +292,9 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             ``np.random.default_rng(seed + i)``.
         perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
         mode: Joint controller, one of :data:`flipkit.execute.MODES`.
+        replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
+            and re-plan pickup, flip and turn back for it (:func:`flipkit.planner.replan_flip`);
+            ``False`` runs the plans open loop.
         executor, cache_dir, progress: See :func:`flipkit.sweep.run_sweep`.
 
     Returns:
@@ -286,14 +312,14 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
         if text is not None:
-            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode)
+            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan)
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
-            "rate_hz": float(rate_hz), "mode": mode, "locations": entries,
+            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
                         "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},

@@ -40,6 +40,9 @@ def register(subparsers) -> None:
                         help="joint controller: plan torques + PD (feedforward, default) or "
                              "the robot's PD position control on servo-rate, delayed desired "
                              "states with its own gravity compensation (position)")
+    parser.add_argument("--replan", action="store_true",
+                        help="sense, plan, act: after the scoop, measure where the burger lies "
+                             "on the blade and re-plan pickup, flip and turn back for it")
     add_sweep_arguments(parser)
     parser.add_argument("--json", required=True, metavar="OUT.json", help="output file")
     parser.set_defaults(run=run)
@@ -71,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--trials must be at least 1, got {args.trials}")
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ConfigError(f"--rate must be a positive number of Hz, got {args.rate}")
-    common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode)
+    common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
+                  replan=args.replan)
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
