@@ -1,0 +1,69 @@
+"""Sense, plan, act: the flip re-planned for the burger's measured place on the blade, in the
+MuJoCo cell; and the baselines that must fail — a plan made without the landing constraint,
+and a replan that cannot be solved (the verified original then runs on)."""
+
+import numpy as np
+import pytest
+
+from flipkit.behaviors import SegmentOptions
+from flipkit.burger_sim import LANDING_TOL, judge_flip, judge_scoop
+from flipkit.errors import ConfigError, FlipkitError
+from flipkit.execute import execute_plan
+from flipkit.planner import plan_flip, replan_flip
+from flipkit.validate import landing_target
+from flipkit.verify import verify_plan
+
+
+@pytest.fixture(scope="module")
+def replanned(flip_plan):
+    return execute_plan(flip_plan, "feedforward", replan=replan_flip)
+
+
+def test_replanned_flip_is_verified_and_made_for_the_sensed_burger(flip_plan, replanned):
+    ex = replanned
+    sensed = np.asarray(ex.sensed_on_blade)
+    assert ex.replan_failure is None and ex.plan is not flip_plan
+    # the scoop drags the burger toward the blade's tip: measured ahead of the blade centre
+    assert 0.005 < sensed[0] < flip_plan.spatula["length"] / 2
+    assert ex.plan.status == "solved" and verify_plan(ex.plan).ok
+    flip = next(s for s in ex.plan.segments if s.name == "flip")
+    np.testing.assert_allclose(flip.landing["burger_on_blade"], sensed, atol=1e-12)
+    kept = [s.name for s in ex.plan.segments[:2]]
+    assert kept == ["go_to_burger", "scoop"]
+    for a, b in zip(flip_plan.segments[:2], ex.plan.segments[:2]):
+        np.testing.assert_array_equal(a.q, b.q)  # what was executed before the sensing
+
+
+def test_replanned_flip_lands_on_its_spot(replanned):
+    run, bounds = replanned.run, replanned.bounds
+    assert judge_scoop(run, bounds["scoop"]).ok
+    verdict = judge_flip(run, bounds["flip"], landing_target(replanned.plan))
+    assert verdict.ok, verdict
+    assert np.all(np.abs(verdict.offset) <= LANDING_TOL)
+
+
+def test_a_plan_without_the_landing_constraint_misses(flip_plan):
+    loc = flip_plan.burger["location"]
+    plan = plan_flip(loc, options=SegmentOptions(landing=False))
+    flip = next(s for s in plan.segments if s.name == "flip")
+    assert flip.landing is None and plan.status == "failed"  # verify: no landing
+    assert "landing" in plan.failure
+    plan.status = "solved"  # execute it anyway, as the paper's flip (26) alone
+    ex = execute_plan(plan, "feedforward")
+    verdict = judge_flip(ex.run, ex.bounds["flip"], np.asarray(loc)[:2])
+    assert not verdict.ok
+    assert np.max(np.abs(verdict.offset)) > LANDING_TOL or not verdict.upside_down
+
+
+def test_a_failed_replan_leaves_the_verified_plan_running(flip_plan):
+    def refuse(plan, on_blade):
+        raise FlipkitError("no solution found (infeasible)")
+
+    ex = execute_plan(flip_plan, "feedforward", replan=refuse)
+    assert ex.plan is flip_plan and "infeasible" in ex.replan_failure
+    assert ex.sensed_on_blade is not None
+
+
+def test_replan_rejects_a_burger_off_the_blade(flip_plan):
+    with pytest.raises(ConfigError, match="on the blade"):
+        replan_flip(flip_plan, (0.5, 0.0))
