@@ -135,7 +135,7 @@ def _solver_failure(name: str, nlp, result) -> str:
     return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status})"
 
 
-def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "sqp",
+def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "auto",
                    q_start=None, yaw: float = 0.0,
                    options: SegmentOptions = SegmentOptions()) -> Plan:
     """Carry the burger on a flat spatula from ``start`` to ``goal`` (paper eq. 9), at rest
@@ -147,7 +147,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
             ``q_start`` is given.
         goal: Blade-centre goal position (m); the spatula ends flat with heading ``yaw``.
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
-        solver: ``"sqp"`` or ``"ipopt"``.
+        solver: ``"auto"`` (default: the SQP, then IPOPT from the same start where the SQP
+            fails), ``"sqp"`` or ``"ipopt"``.
         q_start: Start configuration (rad) instead of the IK one; must lie within the joint
             limits and, if ``start`` is given too, put the blade within 1 mm of it.
         yaw: Heading o_z of the spatula (rad).
@@ -193,7 +194,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
-              solver: str = "sqp", land=None, on_blade=(0.0, 0.0),
+              solver: str = "auto", land=None, on_blade=(0.0, 0.0),
               options: SegmentOptions = SegmentOptions()) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
@@ -268,7 +269,7 @@ def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options,
     return _finish(plan, failure, t0)
 
 
-def replan_flip(plan: Plan, on_blade, *, solver: str = "sqp",
+def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
                 options: SegmentOptions = SegmentOptions()) -> Plan:
     """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
     ``on_blade`` on the blade after the scoop (sense, plan, act).
@@ -301,7 +302,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "sqp",
                   on_blade, options, t0)
 
 
-def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "sqp",
+def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
                progress: bool = True, options: SegmentOptions = SegmentOptions()) -> list[Plan]:
     """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
 

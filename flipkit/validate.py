@@ -25,7 +25,7 @@ from . import targets as tg
 from .behaviors import CARRIES_BURGER
 from .burger_sim import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP, judge_flip,
                          judge_pickup, judge_scoop)
-from .config import CellConfig
+from .config import CellConfig, with_parameter
 from .errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from .plan import Plan
 
@@ -156,7 +156,11 @@ def run_trial(job: dict) -> dict:
     Args:
         job: ``plan_text`` (a solved flip plan file's text), ``trial`` (index), ``seed``,
             ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
-            rate, Hz), ``mode`` (:data:`flipkit.execute.MODES`; default ``"feedforward"``).
+            rate, Hz), ``mode`` (:data:`flipkit.execute.MODES`; default ``"feedforward"``),
+            optionally ``replan`` (bool, see :func:`validate`) and ``physics``
+            (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
+            simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
+            and any replan keep the nominal model).
 
     Returns:
         ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` ({stage: bool}, each
@@ -174,6 +178,8 @@ def run_trial(job: dict) -> dict:
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
     cell = plan.cell()
+    for name, value in (job.get("physics") or {}).items():
+        cell = with_parameter(cell, name, value)
     replan = None
     if job.get("replan", False):
         from .planner import replan_flip
@@ -193,7 +199,7 @@ def run_trial(job: dict) -> dict:
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
             "predicted_landing_xy": _predicted(ex.plan),
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
-            if replan is not None else None}
+            if replan is not None else None, "physics": dict(job.get("physics") or {})}
 
 
 def _predicted(plan) -> list | None:
@@ -241,11 +247,13 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
                rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
-               replan: bool = False) -> list:
-    """The :func:`run_trial` jobs of one plan."""
+               replan: bool = False, physics: dict | None = None) -> list:
+    """The :func:`run_trial` jobs of one plan (``physics``: see :func:`run_trial`; the key
+    is left out when empty, so the cache keys of nominal trials do not change)."""
+    extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
     return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
              "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
-             "replan": bool(replan)} for i in range(trials)]
+             "replan": bool(replan), **extra} for i in range(trials)]
 
 
 def trial_key(job: dict) -> dict:
@@ -340,7 +348,7 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
                     seed, **kwargs)
 
 
-def validate_locations(locations, trials: int, solver: str = "sqp", seed: int = 0, *,
+def validate_locations(locations, trials: int, solver: str = "auto", seed: int = 0, *,
                        executor=None, cache_dir=None, plans_dir=None, progress: bool = True,
                        **kwargs) -> dict:
     """Plan every location (on the sweep, cached), then :func:`validate` the plans.

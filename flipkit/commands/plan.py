@@ -39,8 +39,9 @@ def register(subparsers) -> None:
     sub = parser.add_subparsers(dest="plan_command", required=True, metavar="BEHAVIOR")
 
     def common(p, json_out=True):
-        p.add_argument("--solver", choices=SOLVER_CHOICES, default="sqp",
-                       help="NLP solver: sqp (cvxpy/OSQP, default), ipopt (CasADi), or auto (SQP, then IPOPT if the SQP fails)")
+        p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+                       help="NLP solver: auto (default: the SQP, then IPOPT where the SQP "
+                            "fails), sqp (cvxpy/OSQP) or ipopt (CasADi)")
         if json_out:
             p.add_argument("--json", required=True, metavar="PLAN.json",
                            help="output plan file (flipkit-plan/1)")

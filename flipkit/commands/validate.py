@@ -31,8 +31,8 @@ def register(subparsers) -> None:
                         help="simulated trials per location (>= 1)")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="trial i draws from numpy default_rng(S + i) (default 0)")
-    parser.add_argument("--solver", choices=SOLVER_CHOICES, default="sqp",
-                        help="collocation solver for --locations (default sqp)")
+    parser.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+                        help="collocation solver for --locations (default auto: the SQP, then IPOPT where it fails)")
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz, default 1000)")
