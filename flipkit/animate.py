@@ -135,25 +135,46 @@ def key_frames(execution) -> dict:
     return out
 
 
-def write_filmstrip(execution, out, width: int = 320, height: int = 240) -> Path:
-    """A PNG of the key frames (:func:`key_frames`) side by side, titled with their times;
-    the end of the run stands in for a key moment that did not happen."""
-    import matplotlib
+def filmstrip_figure(execution, width: int = 320, height: int = 240, panel_width: float = 3.2,
+                     fontsize: float = 9):
+    """A matplotlib figure of the key frames (:func:`key_frames`) side by side, titled with
+    their times; the end of the run stands in for a key moment that did not happen.
 
-    matplotlib.use("Agg")
+    Args:
+        execution: An :class:`~flipkit.execute.Execution`.
+        width, height: Rendered frame size (pixels).
+        panel_width: Width of one panel (in); the height follows the frame's aspect.
+        fontsize: Title size (pt).
+
+    Returns:
+        ``(fig, times)``: the figure and ``{key: time (s) or None}`` of the moments shown.
+    """
     import matplotlib.pyplot as plt
 
     keys = key_frames(execution)
     last = len(execution.run.t) - 1
     idx = [last if k is None else k for k in keys.values()]
     frames = render(execution, idx, width, height)
-    fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 2.6))
+    fig, axes = plt.subplots(1, len(frames), figsize=(
+        panel_width * len(frames), panel_width * height / width + 0.35))
     for ax, (name, k), f, i in zip(axes, keys.items(), frames, idx):
         ax.imshow(f)
         ax.set_axis_off()
         what = "not reached: end" if k is None else name
-        ax.set_title(f"{what}, t = {execution.run.t[i]:.2f} s", fontsize=9)
+        ax.set_title(f"{what}, t = {execution.run.t[i]:.2f} s", fontsize=fontsize)
     fig.tight_layout()
+    times = {name: None if k is None else float(execution.run.t[k]) for name, k in keys.items()}
+    return fig, times
+
+
+def write_filmstrip(execution, out, width: int = 320, height: int = 240) -> Path:
+    """A PNG of the key frames (:func:`filmstrip_figure`) side by side."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, _ = filmstrip_figure(execution, width, height)
     try:
         fig.savefig(out, dpi=100)
     except OSError as exc:
@@ -164,4 +185,4 @@ def write_filmstrip(execution, out, width: int = 320, height: int = 240) -> Path
 
 
 __all__ = ["FORMATS", "frame_indices", "render", "write_animation", "key_frames",
-           "write_filmstrip"]
+           "filmstrip_figure", "write_filmstrip"]
