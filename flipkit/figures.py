@@ -29,6 +29,8 @@ FIGURES = {  # figure id -> notebook that makes it (DESIGN.md, "The figures"), i
     "defects": "defects.ipynb", "translate": "translate.ipynb", "flip": "flip.ipynb",
     "table1": "table1.ipynb", "ik_failure": "ik_failure.ipynb",
     "solve_times": "solve_times.ipynb", "cone_forms": "cone_forms.ipynb",
+    "landing": "landing.ipynb", "filmstrip": "landing.ipynb",
+    "sensitivity": "sensitivity.ipynb",
 }
 FIGURE_IDS = tuple(FIGURES)
 COLUMN_WIDTH = 3.5  # in, one RA-L column
@@ -385,23 +387,30 @@ def format_number(value, digits: int = 3) -> str:
 
 def config_constants() -> dict:
     """The configuration values the report quotes, read from the package (not typed by
-    hand): friction coefficients, scoop tip band, acceleration limit, burger and spatula
+    hand): friction coefficients (burger-blade ``mu``, burger-grill ``grill_mu`` of the
+    simulated cell), the scoop's commanded press into the grill and its band (mm), the
+    flip's landing radius (mm) and release fraction, acceleration limit, burger and spatula
     sizes, grill height, nodes per segment, and the duration bounds T_BOUNDS (s) of every
     segment with their sum over pickup-and-flip."""
     from . import targets as tg
-    from .behaviors import SCOOP_TIP_BAND, T_BOUNDS, SegmentOptions
-    from .burger_sim import GRILL_MU
+    from .behaviors import (R_LAND, RELEASE_FRACTION, SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS,
+                            SegmentOptions)
     from .config import CellConfig
 
     cell = CellConfig()
-    out = {"mu": cell.burger.mu, "grill_mu": GRILL_MU, "scoop_tip_band_mm": 1e3 * SCOOP_TIP_BAND,
+    out = {"mu": cell.burger.mu, "grill_mu": cell.physics.mu_grill,
+           "scoop_press_mm": 1e3 * SCOOP_PRESS, "scoop_tip_band_mm": 1e3 * SCOOP_TIP_BAND,
+           "r_land_mm": 1e3 * R_LAND, "release_fraction": RELEASE_FRACTION,
+           "release_node": SegmentOptions().release_node(),
            "accel_limit_rad_s2": cell.robot.accel_limit, "burger_diameter_m":
-               cell.burger.diameter, "burger_mass_kg": cell.burger.mass,
+               cell.burger.diameter, "burger_thickness_m": cell.burger.thickness,
+           "burger_mass_kg": cell.burger.mass,
            "spatula_length_m": cell.spatula.length, "spatula_width_m": cell.spatula.width,
-           "grill_height_m": cell.grill.height, "nodes": SegmentOptions().N + 1}
+           "grill_height_m": cell.grill.height, "nodes": SegmentOptions().N + 1,
+           "segment_intervals": SegmentOptions().N}
     for name, (lo, hi) in T_BOUNDS.items():
         out[f"T_{name}_min_s"], out[f"T_{name}_max_s"] = lo, hi
-    out["T_pickup_and_flip_max_s"] = sum(T_BOUNDS[n][1] for n in tg.SUBBEHAVIORS)
+    out["T_pickup_and_flip_max_s"] = round(sum(T_BOUNDS[n][1] for n in tg.SUBBEHAVIORS), 9)
     return out
 
 

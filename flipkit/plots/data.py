@@ -330,7 +330,59 @@ def paper_table1() -> list[dict]:
              **{k: int(r[k]) for k in ("scoop", "pickup", "flip", "trials")}} for r in rows]
 
 
+# ------------------------------------------------------------------ landing points
+SUCCESS_TOL = 0.05  # m: the paper's flip test, the burger lands within 5 cm in x and in y
+
+
+def landing_points(report: dict, targets_xy) -> dict:
+    """The flips of a :func:`flipkit.validate.validate` report that reached the flight
+    (scoop and pickup succeeded), with their target.
+
+    Args:
+        report: A validate report (``locations[k]["landings"]`` and ``failures``).
+        targets_xy: Landing target (x, y) (m) of each location, in the report's order.
+
+    Returns:
+        Arrays over those trials: ``location`` (index), ``target``, ``xy`` (final burger
+        position), ``predicted`` (the executed plan's predicted landing point; NaN without
+        one) (m, k×2), ``flipped`` (the paper's judge); and ``reached``/``trials`` counts.
+    """
+    rows = []
+    for k, (entry, target) in enumerate(zip(report["locations"], targets_xy)):
+        early = {f["trial"] for f in entry["failures"] if f["stage"] in ("scoop", "pickup")}
+        for land in entry["landings"]:
+            if land["trial"] in early or land["xy"] is None:
+                continue
+            pred = land["predicted_xy"] if land["predicted_xy"] is not None else [np.nan] * 2
+            rows.append((k, target, land["xy"], pred, bool(land["flipped"])))
+    n = len(rows)
+    return {"location": np.array([r[0] for r in rows], int),
+            "target": np.array([r[1] for r in rows], float).reshape(n, 2),
+            "xy": np.array([r[2] for r in rows], float).reshape(n, 2),
+            "predicted": np.array([r[3] for r in rows], float).reshape(n, 2),
+            "flipped": np.array([r[4] for r in rows], bool), "reached": n,
+            "trials": sum(e["trials"] for e in report["locations"])}
+
+
+def landing_summary(points: dict, tol: float = SUCCESS_TOL) -> dict:
+    """Counts and medians of :func:`landing_points`: ``within_tol_xy`` (|Δx|, |Δy| ≤ tol,
+    the paper's test), ``within_tol_radius`` (distance ≤ tol), ``flipped``, ``reached``,
+    ``median_target_distance_m`` (simulated landing to target) and
+    ``median_prediction_error_m`` (|simulated − predicted|) (m; None without trials)."""
+    d = points["xy"] - points["target"]
+    dist = np.hypot(d[:, 0], d[:, 1])
+    err = np.hypot(*(points["xy"] - points["predicted"]).T)
+    err = err[np.isfinite(err)]
+    return {"reached": int(points["reached"]), "trials": int(points["trials"]),
+            "flipped": int(points["flipped"].sum()),
+            "within_tol_xy": int(np.sum(np.all(np.abs(d) <= tol, axis=1))),
+            "within_tol_radius": int(np.sum(dist <= tol)),
+            "median_target_distance_m": float(np.median(dist)) if dist.size else None,
+            "median_prediction_error_m": float(np.median(err)) if err.size else None}
+
+
 __all__ = ["PlanSeries", "plan_series", "spatula_positions", "ContactSeries", "contact_series",
            "HermiteSimpsonCurves", "hermite_simpson_curves", "defect_magnitudes",
            "CONE_CLASSES", "pitch_matrix", "printed_paper_cone", "cone_region_grid",
-           "tangential_boundaries", "PAPER_TABLE1", "paper_table1"]
+           "tangential_boundaries", "PAPER_TABLE1", "paper_table1", "SUCCESS_TOL",
+           "landing_points", "landing_summary"]

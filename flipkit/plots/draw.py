@@ -401,6 +401,47 @@ def plot_success(ax, labels, ours_k, ours_n, paper_k, paper_n, title: str = "",
         ax.set_title(title)
 
 
+def plot_success_series(ax, labels, series, paper_k, paper_n, title: str = "",
+                        pooled: bool = True) -> None:
+    """Success ratios per location of several simulated pipelines side by side (each with a
+    95 % Wilson interval) beside the paper's (open squares); with ``pooled`` a last column
+    "all" pools every location.
+
+    Args:
+        ax: 2D axes. labels: Location labels.
+        series: ``[{"label", "k" (successes per location), "n" (trials per location),
+            optional "color", "marker", "open" (hollow marker)}]``, drawn left to right.
+        paper_k, paper_n: The paper's successes and trials per location.
+    """
+    labels = [str(v) for v in labels]
+    paper_k, paper_n = np.asarray(paper_k, float), np.asarray(paper_n, float)
+    if pooled:
+        labels = labels + ["all"]
+        paper_k, paper_n = np.append(paper_k, paper_k.sum()), np.append(paper_n, paper_n.sum())
+    x = np.arange(len(labels), dtype=float)
+    if pooled:
+        x[-1] += 0.5
+        ax.axvline(x[-1] - 0.75, color="0.6", lw=0.6, ls=":")
+    width = 0.7 / (len(series) + 1)
+    ax.plot(x - 0.35 + width / 2, paper_k / paper_n, "s", mfc="white", mec=DESIRED_COLOR,
+            ms=4, mew=1.0, label="paper (real robot)")
+    for j, sr in enumerate(series, 1):
+        k, n = np.asarray(sr["k"], float), np.asarray(sr["n"], float)
+        if pooled:
+            k, n = np.append(k, k.sum()), np.append(n, n.sum())
+        lo, hi = wilson_interval(k, n)
+        ratio = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
+        color = sr.get("color", f"C{j - 1}")
+        ax.errorbar(x - 0.35 + width * (j + 0.5), ratio, yerr=[ratio - lo, hi - ratio],
+                    fmt=sr.get("marker", "o"), color=color, mfc="white" if sr.get("open")
+                    else color, ms=3.5, capsize=1.2, lw=0.7, label=sr["label"])
+    ax.set_xticks(x, labels)
+    ax.set_ylim(-0.05, 1.08)
+    ax.set_ylabel("success ratio")
+    if title:
+        ax.set_title(title)
+
+
 def plot_solve_times(ax, names, times, budget: float | None = None, log: bool = True,
                      failed=None) -> dict:
     """Solve time per group (subbehaviour) and solver: points per location, box over them.
@@ -508,7 +549,84 @@ def plot_grill_map(ax, cell, points, categories, styles, title: str = "",
         ax.set_title(title)
 
 
+def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, title: str = "",
+                  legend: bool = True) -> None:
+    """Top view of the grill (axes as :func:`plot_grill_map`): each target with a circle of
+    ``radius`` (m) about it, the predicted landing points (crosses), the simulated ones
+    (filled: flipped by the paper's judge; open: not), a thin line from each prediction to
+    its simulated landing.
+
+    Args:
+        ax: 2D axes. cell: The cell (grill area).
+        points: :func:`flipkit.plots.data.landing_points`.
+        targets_xy: The landing targets (k×2) (m).
+        radius: Circle radius (m), the paper's 5 cm.
+    """
+    from matplotlib.patches import Circle, Rectangle
+
+    g = cell.grill
+    ax.add_patch(Rectangle((g.y_range[0], g.x_range[0]), g.y_range[1] - g.y_range[0],
+                           g.x_range[1] - g.x_range[0], facecolor="0.95", edgecolor="0.3",
+                           lw=0.8, zorder=0))
+    tg = np.asarray(targets_xy, float).reshape(-1, 2)
+    for k, (x, y) in enumerate(tg):
+        ax.add_patch(Circle((y, x), radius, fill=False, ec="0.35", lw=0.6, ls="--", zorder=1))
+        ax.annotate(str(k + 1), (y, x), xytext=(0, radius * 0 + 0), textcoords="offset points",
+                    fontsize=5, color="0.3", ha="center", va="center", zorder=1)
+    ax.plot([], [], ls="--", color="0.35", lw=0.6, label=f"{100 * radius:g} cm about target")
+    xy, pred, ok = points["xy"], points["predicted"], points["flipped"]
+    for a, b in zip(pred, xy):
+        if np.all(np.isfinite(a)):
+            ax.plot([a[1], b[1]], [a[0], b[0]], color="0.6", lw=0.4, zorder=2)
+    ax.plot(pred[:, 1], pred[:, 0], "x", color=DESIRED_COLOR, ms=3.5, mew=0.8, zorder=3,
+            label="predicted (plan)")
+    ax.plot(xy[ok, 1], xy[ok, 0], "o", color=ACTUAL_COLOR, ms=3, zorder=4,
+            label=f"simulated, flipped ({int(ok.sum())})")
+    ax.plot(xy[~ok, 1], xy[~ok, 0], "o", mfc="white", mec=ACTUAL_COLOR, ms=3, mew=0.7,
+            zorder=4, label=f"simulated, not flipped ({int((~ok).sum())})")
+    ax.set_xlim(g.y_range[1] + 0.03, g.y_range[0] - 0.03)  # y grows to the left
+    ax.set_ylim(g.x_range[0] - 0.03, g.x_range[1] + 0.03)
+    ax.set_aspect("equal")
+    ax.set_xlabel("y (m)")
+    ax.set_ylabel("x (m)")
+    if title:
+        ax.set_title(title)
+    if legend:
+        ax.legend(loc="lower left", fontsize=6)
+
+
+def plot_sensitivity(axes, result: dict, stages=("scoop", "pickup", "flip"),
+                     labels=None) -> list:
+    """One panel per stage: per parameter (rows), the success ratio at the low end
+    (down-triangle) and the high end (up-triangle) of its range, the nominal cell's ratio as
+    a vertical line. ``result`` is :func:`flipkit.sensitivity.run_sensitivity`'s.
+
+    Returns:
+        The parameter names, top to bottom.
+    """
+    names = list(result["parameters"])
+    y = np.arange(len(names))[::-1]
+    nominal = result.get("nominal")
+    for ax, stage in zip(axes, stages):
+        for end, marker, color in (("low", "v", DESIRED_COLOR), ("high", "^", ACTUAL_COLOR)):
+            r = [result["parameters"][n][end] for n in names]
+            ratio = np.array([c["success"][stage] / c["trials"] for c in r])
+            off = -0.12 if end == "low" else 0.12
+            ax.plot(ratio, y + off, marker, color=color, ms=3.5, ls="none",
+                    label=f"{end} end of range")
+        if nominal is not None:
+            ax.axvline(nominal["success"][stage] / nominal["trials"], color="0.3", lw=0.9,
+                       ls=":", label="nominal")
+        ax.set_xlim(-0.05, 1.05)
+        ax.set_ylim(-0.6, len(names) - 0.4)
+        ax.set_title(stage)
+        ax.set_xlabel("success ratio")
+        ax.set_yticks(y, labels or names)
+    return names
+
+
 __all__ = ["DESIRED_COLOR", "ACTUAL_COLOR", "SOLVER_COLORS", "SOLVER_LABELS", "plot_tracking",
            "plot_tracking_error", "shade_nodes", "plot_forces", "plot_hermite_simpson",
            "plot_cone_regions", "plot_tangential_sections", "draw_burger", "draw_snapshot",
-           "wilson_interval", "plot_success", "plot_solve_times", "plot_grill_map"]
+           "wilson_interval", "plot_success", "plot_success_series", "plot_solve_times", "plot_grill_map",
+           "plot_landings", "plot_sensitivity"]

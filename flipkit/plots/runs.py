@@ -8,6 +8,8 @@
 * :func:`nominal_trial` — one unperturbed Table I trial of a flip plan.
 * :func:`flip_solve_times` / :func:`solve_time_sweep` — solve time of every subbehaviour of
   pickup-and-flip, per solver and location.
+* :func:`plan_targets` — the Table I plans, once, for several validations.
+* :func:`flip_execution` — one unperturbed execution (open loop or replanned) to render.
 """
 
 from __future__ import annotations
@@ -228,5 +230,45 @@ def solve_time_table(rows, names) -> dict:
     return {"times": times, "failed": failed, "solved": solved}
 
 
+
+# ------------------------------------------------------------------ Table I plans and runs
+def plan_targets(locations, solver: str = "sqp", executor=None, progress: bool = False):
+    """Plan pickup-and-flip at every location on the sweep (in a temporary directory) and
+    return the :func:`flipkit.validate.validate` targets ``[(location, plan_info, plan_text
+    or None)]``, so that one set of plans serves several validations."""
+    import tempfile
+    from pathlib import Path
+
+    from ..sweep import run_sweep
+    from ..validate import plan_location
+
+    with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
+        jobs = [{"location": [float(v) for v in loc], "solver": solver, "plans_dir": tmp}
+                for loc in locations]
+        infos = run_sweep(plan_location, jobs, executor, None, progress=progress, desc="plans")
+        return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},
+                 Path(r["path"]).read_text() if r["status"] == "solved" else None)
+                for job, r in zip(jobs, infos)]
+
+
+def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = True):
+    """One unperturbed execution of a plan file's text (the nominal cell), through the
+    sense-plan-act pipeline with ``replan``: ``(execution, ok)``, ``ok`` = {stage: bool}
+    (cumulative, the judges of Table I) — the run :mod:`flipkit.animate` renders."""
+    from ..burger_sim import judge_flip, judge_pickup, judge_scoop
+    from ..execute import execute_plan
+    from ..validate import HOLD_S, landing_target, plan_from_text
+
+    replan_fn = None
+    if replan:
+        from ..planner import replan_flip as replan_fn
+    ex = execute_plan(plan_from_text(plan_text), mode, None, hold=HOLD_S, replan=replan_fn)
+    b = ex.bounds
+    ok = {"scoop": judge_scoop(ex.run, b["scoop"]).ok}
+    ok["pickup"] = ok["scoop"] and judge_pickup(ex.run, b["pickup"]).ok
+    ok["flip"] = ok["pickup"] and judge_flip(ex.run, b["flip"], landing_target(ex.plan)).ok
+    return ex, ok
+
+
 __all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
-           "solve_time_sweep", "solve_time_table"]
+           "solve_time_sweep", "solve_time_table", "plan_targets", "flip_execution"]
