@@ -389,18 +389,20 @@ def config_constants() -> dict:
     """The configuration values the report quotes, read from the package (not typed by
     hand): friction coefficients (burger-blade ``mu``, burger-grill ``grill_mu`` of the
     simulated cell), the scoop's commanded press into the grill and its band (mm), the
-    flip's landing radius (mm) and release fraction, acceleration limit, burger and spatula
+    flip's landing radius (mm), release fraction and node and minimum landing tilt (deg), acceleration limit, burger and spatula
     sizes, grill height, nodes per segment, and the duration bounds T_BOUNDS (s) of every
     segment with their sum over pickup-and-flip."""
     from . import targets as tg
     from .behaviors import (R_LAND, RELEASE_FRACTION, SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS,
                             SegmentOptions)
     from .config import CellConfig
+    from .flight import TILT_MIN_DEG
 
     cell = CellConfig()
     out = {"mu": cell.burger.mu, "grill_mu": cell.physics.mu_grill,
            "scoop_press_mm": 1e3 * SCOOP_PRESS, "scoop_tip_band_mm": 1e3 * SCOOP_TIP_BAND,
            "r_land_mm": 1e3 * R_LAND, "release_fraction": RELEASE_FRACTION,
+           "landing_tilt_min_deg": TILT_MIN_DEG,
            "release_node": SegmentOptions().release_node(),
            "accel_limit_rad_s2": cell.robot.accel_limit, "burger_diameter_m":
                cell.burger.diameter, "burger_thickness_m": cell.burger.thickness,
