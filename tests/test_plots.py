@@ -318,3 +318,48 @@ def test_write_macros_one_macro_per_number(tmp_path):
     # from a path too
     (tmp_path / "m.json").write_text(json.dumps(manifest))
     assert figures.write_macros(tmp_path / "m.json", tmp_path / "n2.tex").read_text() == text
+
+
+def _landing_report():
+    """A validate report of two locations: trial 0 of location 1 failed its scoop."""
+    def landing(trial, xy, pred, flipped):
+        return {"trial": trial, "flipped": flipped, "xy": xy, "predicted_xy": pred,
+                "replan": None}
+    return {"locations": [
+        {"trials": 2, "failures": [{"trial": 0, "stage": "scoop", "reason": "overlap"}],
+         "landings": [landing(0, [0.7, 0.0], [0.7, 0.0], False),
+                      landing(1, [0.74, 0.04], [0.71, 0.0], True)]},
+        {"trials": 2, "failures": [{"trial": 1, "stage": "flip", "reason": "missed_spot"}],
+         "landings": [landing(0, [0.6, -0.3], None, True),
+                      landing(1, [0.66, -0.3], [0.6, -0.3], False)]}]}
+
+
+def test_landing_points_and_summary_count_the_flights_after_a_pickup():
+    pts = data.landing_points(_landing_report(), [[0.7, 0.0], [0.6, -0.3]])
+    assert pts["reached"] == 3 and pts["trials"] == 4
+    assert pts["location"].tolist() == [0, 1, 1]
+    assert np.isnan(pts["predicted"][1]).all()
+    s = data.landing_summary(pts)
+    assert s["flipped"] == 2 and s["within_tol_xy"] == 2  # (0.04, 0.04): in x and y ...
+    assert s["within_tol_radius"] == 1 and s["reached"] == 3  # ... but not within 5 cm
+    assert s["median_target_distance_m"] == pytest.approx(np.hypot(0.04, 0.04))
+    assert s["median_prediction_error_m"] == pytest.approx(0.055)
+    fig, ax = plt.subplots()
+    draw.plot_landings(ax, CellConfig(), pts, [[0.7, 0.0], [0.6, -0.3]], title="open loop")
+    assert ax.get_title() == "open loop" and len(ax.patches) == 3  # grill + two circles
+    plt.close(fig)
+
+
+def test_success_series_and_sensitivity_panels_draw():
+    fig, ax = plt.subplots()
+    draw.plot_success_series(ax, ["1", "2"], [{"label": "a", "k": [1, 2], "n": [2, 2]},
+                                              {"label": "b", "k": [0, 0], "n": [2, 2],
+                                               "open": True}], [10, 7], [10, 10], title="flip")
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["1", "2", "all"]
+    assert {"a", "b", "paper (real robot)"} <= set(ax.get_legend_handles_labels()[1])
+    plt.close(fig)
+    counts = {"trials": 2, "success": {"scoop": 2, "pickup": 1, "flip": 0}}
+    result = {"nominal": counts, "parameters": {"burger.mu": {"low": counts, "high": counts}}}
+    fig, axes = plt.subplots(1, 3)
+    assert draw.plot_sensitivity(axes, result) == ["burger.mu"]
+    plt.close(fig)
