@@ -206,7 +206,9 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     ]
     blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", moving,
                                  grill_floor(name, cell, L.N)[1:, None], np.inf, ctx=ctx))
-    cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity))
+    # the burger's contact acceleration is that of the blade point under its centre
+    on_point = (*np.asarray(on_blade, float)[:2], 0.0) if name == "flip" else None
+    cone = Cone(make_cone(options.cone, cell.burger.mu, cell.gravity), on_point)
     cone_nodes: list[int] = []
     # The scoop ends at rest too (our addition): the blade lies flat on the grill at its end,
     # so any downward or pitching velocity there would push it through the grill on pickup.

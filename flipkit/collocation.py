@@ -109,6 +109,14 @@ class Evaluation:
             self._states[i] = self.robot.state(q, qd, qdd)
         return self._states[i]
 
+    def point_state(self, i: int, point) -> SpatulaState:
+        """Kinematics at node i of a blade point (spatula frame, m), e.g. under the burger."""
+        key = (i, *(float(v) for v in point))
+        if key not in self._states:
+            q, qd, qdd, _ = self.node(i)
+            self._states[key] = self.robot.state(q, qd, qdd, point)
+        return self._states[key]
+
     def rnea(self, i: int):
         """RNEA torque and its Jacobians at node i."""
         if i not in self._rnea:

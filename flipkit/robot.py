@@ -129,22 +129,38 @@ class Robot:
         M = self.data.oMf[self.frame_id]
         return M.translation.copy(), M.rotation.copy(), J[:3].copy(), J[3:].copy()
 
-    def state(self, q, qd, qdd) -> SpatulaState:
-        """Spatula position, orientation, velocity, classical acceleration and Jacobians."""
+    def state(self, q, qd, qdd, point=None) -> SpatulaState:
+        """Spatula position, orientation, velocity, classical acceleration and Jacobians.
+
+        Args:
+            q, qd, qdd: Joint state (rad, rad/s, rad/s²).
+            point: A point of the blade in the spatula frame (m) whose position, velocity
+                and acceleration to give instead of the blade centre's (e.g. where the burger
+                lies); the rotation is the spatula's either way.
+        """
         m, d = self.model, self.data
         q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
         pin.computeForwardKinematicsDerivatives(m, d, q, qd, qdd)
         pin.computeJointJacobians(m, d, q)
         pin.updateFramePlacements(m, d)
         J = pin.getFrameJacobian(m, d, self.frame_id, LWA)
-        v_dq, a_dq, a_dqd, a_dqdd = pin.getPointClassicAccelerationDerivatives(
-            m, d, self.joint_id, self.spatula_in_joint, LWA)
-        acc = pin.getFrameClassicalAcceleration(m, d, self.frame_id, LWA).linear
         M = d.oMf[self.frame_id]
-        return SpatulaState(p=M.translation.copy(), R=M.rotation.copy(), v=J[:3] @ qd,
-                            a=np.array(acc), dp_dq=J[:3].copy(), Jw=J[3:].copy(),
-                            dv_dq=np.array(v_dq), dv_dqd=J[:3].copy(), da_dq=np.array(a_dq),
-                            da_dqd=np.array(a_dqd), da_dqdd=np.array(a_dqdd))
+        placement = self.spatula_in_joint
+        if point is not None:
+            placement = placement * pin.SE3(np.eye(3), np.asarray(point, dtype=float))
+        v_dq, a_dq, a_dqd, a_dqdd = pin.getPointClassicAccelerationDerivatives(
+            m, d, self.joint_id, placement, LWA)
+        acc = pin.getFrameClassicalAcceleration(m, d, self.frame_id, LWA).linear
+        Jv, p, v = J[:3].copy(), M.translation.copy(), J[:3] @ qd
+        if point is not None:  # rigid-body transport from the blade centre to the point
+            r, w = M.rotation @ np.asarray(point, dtype=float), J[3:] @ qd
+            alpha = pin.getFrameAcceleration(m, d, self.frame_id, LWA).angular
+            acc = acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+            Jv, p, v = Jv - skew(r) @ J[3:], p + r, v + np.cross(w, r)
+        return SpatulaState(p=p, R=M.rotation.copy(), v=v, a=np.array(acc), dp_dq=Jv,
+                            Jw=J[3:].copy(), dv_dq=np.array(v_dq), dv_dqd=Jv.copy(),
+                            da_dq=np.array(a_dq), da_dqd=np.array(a_dqd),
+                            da_dqdd=np.array(a_dqdd))
 
     def angular_velocity_jacobian(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """Spatula angular velocity ω = J_ω q̇ (world, rad/s) and ∂ω/∂q (3×nq); ∂ω/∂q̇ = J_ω.

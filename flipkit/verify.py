@@ -242,8 +242,12 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     release = seg.release["node"] if seg.release else 0
     required = {"translate": range(N + 1), "pickup": range(N + 1),
                 "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)]}
+    on_blade = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
-        add("cone", k, max(-cone.margin(states[i]), 0.0), 10 * tol, i)
+        st = states[i]  # the flip's cone holds where the burger lies on the blade
+        if np.any(on_blade):
+            st = robot.state(seg.q[i], seg.qd[i], seg.qdd[i], (*on_blade, 0.0))
+        add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
 
 

@@ -129,3 +129,28 @@ def test_tampered_landing_record_fails_verify(flip_plan):
     assert not report.ok and report.worst()[0] == "landing"
     flip.landing, flip.release = None, None  # a flip without its release fails too
     assert verify_plan(plan).groups["landing"].ok is False
+
+
+def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
+    """A burger dragged 5 cm toward the tip: the cone rows act at the blade point under it
+    (their Jacobian against central differences) and the landing starts from there."""
+    cell = CellConfig()
+    nlp0 = flip_nlp
+    q0, qd0 = nlp0.x0[nlp0.layout.iq(0)], nlp0.x0[nlp0.layout.iqd(0)]
+    nlp = build_segment("flip", models_for(cell), q0, qd0, location=(0.69, -0.16, 0.072),
+                        on_blade=(0.05, 0.01))
+    cone = next(b for b in nlp.blocks if b.name == "cone")
+    x = nlp.x0.copy()
+    x[nlp.layout.T_index] = 0.5
+    vals, entries = cone.evaluate(Evaluation(nlp.layout, nlp.robot, x))
+    vals0 = next(b for b in nlp0.blocks if b.name == "cone").evaluate(
+        Evaluation(nlp0.layout, nlp0.robot, x))[0]
+    assert np.max(np.abs(vals - vals0)) > 1e-3  # a different point, a different margin
+    J = np.zeros((cone.m, nlp.n))
+    np.add.at(J, (cone.rows, cone.cols), entries)
+    cols = np.unique(cone.cols)[:30]
+    fd = central_fd(lambda z: cone.evaluate(Evaluation(nlp.layout, nlp.robot,
+                                                       _set(x, cols, z)))[0], x[cols])
+    np.testing.assert_allclose(J[:, cols], fd, atol=1e-5, rtol=1e-6)
+    landing = next(b for b in nlp.blocks if b.name == "landing")
+    assert landing.on_blade == [0.05, 0.01]

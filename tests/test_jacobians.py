@@ -86,3 +86,22 @@ def test_dynamics_residual_jacobians(robot, seed):
         J = central_fd(f, np.concatenate([q, qd, qdd, u]))
         np.testing.assert_allclose(np.hstack([dq, dqd, dqdd, du]), J, atol=1e-5, rtol=1e-6)
         np.testing.assert_allclose(tau, robot.inverse_dynamics(q, qd, qdd))
+
+
+@pytest.mark.parametrize("seed", [5, 6])
+def test_blade_point_state_jacobians(robot, seed):
+    """A blade point off the centre (where a dragged burger lies): position, velocity and
+    acceleration values and Jacobians against central differences."""
+    point = np.array([0.05, -0.012, 0.0])
+    for q, qd, qdd in random_states(robot, seed, n=3):
+        st = robot.state(q, qd, qdd, point)
+        centre = robot.state(q, qd, qdd)
+        np.testing.assert_allclose(st.p, centre.p + centre.R @ point, **TOL)
+        np.testing.assert_allclose(st.dp_dq, central_fd(lambda x: robot.state(x, qd, qdd, point).p, q), **TOL)
+        np.testing.assert_allclose(st.v, st.dp_dq @ qd, **TOL)
+        x = np.concatenate([q, qd, qdd])
+        fa = central_fd(lambda z: robot.state(z[:6], z[6:12], z[12:], point).a, x)
+        np.testing.assert_allclose(np.hstack([st.da_dq, st.da_dqd, st.da_dqdd]), fa, **TOL)
+        fv = central_fd(lambda z: robot.state(z[:6], z[6:12], qdd, point).v, x[:12])
+        np.testing.assert_allclose(np.hstack([st.dv_dq, st.dv_dqd]), fv, **TOL)
+        np.testing.assert_allclose(st.a, fv[:, :6] @ qd + fv[:, 6:] @ qdd, atol=1e-6)

@@ -94,12 +94,14 @@ class Acceleration(Quantity):
 
 
 class Cone(Quantity):
-    """Friction-cone margin h ≥ 0 of a :class:`~flipkit.contact.ConeForm`."""
+    """Friction-cone margin h ≥ 0 of a :class:`~flipkit.contact.ConeForm`, for the burger
+    resting over the blade point ``point`` (spatula frame, m; default the blade centre)."""
 
     order = 2
 
-    def __init__(self, cone: ConeForm):
+    def __init__(self, cone: ConeForm, point=None):
         self.cone, self.size = cone, cone.rows
+        self.point = None if point is None or not np.any(point) else np.asarray(point, float)
 
     def __call__(self, st, ctx):
         return self.cone.jacobians(st)
@@ -138,8 +140,10 @@ class KinematicBlock(Block):
 
     def evaluate(self, ev):
         vals, jac = [], []
+        point = getattr(self.quantity, "point", None)
         for i in self.nodes:
-            out = self.quantity(ev.state(i), self.ctx)
+            st = ev.state(i) if point is None else ev.point_state(i, point)
+            out = self.quantity(st, self.ctx)
             vals.append(out[0])
             jac.append(np.hstack(out[1:]).ravel())
         if not vals:
