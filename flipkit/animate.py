@@ -57,8 +57,32 @@ def frame_indices(t: np.ndarray, fps: float) -> np.ndarray:
     return np.unique(np.clip(np.searchsorted(t, clock - 1e-9), 0, len(t) - 1))
 
 
+SPOT_RADIUS = 0.05  # m: the paper's landing tolerance (5 cm), drawn about the target
+
+
+def _landing_spot(execution):
+    """(x, y, z) of the executed plan's landing target on the grill surface, or None."""
+    plan = getattr(execution, "plan", None)
+    flip = next((s for s in plan.segments if s.name == "flip"), None) if plan else None
+    if flip is None or not flip.landing:
+        return None
+    x, y = flip.landing["target"]
+    return np.array([x, y, execution.run.grill_height + 0.0005])
+
+
+def _mark_spot(scene, spot) -> None:
+    """A translucent red disc of :data:`SPOT_RADIUS` at the landing target (visual only)."""
+    if scene.ngeom >= scene.maxgeom:
+        return
+    mujoco.mjv_initGeom(scene.geoms[scene.ngeom], mujoco.mjtGeom.mjGEOM_CYLINDER,
+                        np.array([SPOT_RADIUS, 0.0005, 0.0]), spot,
+                        np.eye(3).ravel(), np.array([0.9, 0.1, 0.1, 0.45], np.float32))
+    scene.ngeom += 1
+
+
 def render(execution, indices, width: int = 480, height: int = 360, progress: bool = False):
-    """Rendered RGB frames (height×width×3 uint8) of the samples ``indices`` of a run."""
+    """Rendered RGB frames (height×width×3 uint8) of the samples ``indices`` of a run, with the
+    landing target marked by a translucent 5 cm disc."""
     scene = execution.scene
     m, d = scene.model, mujoco.MjData(scene.model)
     cam, frames = _camera(), []
@@ -68,10 +92,13 @@ def render(execution, indices, width: int = 480, height: int = 360, progress: bo
         if progress:
             from tqdm import tqdm
             it = tqdm(indices, desc="frames", unit="frame")
+        spot = _landing_spot(execution)
         for k in it:
             d.qpos[:] = execution.qpos[k]
             mujoco.mj_forward(m, d)
             renderer.update_scene(d, camera=cam)
+            if spot is not None:
+                _mark_spot(renderer.scene, spot)
             frames.append(renderer.render().copy())
     finally:
         renderer.close()

@@ -31,6 +31,9 @@ def register(subparsers) -> None:
     parser.add_argument("--height", type=int, default=360, help="pixels (default 360)")
     parser.add_argument("--filmstrip", metavar="FILE.png",
                         help="also write the key frames (release, apex, landing) as a PNG")
+    parser.add_argument("--replan", action="store_true",
+                        help="sense, plan, act: re-plan the flip for where the scoop left the "
+                             "burger on the blade (as flipkit validate --replan)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
 
@@ -50,7 +53,12 @@ def run(args: argparse.Namespace) -> int:
     if plan.behavior != "flip" or plan.status != "solved":
         raise FlipkitError(f"{args.plan}: a {plan.status} {plan.behavior} plan; animate needs a "
                            f"solved flip plan")
-    ex = execute_plan(plan, args.mode)
+    replan = None
+    if args.replan:
+        from ..planner import replan_flip
+
+        replan = replan_flip
+    ex = execute_plan(plan, args.mode, replan=replan)
     out = write_animation(ex, args.out, args.fps, args.width, args.height,
                           progress=not args.no_progress)
     if args.filmstrip:
