@@ -393,8 +393,8 @@ def config_constants() -> dict:
     sizes, grill height, nodes per segment, and the duration bounds T_BOUNDS (s) of every
     segment with their sum over pickup-and-flip."""
     from . import targets as tg
-    from .behaviors import (R_LAND, RELEASE_FRACTION, SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS,
-                            SegmentOptions)
+    from .behaviors import (FLIGHT_MARGIN, MU_SAFETY, R_LAND, RELEASE_FRACTION, SCOOP_PRESS,
+                            SCOOP_TIP_BAND, T_BOUNDS, SegmentOptions)
     from .config import CellConfig
     from .flight import TILT_MIN_DEG
 
@@ -402,7 +402,9 @@ def config_constants() -> dict:
     out = {"mu": cell.burger.mu, "grill_mu": cell.physics.mu_grill,
            "scoop_press_mm": 1e3 * SCOOP_PRESS, "scoop_tip_band_mm": 1e3 * SCOOP_TIP_BAND,
            "r_land_mm": 1e3 * R_LAND, "release_fraction": RELEASE_FRACTION,
-           "landing_tilt_min_deg": TILT_MIN_DEG,
+           "landing_tilt_min_deg": TILT_MIN_DEG, "mu_safety": MU_SAFETY,
+           "scoop_start_margin_mm": 1e3 * tg.SCOOP_START_MARGIN,
+           "flight_margin_mm": 1e3 * FLIGHT_MARGIN,
            "release_node": SegmentOptions().release_node(),
            "accel_limit_rad_s2": cell.robot.accel_limit, "burger_diameter_m":
                cell.burger.diameter, "burger_thickness_m": cell.burger.thickness,
