@@ -104,7 +104,7 @@ def test_benign_verdicts(benign):
     by = {s.subbehavior: s for s in benign.segments}
     for name in ("go_to_burger", "scoop", "pickup"):
         assert by[name].status == "solved", by[name]
-        assert by[name].measures["tracking_position_m"] < 1e-6
+        assert by[name].measures["tracking_position_m"] < 5e-6  # placo's IK accuracy
     # the 2.7 rad roll within the flip's T_max needs ~9 rad/s of wrist 3 (limit 3.2): IK lags
     assert benign.status == "failed" and benign.subbehavior == "flip"
     assert benign.reason == "tracking_error" and benign.amount > 0.05

@@ -119,7 +119,7 @@ def test_flip_plan_is_solved_continuous_and_verified(flip_file):
         np.testing.assert_allclose(a.q[-1], b.q[0], atol=1e-9)
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
     flip = plan.segments[SUBBEHAVIORS.index("flip")]
-    assert flip.cone_nodes == list(range(13))
+    assert flip.cone_nodes == list(range(15))  # up to the release node
 
 
 def test_batch_writes_plans_and_summary(tmp_path, capsys):
