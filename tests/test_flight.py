@@ -154,3 +154,17 @@ def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
     np.testing.assert_allclose(J[:, cols], fd, atol=1e-5, rtol=1e-6)
     landing = next(b for b in nlp.blocks if b.name == "landing")
     assert landing.on_blade == [0.05, 0.01]
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--land", "2", "0"], "landing spot (2.000, 0.000) is outside the grill"),
+    (["--r-land", "0"], "r_land must be in (0, 0.1] m"),
+    (["--land", "0.7"], "--land"),
+])
+def test_cli_landing_options_fail_in_one_line(tmp_path, capsys, extra, message):
+    from flipkit.cli import main
+
+    out = tmp_path / "p.json"
+    rc = main(["plan", "flip", "--burger", "0.69", "-0.16", "0.072", *extra, "--json", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and message in err and "\n" not in err and not out.exists()
