@@ -232,7 +232,7 @@ def solve_time_table(rows, names) -> dict:
 
 
 # ------------------------------------------------------------------ Table I plans and runs
-def plan_targets(locations, solver: str = "sqp", executor=None, progress: bool = False):
+def plan_targets(locations, solver: str = "auto", executor=None, progress: bool = False):
     """Plan pickup-and-flip at every location on the sweep (in a temporary directory) and
     return the :func:`flipkit.validate.validate` targets ``[(location, plan_info, plan_text
     or None)]``, so that one set of plans serves several validations."""
