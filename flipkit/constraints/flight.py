@@ -23,7 +23,15 @@ from .base import Block
 
 
 def _release_inputs(ev, r: int):
-    """(x_r = (p, v, δ, ω), R, ∂x_r/∂q_r, ∂x_r/∂q̇_r) at node r."""
+    """(x_r = (p, v, δ, ω), R, ∂x_r/∂q_r, ∂x_r/∂q̇_r) at node r, computed once per
+    evaluation point (Landing and FlightClearance share it)."""
+    key = ("release", r)
+    if key not in ev._states:
+        ev._states[key] = _release_state(ev, r)
+    return ev._states[key]
+
+
+def _release_state(ev, r: int):
     q, qd = ev.node(r)[:2]
     st = ev.state(r)
     w, dw_dq = ev.robot.angular_velocity_jacobian(q, qd)
