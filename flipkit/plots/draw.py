@@ -540,11 +540,16 @@ def plot_grill_map(ax, cell, points, categories, styles, title: str = "",
         tl = np.asarray(table_locations, float)
         ax.plot(tl[:, 1], tl[:, 0], "+", color="0.1", ms=4, mew=0.6, zorder=4,
                 label="Table I location")
+    _grill_view(ax, g, "$p^b_y$ (m)", "$p^b_x$ (m)", title)
+
+
+def _grill_view(ax, g, xlabel: str, ylabel: str, title: str = "") -> None:
+    """Top view of the grill area ``g``: y to the left, x up, 3 cm of margin, equal axes."""
     ax.set_xlim(g.y_range[1] + 0.03, g.y_range[0] - 0.03)  # y grows to the left
     ax.set_ylim(g.x_range[0] - 0.03, g.x_range[1] + 0.03)
     ax.set_aspect("equal")
-    ax.set_xlabel("$p^b_y$ (m)")
-    ax.set_ylabel("$p^b_x$ (m)")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     if title:
         ax.set_title(title)
 
@@ -571,7 +576,7 @@ def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, titl
     tg = np.asarray(targets_xy, float).reshape(-1, 2)
     for k, (x, y) in enumerate(tg):
         ax.add_patch(Circle((y, x), radius, fill=False, ec="0.35", lw=0.6, ls="--", zorder=1))
-        ax.annotate(str(k + 1), (y, x), xytext=(0, radius * 0 + 0), textcoords="offset points",
+        ax.annotate(str(k + 1), (y, x), xytext=(0, 0), textcoords="offset points",
                     fontsize=5, color="0.3", ha="center", va="center", zorder=1)
     ax.plot([], [], ls="--", color="0.35", lw=0.6, label=f"{100 * radius:g} cm about target")
     xy, pred, ok = points["xy"], points["predicted"], points["flipped"]
@@ -584,13 +589,7 @@ def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, titl
             label=f"simulated, flipped ({int(ok.sum())})")
     ax.plot(xy[~ok, 1], xy[~ok, 0], "o", mfc="white", mec=ACTUAL_COLOR, ms=3, mew=0.7,
             zorder=4, label=f"simulated, not flipped ({int((~ok).sum())})")
-    ax.set_xlim(g.y_range[1] + 0.03, g.y_range[0] - 0.03)  # y grows to the left
-    ax.set_ylim(g.x_range[0] - 0.03, g.x_range[1] + 0.03)
-    ax.set_aspect("equal")
-    ax.set_xlabel("y (m)")
-    ax.set_ylabel("x (m)")
-    if title:
-        ax.set_title(title)
+    _grill_view(ax, g, "y (m)", "x (m)", title)
     if legend:
         ax.legend(loc="lower left", fontsize=6)
 
