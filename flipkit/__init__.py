@@ -6,7 +6,7 @@ Contacts: Application to Flipping Burgers" (RA-L 2018) and goes beyond it.
 
 __version__ = "0.1.0"
 
-from .config import CellConfig  # noqa: E402
-from .errors import FlipkitError  # noqa: E402
+from flipkit.config import CellConfig  # noqa: E402
+from flipkit.errors import FlipkitError  # noqa: E402
 
 __all__ = ["CellConfig", "FlipkitError", "__version__"]

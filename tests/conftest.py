@@ -1,13 +1,13 @@
 import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
-os.environ.setdefault("MUJOCO_GL", "osmesa")  # offscreen rendering (flipkit.animate)
+os.environ.setdefault("MUJOCO_GL", "osmesa")  # offscreen rendering (flipkit.simulation.animate)
 
 import numpy as np
 import pytest
 
 from flipkit.config import CellConfig
-from flipkit.robot import Robot
+from flipkit.model.robot import Robot
 
 
 @pytest.fixture(scope="session")
@@ -45,8 +45,8 @@ def flip_plan():
     ``FLIPKIT_TEST_PLAN=path.json`` reuses a plan file instead (e.g. while iterating on the
     simulation side); the default plans it with the current planner.
     """
-    from flipkit.plan import Plan
-    from flipkit.planner import plan_flip
+    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.planner import plan_flip
 
     path = os.environ.get("FLIPKIT_TEST_PLAN")
     plan = Plan.load(path) if path else plan_flip((0.69, -0.16, 0.072))

@@ -8,10 +8,10 @@ Regenerate (after an intended change of the solver) with::
 import json
 from pathlib import Path
 
-from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import CellConfig
-from flipkit.ik import solve_pose
-from flipkit.sqp import solve_sqp
+from flipkit.model.ik import solve_pose
+from flipkit.solvers.sqp import solve_sqp
 
 LOG_PATH = Path(__file__).parent / "data" / "sqp_translate_log.json"
 START, GOAL = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)

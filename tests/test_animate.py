@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from flipkit.animate import frame_indices, key_frames, write_filmstrip
+from flipkit.simulation.animate import frame_indices, key_frames, write_filmstrip
 from flipkit.cli import main
-from flipkit.commands.animate import MODES as CLI_MODES
-from flipkit.execute import MODES, execute_plan
+from flipkit.cli.animate import MODES as CLI_MODES
+from flipkit.simulation.execute import MODES, execute_plan
 
 
 def test_tiny_gif_has_frames(flip_plan_file, tmp_path):

@@ -9,16 +9,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flipkit import targets as tg
+from flipkit.behaviors import targets as tg
 from flipkit.baseline import (REASONS, PlacoTracker, Thresholds, classify_segment, plan_segment,
                               run_baseline)
 from flipkit.baseline.ee_opt import EEState
 from flipkit.config import TABLE1_LOCATIONS, RobotConfig, SpatulaConfig
-from flipkit.contact import specific_force
+from flipkit.model.contact import specific_force
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.ik import solve_pose
-from flipkit.orientation import rpy
-from flipkit.robot import Robot
+from flipkit.model.ik import solve_pose
+from flipkit.model.orientation import rpy
+from flipkit.model.robot import Robot
 
 BENIGN = TABLE1_LOCATIONS[5]  # (0.69, -0.16): the first three subbehaviours track exactly
 RATE = 200.0

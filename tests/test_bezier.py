@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from conftest import central_fd
 
-from flipkit.bezier import Bezier
+from flipkit.model.bezier import Bezier
 from flipkit.errors import ConfigError, FlipkitError
 
 

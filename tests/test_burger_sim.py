@@ -4,11 +4,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, RotationSpline
 
-from flipkit.burger_sim import (BurgerRun, BurgerSim, judge_flip, judge_pickup, judge_scoop,
-                                overlap_fraction)
+from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop, overlap_fraction
+from flipkit.simulation.prescribed_blade import BurgerSim
+from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.orientation import rpy_matrix
+from flipkit.model.orientation import rpy_matrix
 
 CELL = CellConfig()
 HG = CELL.grill.height

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from flipkit.cli import main
-from flipkit.commands.plan import read_locations
+from flipkit.cli.plan import read_locations
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
-from flipkit.plan import Plan
-from flipkit.targets import SUBBEHAVIORS
-from flipkit.verify import verify_plan
+from flipkit.planning.plan_file import Plan
+from flipkit.behaviors.targets import SUBBEHAVIORS
+from flipkit.planning.verify import verify_plan
 
 
 def _run(capsys, *argv):

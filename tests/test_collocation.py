@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit import targets as tg
-from flipkit.behaviors import Models, build_segment, flat_pose
-from flipkit.collocation import Evaluation, Layout
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import Models, build_segment, flat_pose
+from flipkit.transcription.layout import Evaluation, Layout
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
-from flipkit.constraints import BezierOutput, HermiteSimpson
+from flipkit.transcription.constraints import BezierOutput, HermiteSimpson
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.ik import solve_pose
+from flipkit.model.ik import solve_pose
 
 
 @pytest.fixture(scope="module")

@@ -8,12 +8,12 @@ import pytest
 
 from flipkit.baseline import REASONS
 from flipkit.cli import main
-from flipkit.compare import compare_ik, plan_filename
+from flipkit.experiments.compare_ik import compare_ik, plan_filename
 from flipkit.config import TABLE1_LOCATIONS
-from flipkit.plan import Plan
-from flipkit.sweep import make_executor
-from flipkit.targets import SUBBEHAVIORS
-from flipkit.verify import verify_plan
+from flipkit.planning.plan_file import Plan
+from flipkit.experiments.sweep import make_executor
+from flipkit.behaviors.targets import SUBBEHAVIORS
+from flipkit.planning.verify import verify_plan
 
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
 COLLOCATION_KEYS = {"status", "reason", "time_s"}

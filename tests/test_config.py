@@ -4,9 +4,9 @@ import pytest
 from flipkit.config import (TABLE1_LOCATIONS, BurgerConfig, CellConfig, GrillConfig, RobotConfig,
                             SpatulaConfig, TaskLimits)
 from flipkit.errors import ConfigError, FlipkitError
-from flipkit.ik import solve_pose
-from flipkit.orientation import rpy
-from flipkit.robot import Robot
+from flipkit.model.ik import solve_pose
+from flipkit.model.orientation import rpy
+from flipkit.model.robot import Robot
 
 
 def test_q_home_puts_the_spatula_flat_above_the_grill():

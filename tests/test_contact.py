@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from flipkit.contact import make_cone, specific_force
+from flipkit.model.contact import make_cone, specific_force
 from flipkit.errors import InvalidChoiceError
-from flipkit.orientation import rpy_matrix
-from flipkit.robot import SpatulaState
+from flipkit.model.orientation import rpy_matrix
+from flipkit.model.robot import SpatulaState
 
 G = (0.0, 0.0, -9.81)
 

@@ -5,7 +5,7 @@ import pinocchio as pin
 from conftest import random_states
 
 from flipkit.config import CellConfig
-from flipkit.robot import Robot
+from flipkit.model.robot import Robot
 
 
 def test_rnea_equals_assembled_lagrangian_dynamics(robot):

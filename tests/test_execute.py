@@ -7,9 +7,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from flipkit.burger_sim import SCOOP_OVERLAP, judge_scoop
+from flipkit.simulation.judges import SCOOP_OVERLAP, judge_scoop
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.execute import MODES, execute_plan
+from flipkit.simulation.execute import MODES, execute_plan
 
 
 def held(plan, q, burger_dx=0.0):
@@ -44,7 +44,7 @@ def test_blade_pressed_into_grill_pushes_back_and_arm_tracks(flip_plan):
     underside is 2 mm below its surface."""
     cell = flip_plan.cell()
     plan = held(flip_plan, cell.robot.q_home)
-    from flipkit.robot import Robot
+    from flipkit.model.robot import Robot
 
     top = Robot(cell).placement(cell.robot.q_home).translation[2]
     bottom = top - cell.physics.blade_thickness
@@ -114,7 +114,7 @@ def test_bad_inputs(flip_plan):
 
 
 def test_validate_checks_the_mode_and_records_it(flip_plan_file):
-    from flipkit.validate import Perturbations, run_trial, trial_jobs, validate
+    from flipkit.experiments.trials import Perturbations, run_trial, trial_jobs, validate
 
     with pytest.raises(InvalidChoiceError, match="'feedforward', 'position'"):
         validate([((0.69, -0.16, 0.072), {}, None)], 1, mode="servo")

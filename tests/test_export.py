@@ -7,7 +7,7 @@ from test_plan import translate_plan
 
 from flipkit.cli import main
 from flipkit.errors import FlipkitError
-from flipkit.export import resample, write_csv
+from flipkit.planning.export import resample, write_csv
 
 RATE = 100.0  # Hz; the plan lasts 1.0 + 0.8 s
 

@@ -8,7 +8,9 @@ import matplotlib.pyplot as plt
 import nbformat
 import pytest
 
-from flipkit import cli, figures
+from flipkit import cli
+from flipkit import figures
+from flipkit.figures import pipeline
 from flipkit.errors import InvalidChoiceError
 
 NOTEBOOKS = sorted(figures.NOTEBOOKS_DIR.glob("*.ipynb"))
@@ -101,7 +103,7 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
         nbformat.v4.new_code_cell("quick = False", metadata={"tags": ["parameters"]}),
         nbformat.v4.new_code_cell("raise ValueError('burnt\\nbadly')")]), notebook)
     with pytest.raises(figures.NotebookError) as info:
-        figures._execute(notebook, tmp_path / "executed.ipynb", {"quick": True},
+        pipeline._execute(notebook, tmp_path / "executed.ipynb", {"quick": True},
                          figures.kernel_name())
     message = str(info.value)
     assert "\n" not in message

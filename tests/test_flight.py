@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 from conftest import central_fd
 
-from flipkit.behaviors import SegmentOptions, build_segment
-from flipkit.collocation import Evaluation
+from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.transcription.layout import Evaluation
 from flipkit.config import CellConfig
-from flipkit.constraints.flight import FlightClearance, Landing
+from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.errors import ConfigError, UnreachableError
-from flipkit.flight import predict_landing
-from flipkit.planner import models_for
-from flipkit.verify import verify_plan
-from flipkit.verify_flight import recompute_landing
+from flipkit.model.flight import predict_landing
+from flipkit.planning.planner import models_for
+from flipkit.planning.verify import verify_plan
+from flipkit.planning.verify_flight import recompute_landing
 
 G = (0.0, 0.0, -9.81)
 
@@ -57,8 +57,8 @@ def flip_nlp():
     """A flip NLP at a pickup end state, evaluated at a moving point of its initial guess."""
     cell = CellConfig()
     models = models_for(cell)
-    from flipkit.ik import solve_pose
-    from flipkit.targets import pickup_end
+    from flipkit.model.ik import solve_pose
+    from flipkit.behaviors.targets import pickup_end
 
     pb = np.array([0.69, -0.16, 0.072])
     pose = pickup_end(cell, pb)
@@ -99,7 +99,7 @@ def test_release_node_and_options_are_validated():
 
 
 def test_landing_spot_off_the_grill_is_refused(flip_nlp):
-    from flipkit.planner import plan_flip
+    from flipkit.planning.planner import plan_flip
 
     with pytest.raises(UnreachableError, match="landing spot"):
         plan_flip((0.69, -0.16, 0.072), land=(1.5, 0.0))

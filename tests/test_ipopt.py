@@ -1,4 +1,4 @@
-"""IPOPT cross-check solver (flipkit.ipopt) on the translate segment."""
+"""IPOPT cross-check solver (flipkit.solvers.ipopt) on the translate segment."""
 
 import copy
 
@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import CellConfig
 from flipkit.errors import NoSolutionFound
-from flipkit.ik import solve_pose
-from flipkit.ipopt import IpoptOptions, IpoptResult, _ConstraintCallback, _EvalCache, solve_ipopt
-from flipkit.sqp import SolveResult
+from flipkit.model.ik import solve_pose
+from flipkit.solvers.ipopt import IpoptOptions, IpoptResult, _ConstraintCallback, _EvalCache, solve_ipopt
+from flipkit.solvers.sqp import SolveResult
 
 
 @pytest.fixture(scope="module")

@@ -10,8 +10,8 @@ import pinocchio as pin
 import pytest
 from conftest import central_fd, random_states
 
-from flipkit.contact import make_cone
-from flipkit.orientation import axis_jacobian, rpy_jacobian
+from flipkit.model.contact import make_cone
+from flipkit.model.orientation import axis_jacobian, rpy_jacobian
 
 TOL = dict(atol=1e-6, rtol=1e-6)
 

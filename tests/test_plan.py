@@ -10,14 +10,15 @@ import json
 import numpy as np
 import pytest
 
-from flipkit import targets as tg
-from flipkit.behaviors import CARRIES_BURGER, T_BOUNDS, Models, build_segment, flat_pose
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import CARRIES_BURGER, T_BOUNDS, Models, build_segment, flat_pose
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, PlanFileError
-from flipkit.ik import solve_pose
-from flipkit.orientation import rpy
-from flipkit.plan import FORMAT, Plan, Segment, SolverInfo
-from flipkit.sqp import SolveResult
+from flipkit.model.ik import solve_pose
+from flipkit.model.orientation import rpy
+from flipkit.planning.plan_file import FORMAT, Plan
+from flipkit.planning.segment import Segment, SolverInfo
+from flipkit.solvers.sqp import SolveResult
 
 LOCATION = (0.68, -0.31, 0.072)  # Table I, location 5
 BASE_TURN = np.array([0.3, 0, 0, 0, 0, 0])  # rad: a pure base rotation keeps the blade flat

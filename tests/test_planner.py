@@ -1,17 +1,17 @@
-"""flipkit.planner: translate / flip / batch front end, status only 'solved' when verified."""
+"""flipkit.planning.planner: translate / flip / batch front end, status only 'solved' when verified."""
 
 import numpy as np
 import pytest
 
-import flipkit.planner as planner
-from flipkit.bench import TRANSLATE_KEY_POINTS
+import flipkit.planning.planner as planner
+from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
-from flipkit.plan import Plan
-from flipkit.planner import (format_summary, models_for, plan_batch, plan_flip, plan_translate,
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.planner import (format_summary, models_for, plan_batch, plan_flip, plan_translate,
                              solve_segment, summary_table)
-from flipkit.sqp import SolveResult
-from flipkit.verify import verify_plan
+from flipkit.solvers.sqp import SolveResult
+from flipkit.planning.verify import verify_plan
 
 GRILL_A, GRILL_B = (0.65, -0.30, 0.15), (0.80, -0.10, 0.15)
 
@@ -129,7 +129,7 @@ def test_translate_key_points_lie_over_grill_and_table():
 
 
 def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
-    import flipkit.sqp as sqp_module
+    import flipkit.solvers.sqp as sqp_module
 
     calls = []
 
@@ -141,8 +141,8 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
 
     monkeypatch.setattr(sqp_module, "solve_sqp", failing_sqp)
     models = models_for(CellConfig())
-    from flipkit.behaviors import build_segment, flat_pose
-    from flipkit.ik import solve_pose
+    from flipkit.behaviors.segments import build_segment, flat_pose
+    from flipkit.model.ik import solve_pose
 
     nlp = build_segment("translate", models, solve_pose(models.loaded, GRILL_A, (0, 0, 0)),
                         goal=flat_pose(GRILL_B))

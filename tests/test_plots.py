@@ -1,4 +1,4 @@
-"""Figure helpers: flipkit.plots (data, draw, runs), the draw_cell options they use, and the
+"""Figure helpers: flipkit.figures (data, draw, runs), the draw_cell options they use, and the
 LaTeX macro file of the manifest (flipkit.figures.write_macros)."""
 
 import json
@@ -8,16 +8,20 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from flipkit import figures, targets
-from flipkit.behaviors import build_segment, flat_pose
+from flipkit import figures
+from flipkit.behaviors import targets
+from flipkit.behaviors.segments import build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError
-from flipkit.ik import solve_pose
-from flipkit.plan import Plan, Segment
-from flipkit.planner import models_for
-from flipkit.plots import data, draw, runs
-from flipkit.plotting import draw_cell
-from flipkit.sqp import SolveResult
+from flipkit.model.ik import solve_pose
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.segment import Segment
+from flipkit.planning.planner import models_for
+from flipkit.figures import data
+from flipkit.figures import draw
+from flipkit.figures import runs
+from flipkit.figures.draw import draw_cell
+from flipkit.solvers.sqp import SolveResult
 
 G = 9.81
 
@@ -87,7 +91,7 @@ def test_cone_margins_flat_at_rest():
     # f = (0, 0, g): physical margin min(g, mu g) = mu g; paper form 1 - cos(mu)
     R = data.pitch_matrix(0.0)
     st = data._state(R, np.zeros(3))
-    from flipkit.contact import make_cone
+    from flipkit.model.contact import make_cone
 
     assert np.isclose(make_cone("physical", 0.5).margin(st), 0.5 * G)
     assert np.isclose(make_cone("paper", 0.5).margin(st), 1 - np.cos(0.5))
@@ -221,7 +225,7 @@ def test_defect_zoom_reports_the_pair_defects():
 
 
 def test_draw_snapshot_and_draw_cell_options(guess_plan):
-    from flipkit.robot import Robot
+    from flipkit.model.robot import Robot
 
     cell = CellConfig()
     robot = Robot(cell)

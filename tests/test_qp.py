@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import CellConfig
-from flipkit.ik import solve_pose
-from flipkit.qp import QPSubproblem, subproblem_for
+from flipkit.model.ik import solve_pose
+from flipkit.solvers.full_qp import QPSubproblem, subproblem_for
 
 
 @pytest.fixture(scope="module")

@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors import Models, build_segment, flat_pose
+from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
-from flipkit.ik import solve_pose
-from flipkit.qp import QPSubproblem
-from flipkit.reduced_qp import ReducedQP, reduced_subproblem_for
-from flipkit.sqp import SQPOptions, solve_sqp
+from flipkit.model.ik import solve_pose
+from flipkit.solvers.full_qp import QPSubproblem
+from flipkit.solvers.condensed_qp import ReducedQP, reduced_subproblem_for
+from flipkit.solvers.sqp import SQPOptions, solve_sqp
 
 
 @pytest.fixture(scope="module")

@@ -5,13 +5,13 @@ and a replan that cannot be solved (the verified original then runs on)."""
 import numpy as np
 import pytest
 
-from flipkit.behaviors import SegmentOptions
-from flipkit.burger_sim import LANDING_TOL, judge_flip, judge_scoop
+from flipkit.behaviors.segments import SegmentOptions
+from flipkit.simulation.judges import LANDING_TOL, judge_flip, judge_scoop
 from flipkit.errors import ConfigError, FlipkitError
-from flipkit.execute import execute_plan
-from flipkit.planner import plan_flip, replan_flip
-from flipkit.validate import landing_target
-from flipkit.verify import verify_plan
+from flipkit.simulation.execute import execute_plan
+from flipkit.planning.planner import plan_flip, replan_flip
+from flipkit.experiments.trials import landing_target
+from flipkit.planning.verify import verify_plan
 
 
 @pytest.fixture(scope="module")

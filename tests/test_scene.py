@@ -6,8 +6,8 @@ import pinocchio as pin
 import pytest
 
 from flipkit.config import CellConfig
-from flipkit.robot import Robot
-from flipkit.scene import ARM_JOINTS, blade_vertices, build_scene, place_burger
+from flipkit.model.robot import Robot
+from flipkit.simulation.scene import ARM_JOINTS, blade_vertices, build_scene, place_burger
 
 from conftest import random_states
 

@@ -3,10 +3,10 @@ override of validate.run_trial, the worst setting, and one small real study."""
 
 import pytest
 
-from flipkit import sensitivity
+from flipkit.experiments import sensitivity
 from flipkit.config import PHYSICAL_RANGES, CellConfig, with_parameter
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.validate import Perturbations, trial_jobs, trial_key
+from flipkit.experiments.trials import Perturbations, trial_jobs, trial_key
 
 
 def test_settings_cover_both_ends_of_every_range_in_order():

@@ -7,8 +7,8 @@ import pytest
 from sqp_reference import LOG_PATH, log_rows, run
 
 from flipkit.errors import NoSolutionFound
-from flipkit.ipopt import solve_ipopt
-from flipkit.sqp import SQPOptions, solve_sqp
+from flipkit.solvers.ipopt import solve_ipopt
+from flipkit.solvers.sqp import SQPOptions, solve_sqp
 
 
 @pytest.fixture(scope="module")
@@ -81,9 +81,9 @@ def test_locally_infeasible_segment_stops_early_as_infeasible():
     the solve ends as ``infeasible`` long before ``max_iter``, naming the end pose."""
     from sqp_reference import START
 
-    from flipkit.behaviors import Models, build_segment, flat_pose
+    from flipkit.behaviors.segments import Models, build_segment, flat_pose
     from flipkit.config import CellConfig
-    from flipkit.ik import solve_pose
+    from flipkit.model.ik import solve_pose
 
     models = Models(CellConfig())
     q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
@@ -114,7 +114,7 @@ def test_no_restoration_from_a_feasible_point():
     must never fall back to restoration there. Regression: a warm start from the previous
     subproblem's duals made OSQP report a false infeasibility certificate at this go-to-
     burger segment, and the solve stalled at J = 15 838 instead of reaching 13 678."""
-    from flipkit.behaviors import Models, build_segment
+    from flipkit.behaviors.segments import Models, build_segment
     from flipkit.config import CellConfig
 
     models = Models(CellConfig())

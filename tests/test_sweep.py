@@ -8,7 +8,7 @@ import pytest
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.sweep import grill_grid, make_executor, run_sweep, stable_hash
+from flipkit.experiments.sweep import grill_grid, make_executor, run_sweep, stable_hash
 
 ITEMS = list(range(6))
 

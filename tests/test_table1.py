@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from flipkit.config import TABLE1_LOCATIONS
-from flipkit.planner import plan_flip
-from flipkit.targets import SUBBEHAVIORS
-from flipkit.verify import verify_plan
+from flipkit.planning.planner import plan_flip
+from flipkit.behaviors.targets import SUBBEHAVIORS
+from flipkit.planning.verify import verify_plan
 
 
 @pytest.mark.parametrize("index", range(len(TABLE1_LOCATIONS)))

@@ -5,8 +5,8 @@ import pinocchio as pin
 import pytest
 
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.robot import Robot
-from flipkit.tracking import DEFAULT_KD, DEFAULT_KP, TrackingResult, track
+from flipkit.model.robot import Robot
+from flipkit.simulation.tracking import DEFAULT_KD, DEFAULT_KP, TrackingResult, track
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ import pytest
 from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
-from flipkit.targets import SUBBEHAVIORS
-from flipkit.validate import STAGES, Perturbations, run_trial, track_plan, trial_jobs
+from flipkit.behaviors.targets import SUBBEHAVIORS
+from flipkit.experiments.trials import STAGES, Perturbations, run_trial, track_plan, trial_jobs
 
 LOCATION = TABLE1_LOCATIONS[5]  # where conftest's flip_plan is planned
 TRIALS = 2
@@ -80,7 +80,7 @@ def test_perturbation_draws_within_their_ranges():
 
 
 def test_tracked_poses_follow_the_plan(plan_file):
-    from flipkit.plan import Plan
+    from flipkit.planning.plan_file import Plan
 
     plan = Plan.load(plan_file)
     t, p, R, bounds, errors = track_plan(plan)
@@ -122,8 +122,8 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
     falls back to the pickup spot for a plan without one."""
     from dataclasses import replace
 
-    from flipkit import targets as tg
-    from flipkit.validate import landing_target, plan_from_text
+    from flipkit.behaviors import targets as tg
+    from flipkit.experiments.trials import landing_target, plan_from_text
 
     flip = next(s for s in flip_plan.segments if s.name == "flip")
     assert flip.landing is not None

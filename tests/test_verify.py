@@ -7,13 +7,13 @@ import pytest
 from test_plan import models  # noqa: F401  (fixture)
 from test_plan import chain_plan, cubic_segment, translate_plan
 
-from flipkit import targets as tg
-from flipkit.behaviors import T_BOUNDS
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import T_BOUNDS
 from flipkit.cli import main
 from flipkit.errors import ConfigError, VerificationError
-from flipkit.plan import Plan
-from flipkit.behaviors import SCOOP_PRESS
-from flipkit.verify import GROUPS, verify_plan
+from flipkit.planning.plan_file import Plan
+from flipkit.behaviors.segments import SCOOP_PRESS
+from flipkit.planning.verify import GROUPS, verify_plan
 
 
 @pytest.fixture(scope="module")

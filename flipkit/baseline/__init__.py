@@ -11,7 +11,7 @@ durations within collocation's bounds is issue 14's work. Each subbehaviour's
 end-effector QP starts at the previous one's end state (position, velocity, orientation);
 the IK continues from the previous IK configuration, except after a failed subbehaviour,
 where it restarts from an exact single-pose IK solution of the planned start pose
-(:func:`flipkit.ik.solve_pose`, see :func:`_restart`) so that every subbehaviour is judged
+(:func:`flipkit.model.ik.solve_pose`, see :func:`_restart`) so that every subbehaviour is judged
 on its own rather than on the previous one's lag.
 """
 
@@ -19,17 +19,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import targets as tg
-from ..behaviors import Models
-from ..config import CellConfig
-from ..errors import ConfigError, NoSolutionFound, UnreachableError
-from ..ik import solve_pose
-from ..orientation import rpy
-from .classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
-from .ee_opt import EEState, EETrajectory, plan_segment
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import Models
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, NoSolutionFound, UnreachableError
+from flipkit.model.ik import solve_pose
+from flipkit.model.orientation import rpy
+from flipkit.baseline.classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
+from flipkit.baseline.ee_opt import EEState, EETrajectory, plan_segment
 
 BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
-from .ik_track import IKTrack, PlacoTracker
+from flipkit.baseline.ik_track import IKTrack, PlacoTracker
 
 
 def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: float = 200.0,

@@ -1,6 +1,6 @@
 """Failure classification of an IK-tracked end-effector trajectory, per subbehaviour.
 
-Every measurement uses flipkit's pinocchio model (:class:`flipkit.robot.Robot`), not placo.
+Every measurement uses flipkit's pinocchio model (:class:`flipkit.model.robot.Robot`), not placo.
 The checks run in this order and the first one that fails is the verdict:
 
 1. ``tracking_error`` — spatula pose error, max over samples: position > 1 mm or rotation
@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ConfigError
-from ..robot import Robot
+from flipkit.errors import ConfigError
+from flipkit.model.robot import Robot
 
 REASONS = ("ee_infeasible", "tracking_error", "joint_limit", "configuration_jump",
            "joint_velocity", "joint_acceleration", "torque", "below_grill")

@@ -22,11 +22,11 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from .. import targets as tg
-from ..bezier import Bezier
-from ..config import CellConfig
-from ..errors import ConfigError, InvalidChoiceError, NoSolutionFound
-from ..orientation import rpy_matrix
+from flipkit.behaviors import targets as tg
+from flipkit.model.bezier import Bezier
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
+from flipkit.model.orientation import rpy_matrix
 
 DEGREE = 7
 FLIP_END_RPY = (-2.7, 0.1, 0.0)  # rad; normal (-0.09, 0.43, -0.90) lies inside FLIP_NORMAL_BOUNDS
@@ -155,7 +155,7 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
     """Optimise the spatula trajectory of subbehaviour ``name``.
 
     Args:
-        name: One of :data:`flipkit.targets.SUBBEHAVIORS`.
+        name: One of :data:`flipkit.behaviors.targets.SUBBEHAVIORS`.
         cell: Cell configuration (spatula, burger μ, grill, task limits, gravity).
         location: Burger location p^b (m).
         start: Start state (the previous subbehaviour's end, or the pose at q_start at rest).

@@ -2,7 +2,7 @@
 
 The spatula frame is not in the URDF (flipkit adds it to the pinocchio model in code), so
 the tracker writes a temporary copy of the URDF with a fixed ``spatula`` link on the tool
-link, at :attr:`flipkit.robot.Robot.spatula_in_parent`; visual and collision geometry is
+link, at :attr:`flipkit.model.robot.Robot.spatula_in_parent`; visual and collision geometry is
 dropped (placo would otherwise resolve ``package://`` meshes, which are irrelevant here).
 Each sample warm-starts from the previous configuration and runs a few solver iterations
 with joint limits and joint velocity limits; the per-iteration step is dt = Δt / iterations,
@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ..errors import ConfigError
-from ..robot import SPATULA_FRAME, Robot
-from .ee_opt import EETrajectory
+from flipkit.errors import ConfigError
+from flipkit.model.robot import SPATULA_FRAME, Robot
+from flipkit.baseline.ee_opt import EETrajectory
 
 
 @dataclass

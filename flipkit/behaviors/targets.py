@@ -1,0 +1,92 @@
+"""Task-space targets of the subbehaviours (paper Sec. IV.C, eqs. 22–27), shared by the
+joint-space collocation and the end-effector-space baseline.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import UnreachableError
+
+SCOOP_PITCH = 0.314  # o_y* (rad), eq. (22)
+SCOOP_PRESS = 0.003  # m: the scoop presses the blade this far into the grill (flipkit's choice)
+# m: the scoop starts with the tip this far before the burger's near edge (the paper: at it,
+# eq. 23). The burger lies where it was put within a 5 mm standard deviation (the Table I
+# trials' placement error); coming down at the edge itself, the blade landed on the burger's
+# rim in 7 of 10 trials at (0.70, 0.10) (measured), so the tip comes down 3 σ before it.
+SCOOP_START_MARGIN = 0.015
+PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, eq. (25)
+PICKUP_PITCH = -0.05  # rad, eq. (25)
+FLIP_CONE_FRACTION = 0.6  # cone on nodes i <= 0.6 N, eq. (26)
+FLIP_NORMAL_BOUNDS = ((-0.5, -0.5, -1.0), (0.0, 0.5, -0.8))  # F_n(q_N), eq. (26)
+FLIP_XAXIS_BOUNDS = ((0.6, -1.0, -1.0), (1.0, 1.0, 1.0))  # R(q_i) x̂, eq. (26)
+FLIP_HEIGHT_BAND = (0.1, 0.4)  # h_g + band on p_z(q_N) (m), eq. (26)
+SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Spatula pose target: blade-centre position (m) and rpy o (rad)."""
+
+    p: tuple
+    o: tuple
+
+
+def check_location(cell: CellConfig, location) -> np.ndarray:
+    """The burger location as an array, or :class:`UnreachableError` if not on the grill."""
+    loc = np.asarray(location, dtype=float)
+    if loc.shape != (3,) or not np.all(np.isfinite(loc)):
+        raise UnreachableError(f"burger location must be three finite numbers (m), got {location!r}")
+    g = cell.grill
+    if not g.contains(loc[:2]):
+        raise UnreachableError(
+            f"burger location ({loc[0]:.3f}, {loc[1]:.3f}) is outside the grill area "
+            f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
+    if abs(loc[2] - g.height) > 0.01:
+        raise UnreachableError(
+            f"burger height {loc[2]:.3f} m is not on the grill surface (h_g = {g.height} m)")
+    return loc
+
+
+def scoop_ready(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
+    """End of go-to-burger / start of scoop (eqs. 22–23): tip :data:`SCOOP_START_MARGIN`
+    before the burger's near edge, pressed ``press`` (m) into the grill (0: on its surface,
+    the paper's eq. 24)."""
+    d, l, oy = cell.burger.diameter, cell.spatula.length, SCOOP_PITCH
+    z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+    x = pb[0] - d / 2 - SCOOP_START_MARGIN - l / 2 * math.cos(oy)
+    return Pose((x, pb[1], z + l / 2 * math.sin(oy)), (0.0, oy, 0.0))
+
+
+def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
+    """End of scoop (eq. 23): blade flat, centred under the burger, pressed ``press`` (m)
+    into the grill."""
+    z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
+    return Pose((float(pb[0]), float(pb[1]), z), (0.0, 0.0, 0.0))
+
+
+def pickup_end(cell: CellConfig, pb) -> Pose:
+    """End of pickup (eq. 25): 2 cm forward, 5 cm up, slightly tipped back."""
+    return Pose(tuple(float(pb[k] + PICKUP_OFFSET[k]) for k in range(3)), (0.0, PICKUP_PITCH, 0.0))
+
+
+def check_spot(cell: CellConfig, spot) -> np.ndarray:
+    """A landing spot (x, y) (m) on the grill as an array, or :class:`UnreachableError`."""
+    xy = np.asarray(spot, dtype=float).ravel()
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+        raise UnreachableError(f"landing spot must be two finite numbers (m), got {spot!r}")
+    g = cell.grill
+    if not g.contains(xy):
+        raise UnreachableError(
+            f"landing spot ({xy[0]:.3f}, {xy[1]:.3f}) is outside the grill area "
+            f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
+    return xy
+
+
+def landing_spot(cell: CellConfig, pb) -> np.ndarray:
+    """Designated landing spot of the flipped burger (x, y) (m): where it was picked up."""
+    return np.asarray(pb[:2], dtype=float)

@@ -1,0 +1,40 @@
+"""The ``flipkit`` command line.
+
+Each sub-command lives in :mod:`flipkit.cli` as a module with ``register(subparsers)``;
+errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from flipkit.errors import FlipkitError
+
+COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="flipkit", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(f"flipkit.cli.{name.replace('-', '_')}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except FlipkitError as exc:
+        print(f"flipkit: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("flipkit: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,46 @@
+"""``flipkit figures``: execute the figure notebooks and write the figures and the manifest."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from flipkit.errors import InvalidChoiceError
+from flipkit.figures import FIGURE_IDS
+
+
+def register(subparsers) -> None:
+    """Add the ``figures`` sub-command to the ``flipkit`` parser."""
+    parser = subparsers.add_parser(
+        "figures", help="run the notebooks and write figures/*.pdf, *.png and manifest.json",
+        description="Execute the figure notebooks with papermill (executed copies in "
+                    "build/notebooks/) and write each figure as PDF and PNG with "
+                    "manifest.json. Figures whose notebook does not exist yet are reported "
+                    "as missing.")
+    parser.add_argument("--quick", action="store_true",
+                        help="smaller runs (fewer trials and locations) for a fast check")
+    parser.add_argument("--only", nargs="+", action="extend", metavar="ID",
+                        help=f"make only these figures; ids: {', '.join(FIGURE_IDS)}")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="Dask scheduler address for sweeps (default: local processes)")
+    parser.add_argument("--out", default="figures", metavar="DIR",
+                        help="output directory (default: figures)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Make the figures; print what was made, what is missing, and the manifest path."""
+    from flipkit.figures import run_notebooks
+
+    for fig_id in args.only or ():
+        if fig_id not in FIGURE_IDS:
+            raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)
+    report = run_notebooks(quick=args.quick, only=args.only, scheduler=args.scheduler,
+                           out_dir=args.out)
+    made = ", ".join(report.made) or "none"
+    print(f"flipkit figures: made {made} in {report.wall_time_s:.1f} s; "
+          f"manifest {report.manifest}")
+    if report.missing:
+        print(f"flipkit figures: no notebook yet for {', '.join(report.missing)} (skipped)",
+              file=sys.stderr)
+    return 0

@@ -1,0 +1,221 @@
+"""``flipkit plan``: plan a translate, a pickup-and-flip, or a batch of burgers.
+
+Exit status: 0 every plan is solved and passes :func:`~flipkit.planning.verify.verify_plan`; 1 a plan
+failed — one line ``flipkit: error: <segment>: <group> violated by <amount> (...)`` on
+stderr per failed plan, and the plan file is still written, with ``"status": "failed"``, so
+it can be inspected (``flipkit verify`` exits 1 on it, ``flipkit export`` refuses it without
+``--force``); 2 bad input (non-finite numbers, a burger off the grill, a point out of reach,
+a start configuration of the wrong size or outside the joint limits, a malformed CSV) —
+one line on stderr, nothing written. A plan file is never written as ``"solved"`` unless it
+passed the check.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import warnings
+from pathlib import Path
+
+from flipkit.errors import ConfigError, FlipkitError
+
+SOLVER_CHOICES = ("sqp", "ipopt", "auto")
+CSV_COLUMNS = (("x", "y", "z"), ("px", "py", "pz"))
+DESCRIPTION = (
+    "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
+    "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
+    "plan file is written with status 'failed' for inspection. Exit 2: bad input (non-finite "
+    "numbers, burger off the grill, point out of reach, start configuration of the wrong "
+    "size or outside the joint limits, malformed CSV); nothing is written.")
+
+
+def register(subparsers) -> None:
+    """Add the ``plan`` sub-command (``translate``, ``flip``, ``batch``) to the parser."""
+    parser = subparsers.add_parser(
+        "plan", help="plan a translate, a pickup-and-flip, or a batch of up to five burgers",
+        description=DESCRIPTION)
+    sub = parser.add_subparsers(dest="plan_command", required=True, metavar="BEHAVIOR")
+
+    def common(p, json_out=True):
+        p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+                       help="NLP solver: auto (default: the SQP, then IPOPT where the SQP "
+                            "fails), sqp (cvxpy/OSQP) or ipopt (CasADi)")
+        if json_out:
+            p.add_argument("--json", required=True, metavar="PLAN.json",
+                           help="output plan file (flipkit-plan/1)")
+
+    t = sub.add_parser("translate", help="carry the burger flat from one point to another",
+                       description="Translate the flat spatula (burger on it) between two "
+                                   "blade-centre positions, at rest at both ends (eq. 9).")
+    t.add_argument("--from", dest="start", nargs="+", required=True, metavar="X",
+                   help="start position X Y Z (m); the start configuration is found by IK")
+    t.add_argument("--to", dest="goal", nargs="+", required=True, metavar="X",
+                   help="goal position X Y Z (m)")
+    t.add_argument("--yaw", default="0", metavar="RAD", help="spatula heading o_z (rad)")
+    common(t)
+    t.set_defaults(run=run_translate)
+
+    f = sub.add_parser("flip", help="pick up and flip one burger (five chained segments)",
+                       description="Go to burger, scoop, pickup, flip and turn back "
+                                   "(eqs. 22-27), chained by (29).")
+    f.add_argument("--burger", nargs="+", required=True, metavar="X",
+                   help="burger location X Y Z (m), on the grill (z = grill height)")
+    f.add_argument("--start-q", nargs="+", metavar="Q",
+                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+    f.add_argument("--land", nargs="+", metavar="X",
+                   help="landing spot X Y (m) on the grill; default where the burger lies")
+    f.add_argument("--r-land", default="0.02", metavar="M",
+                   help="radius (m) of the landing disc about the spot (default 0.02)")
+    common(f)
+    f.set_defaults(run=run_flip)
+
+    b = sub.add_parser("batch", help="pick up and flip up to five burgers in a row",
+                       description="Plan up to five burgers, each starting where the "
+                                   "previous solved plan ended; write DIR/burger_<k>.json "
+                                   "and DIR/summary.csv.")
+    b.add_argument("--burgers", required=True, metavar="FILE.csv",
+                   help="CSV with header x,y,z (or px,py,pz); lines starting with # skipped")
+    b.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    b.add_argument("--no-progress", action="store_true", help="no progress bar")
+    common(b, json_out=False)
+    b.set_defaults(run=run_batch)
+
+
+def _numbers(what: str, values, count: int | None = None) -> list[float]:
+    """Command-line words as finite floats (exactly ``count`` of them if given)."""
+    values = [values] if isinstance(values, str) else list(values)
+    if count is not None and len(values) != count:
+        raise ConfigError(f"{what} takes {count} numbers, got {len(values)}")
+    try:
+        out = [float(v) for v in values]
+    except ValueError:
+        raise ConfigError(f"{what}: not a number in {' '.join(values)}") from None
+    if not all(math.isfinite(v) for v in out):
+        raise ConfigError(f"{what} must be finite, got {' '.join(values)}")
+    return out
+
+
+def read_locations(path) -> list[tuple[float, float, float]]:
+    """Burger locations (m) from a CSV with columns x,y,z or px,py,pz (others ignored).
+
+    Blank lines and lines starting with ``#`` are skipped; at most five rows.
+
+    Raises:
+        ConfigError: Unreadable file, missing columns, a non-numeric or non-finite value,
+            no rows or more than five (one line naming the file and the line).
+    """
+    from flipkit.planning.planner import MAX_BATCH
+
+    try:
+        text = Path(path).read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = getattr(exc, "strerror", None) or exc
+        raise ConfigError(f"{path}: cannot read burger CSV ({reason})") from None
+    lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise ConfigError(f"{path}: no header and no burger rows")
+    header = [h.strip().lower() for h in next(csv.reader([lines[0][1]]))]
+    cols = next((c for c in CSV_COLUMNS if set(c) <= set(header)), None)
+    if cols is None:
+        raise ConfigError(f"{path}: line {lines[0][0]}: header must have columns x,y,z or "
+                          f"px,py,pz, got {','.join(header)}")
+    idx = [header.index(c) for c in cols]
+    rows = lines[1:]
+    if not 1 <= len(rows) <= MAX_BATCH:
+        raise ConfigError(f"{path}: expected 1 to {MAX_BATCH} burger rows, got {len(rows)}")
+    out = []
+    for n, line in rows:
+        cells = next(csv.reader([line]))
+        if len(cells) != len(header):
+            raise ConfigError(f"{path}: line {n}: expected {len(header)} values, got {len(cells)}")
+        out.append(tuple(_numbers(f"{path}: line {n}", [cells[i].strip() for i in idx])))
+    return out
+
+
+def _quiet():
+    """Silence cvxpy's 'Solution may be inaccurate' warnings (the SQP handles them)."""
+    warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+
+
+def _report(plan, path: str | None) -> int:
+    """Print the plan's summary (stdout) or its failure (one line, stderr); 0 or 1."""
+    segs = plan.segments
+    for s in segs:
+        print(f"  {s.name:<13} T {s.T:5.3f} s  solve {s.solver.wall_time_s:7.2f} s  "
+              f"{s.solver.iterations:4d} it  viol {s.solver.max_violation:.1e}  {s.solver.status}")
+    where = f"; wrote {path}" if path else ""
+    solve = sum(s.solver.wall_time_s for s in segs)
+    print(f"flipkit plan: {plan.behavior} {plan.status}: {len(segs)} segment(s), "
+          f"T {sum(s.T for s in segs):.3f} s, solve {solve:.2f} s "
+          f"({segs[0].solver.name}), {sum(s.solver.iterations for s in segs)} iterations, "
+          f"max violation {max(s.solver.max_violation for s in segs):.1e}{where}")
+    for s in segs:
+        if s.landing:
+            land = s.landing
+            print(f"  landing: release at node {s.release['node']} ({s.release['time']:.3f} s), "
+                  f"flight {land['time_of_flight']:.3f} s, lands {1e3 * land['offset']:.1f} mm "
+                  f"from ({land['target'][0]:.3f}, {land['target'][1]:.3f}) m, top face "
+                  f"{land['tilt_deg']:.1f} deg from up")
+    if plan.status == "solved":
+        return 0
+    print(f"flipkit: error: {plan.failure}", file=sys.stderr)
+    return 1
+
+
+def run_translate(args: argparse.Namespace) -> int:
+    """Plan, write (solved or failed), summarise."""
+    from flipkit.planning.planner import plan_translate
+
+    _quiet()
+    start, goal = _numbers("--from", args.start, 3), _numbers("--to", args.goal, 3)
+    plan = plan_translate(start, goal, solver=args.solver, yaw=_numbers("--yaw", args.yaw)[0])
+    plan.to_json(args.json)
+    return _report(plan, args.json)
+
+
+def run_flip(args: argparse.Namespace) -> int:
+    """Plan, write (solved or failed), summarise."""
+    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.planning.planner import plan_flip
+
+    _quiet()
+    location = _numbers("--burger", args.burger, 3)
+    q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
+    land = None if args.land is None else _numbers("--land", args.land, 2)
+    options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
+    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options)
+    plan.to_json(args.json)
+    return _report(plan, args.json)
+
+
+def run_batch(args: argparse.Namespace) -> int:
+    """Plan the batch, write every plan and summary.csv, print the table."""
+    from flipkit.planning.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
+
+    _quiet()
+    locations = read_locations(args.burgers)
+    plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress)
+    out = Path(args.out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        rows = summary_table(plans)
+        for k, plan in enumerate(plans, 1):
+            plan.to_json(out / f"burger_{k}.json")
+        with open(out / "summary.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(SUMMARY_HEADER[:1] + ("x", "y", "z") + SUMMARY_HEADER[2:])
+            for k, loc, *rest in rows:
+                w.writerow([k, *loc, *rest])
+    except OSError as exc:
+        raise FlipkitError(f"{out}: cannot write ({exc.strerror or exc})") from None
+    print(format_summary(rows))
+    total = sum(r[3] for r in rows)
+    print(f"flipkit plan: batch of {len(plans)}: {sum(p.status == 'solved' for p in plans)} "
+          f"solved, solve time {total:.1f} s ({args.solver}); wrote {out}/")
+    for k, plan in enumerate(plans, 1):
+        if plan.status != "solved":
+            print(f"flipkit: error: burger {k}: {plan.failure}", file=sys.stderr)
+    return 0 if all(p.status == "solved" for p in plans) else 1

@@ -1,0 +1,46 @@
+"""``flipkit verify``: independent residual check of a plan file.
+
+Exit status: 0 the plan passes, 1 it fails (one line names the worst group and amount),
+2 the file is unreadable or malformed (printed by :mod:`flipkit.cli`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def register(subparsers) -> None:
+    """Add the ``verify`` sub-command to the ``flipkit`` parser."""
+    parser = subparsers.add_parser(
+        "verify", help="recompute dynamics, defects, limits, endpoints, continuity and cone",
+        description="Check a plan from its arrays alone: dynamics residual, Hermite-Simpson "
+                    "defects, time grid, joint limits, behaviour endpoints, continuity "
+                    "between segments, friction cone and grill clearance. Exit 0 if the plan "
+                    "passes, 1 if it fails, 2 if the file is unreadable or malformed.")
+    parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/1)")
+    parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT")
+    parser.add_argument("--tol", type=float, metavar="TOL",
+                        help="tolerance in the solver's scaled units (default: "
+                             "flipkit.planning.verify.TOL, 10x the SQP feasibility tolerance)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Verify, print the table and the verdict; 0 pass, 1 fail."""
+    from flipkit.errors import FlipkitError
+    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.verify import TOL, verify_plan
+
+    report = verify_plan(Plan.load(args.plan), tol=TOL if args.tol is None else args.tol)
+    print(report.table())
+    if args.json:
+        try:
+            report.write_json(args.json)
+        except OSError as exc:
+            raise FlipkitError(f"cannot write {args.json}: {exc.strerror or exc}") from None
+    if report.ok:
+        print(f"flipkit verify: {report.summary()}")
+        return 0
+    print(f"flipkit verify: {report.summary()}", file=sys.stderr)
+    return 1

@@ -1,1 +1,0 @@
-"""Sub-commands of the ``flipkit`` command line, one module each."""

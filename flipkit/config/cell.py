@@ -1,0 +1,242 @@
+"""The cell: robot, spatula, burger, grill, table and task limits.
+
+Frozen dataclasses in SI units (m, kg, s, rad, N·m). Every default names its source: the
+paper (Kolathaya et al., RA-L 2018) where it gives a value, the URDF, or a stated choice of
+ours where the paper is silent. Constructors validate their arguments and raise
+:class:`~flipkit.errors.ConfigError`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from flipkit.config.checks import box, finite, positive
+from flipkit.config.physics import PhysicsConfig
+from flipkit.errors import ConfigError
+
+GRAVITY = (0.0, 0.0, -9.81)  # m/s², world z up (DESIGN.md conventions)
+UR10_URDF_RELATIVE = ("cmeel.prefix", "share", "example-robot-data", "robots", "ur_description",
+                      "urdf", "ur10_joint_limited_robot.urdf")
+
+
+def default_urdf() -> str:
+    """Absolute path of the UR10 joint-limited URDF shipped by example-robot-data (pip)."""
+    import sysconfig
+
+    for key in ("purelib", "platlib"):
+        path = Path(sysconfig.get_paths()[key]).joinpath(*UR10_URDF_RELATIVE)
+        if path.is_file():
+            return str(path)
+    raise ConfigError("example-robot-data is not installed: UR10 URDF not found "
+                      "(install the environment.lock)")
+
+
+def _identity() -> tuple:
+    return tuple(tuple(float(i == j) for j in range(4)) for i in range(4))
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """The arm: URDF, tool frame, base placement and home configuration.
+
+    Attributes:
+        urdf: URDF path; ``None`` means the UR10 joint-limited robot of example-robot-data
+            (the paper's arm is an unnamed 6-DOF industrial arm; the UR10 matches its reach).
+        tool_frame: Frame the spatula is mounted on (``tool0``, the ROS-Industrial flange).
+        base_in_world: 4x4 homogeneous transform of the robot base in the world (identity:
+            DESIGN.md, world = robot base frame).
+        q_home: Home configuration (rad): spatula flat and level, radially in front of the
+            above the grill at (0.62, -0.20, 0.30) m, o = 0, elbow up (our choice; found by
+            IK, checked in tests/test_config.py).
+        accel_limit: Joint acceleration bound (rad/s²), same for every joint (the URDF has
+            none; UR10 datasheet order of magnitude).
+    """
+
+    urdf: str | None = None
+    tool_frame: str = "tool0"
+    base_in_world: tuple = field(default_factory=_identity)
+    q_home: tuple = (-0.988933, -1.792774, 2.362261, -0.569486, 0.581863, 1.570796)
+    accel_limit: float = 20.0
+
+    def __post_init__(self):
+        if self.urdf is not None and not Path(self.urdf).is_file():
+            raise ConfigError(f"URDF file not found: {self.urdf}")
+        base = finite("base_in_world", self.base_in_world, (4, 4))
+        if not np.allclose(base[3], [0, 0, 0, 1]) or not np.allclose(
+                base[:3, :3] @ base[:3, :3].T, np.eye(3), atol=1e-6):
+            raise ConfigError("base_in_world must be a rigid 4x4 transform")
+        finite("q_home", self.q_home)
+        positive("accel_limit", self.accel_limit)
+
+    @property
+    def urdf_path(self) -> str:
+        """Absolute URDF path (the default resolved)."""
+        return str(Path(self.urdf).resolve()) if self.urdf else default_urdf()
+
+
+@dataclass(frozen=True)
+class SpatulaConfig:
+    """The spatula: a flat blade at the end of a straight handle along the tool axis.
+
+    The paper gives no dimensions; these are a standard grill spatula's.
+
+    Attributes:
+        length: Blade length l_l along its x axis (m).
+        width: Blade width l_w (m).
+        thickness: Blade thickness (m), for the MuJoCo box.
+        handle: Distance from the tool flange to the blade centre along the tool z axis (m).
+        mass: Total mass (kg), lumped at the blade centre for dynamics.
+    """
+
+    length: float = 0.16
+    width: float = 0.12
+    thickness: float = 0.003
+    handle: float = 0.20
+    mass: float = 0.30
+
+    def __post_init__(self):
+        for name in ("length", "width", "thickness", "handle", "mass"):
+            positive(f"spatula {name}", getattr(self, name))
+
+    def placement_in_tool(self) -> np.ndarray:
+        """4x4 placement of the spatula frame in the tool frame.
+
+        Spatula x (toward the tip) is the tool z axis; spatula z (blade normal) is the tool
+        x axis; y = z × x. The origin is the blade centre, ``handle`` along tool z.
+        """
+        T = np.eye(4)
+        T[:3, :3] = np.column_stack(([0, 0, 1], [0, -1, 0], [1, 0, 0]))
+        T[:3, 3] = [0, 0, self.handle]
+        return T
+
+
+@dataclass(frozen=True)
+class BurgerConfig:
+    """The burger patty: a uniform disc (paper Sec. II.C). Sources beside each value; the
+    plausible ranges the sensitivity study sweeps are in :data:`PHYSICAL_RANGES`.
+
+    Attributes:
+        diameter: d (m). 0.10 m = 3.9 in: "a standard hamburger patty is formed into a 4-5
+            inch wide patty that is about 3/4 inch thick" (The Donut Whole, "How many ounces
+            is a 1/4 burger?", https://www.thedonutwhole.com/how-many-ounces-is-a-1-4-burger/);
+            homemade 3.5-4 in (Kitchen Wisdom, "How many ounces are in a quarter-pound
+            burger?", https://kitchenwisdom.info/how-many-ounces-are-in-a-quarter-pound-burger).
+        thickness: Patty thickness (m). The same sources give 3/4 in (19 mm) for the raw,
+            hand-formed patty; 15 mm is a pressed patty (no source gives it: range
+            10-19 mm, stated as ours).
+        mass: m (kg). A quarter pound = 4 oz = 113.4 g raw (ChefRadar, "How many ounces does
+            a hamburger weighing a quarter pound have?", https://chefradar.com/how-many-ounces-
+            does-a-hamburger-weighing-a-quarter-pound-have/); cooking loses 15-25 % (The Donut
+            Whole, above), 24.7-32.1 % for 5-30 % fat patties (J. Food Sci., "Chemical,
+            physical and sensory characterization of ground beef containing 5 to 30 percent
+            fat").
+        mu: Spatula-burger (meat on stainless steel) friction coefficient mu. No measurement
+            of meat on stainless steel was found; friction coefficients of foods on a texture
+            test cell's surface range 0.04-0.52 ("Effect of friction on the performance of
+            texture test cells", J. Texture Studies; https://paperexplained.cn/articles/paper/
+            detail/0401cf38c535a35e153632f5b9bb1a2a752387d2). 0.5 (the planner's value, top of
+            that range) is kept; range 0.2-0.8 stated as ours.
+    """
+
+    diameter: float = 0.10
+    thickness: float = 0.015
+    mass: float = 0.113
+    mu: float = 0.5
+
+    def __post_init__(self):
+        for name in ("diameter", "thickness", "mass", "mu"):
+            positive(f"burger {name}", getattr(self, name))
+
+
+@dataclass(frozen=True)
+class GrillConfig:
+    """The grill: a horizontal plate at height h_g; burgers may lie anywhere in the area.
+
+    Attributes:
+        height: Surface height h_g (m), Table I z column.
+        x_range: Grill area along world x (m); contains all ten Table I locations.
+        y_range: Grill area along world y (m); contains all ten Table I locations.
+    """
+
+    height: float = 0.072
+    x_range: tuple = (0.60, 0.88)
+    y_range: tuple = (-0.50, 0.16)
+
+    def __post_init__(self):
+        finite("grill height", self.height)
+        box("grill area", (self.x_range[0], self.y_range[0]),
+             (self.x_range[1], self.y_range[1]), 2)
+
+    def contains(self, xy, tol: float = 1e-9) -> bool:
+        """Whether the point (x, y) lies in the grill area (m)."""
+        x, y = float(xy[0]), float(xy[1])
+        return (self.x_range[0] - tol <= x <= self.x_range[1] + tol
+                and self.y_range[0] - tol <= y <= self.y_range[1] + tol)
+
+
+@dataclass(frozen=True)
+class TableConfig:
+    """The table (tray) beside the grill where finished burgers are placed (paper Fig. 1).
+
+    Attributes:
+        height: Surface height (m).
+        x_range: Table area along world x (m).
+        y_range: Table area along world y (m).
+    """
+
+    height: float = 0.10
+    x_range: tuple = (0.20, 0.55)
+    y_range: tuple = (0.45, 0.80)
+
+    def __post_init__(self):
+        finite("table height", self.height)
+        box("table area", (self.x_range[0], self.y_range[0]),
+             (self.x_range[1], self.y_range[1]), 2)
+
+
+@dataclass(frozen=True)
+class TaskLimits:
+    """Spatula task-space bounds (paper Constraint 1, eq. 4); the values are ours.
+
+    Attributes:
+        p_min, p_max: Spatula-centre position box (m); p_z stays above the grill.
+        v_max: Bound on |v_x|, |v_y|, |v_z| (m/s).
+        a_max: Bound on |a_x|, |a_y|, |a_z| (m/s²).
+    """
+
+    p_min: tuple = (0.0, -0.9, 0.072)
+    p_max: tuple = (1.2, 0.95, 0.9)
+    v_max: float = 3.0
+    a_max: float = 40.0
+
+    def __post_init__(self):
+        box("task position", self.p_min, self.p_max, 3)
+        positive("v_max", self.v_max)
+        positive("a_max", self.a_max)
+
+
+@dataclass(frozen=True)
+class CellConfig:
+    """Everything about the cell, bundled; the default is the paper's setting."""
+
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    spatula: SpatulaConfig = field(default_factory=SpatulaConfig)
+    burger: BurgerConfig = field(default_factory=BurgerConfig)
+    grill: GrillConfig = field(default_factory=GrillConfig)
+    table: TableConfig = field(default_factory=TableConfig)
+    limits: TaskLimits = field(default_factory=TaskLimits)
+    gravity: tuple = GRAVITY
+    physics: PhysicsConfig = field(default_factory=PhysicsConfig)
+
+    def __post_init__(self):
+        finite("gravity", self.gravity, (3,))
+
+
+TABLE1_LOCATIONS = (  # Table I of the paper: p^b (m), robot base frame (shared/data/paper_table1.csv)
+    (0.64, -0.33, 0.073), (0.75, 0.00, 0.073), (0.76, 0.09, 0.072), (0.64, -0.33, 0.072),
+    (0.68, -0.31, 0.072), (0.69, -0.16, 0.072), (0.73, -0.13, 0.072), (0.73, -0.18, 0.072),
+    (0.75, -0.45, 0.072), (0.84, 0.12, 0.072),
+)

@@ -1,0 +1,219 @@
+"""Solve-time benchmarks against the paper's budgets: SQP (cvxpy/OSQP) beside IPOPT.
+
+    python -m flipkit.experiments.bench translate [--json OUT]
+    python -m flipkit.experiments.bench flip [--locations N] [--batch K] [--json OUT]
+
+``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
+NLP solved by both solvers from the same start point ``nlp.x0``. ``flip``: the full
+pickup-and-flip (five segments) at the first N Table I locations with both solvers, then
+a batch of the first K locations with the SQP, beside the paper's budgets (Sec. I: < 20 s
+per trajectory, 4–5 burgers within 90 s). Times are wall-clock seconds of the solver calls
+(IPOPT's include building its CasADi problem). Before timing, every NLP structure gets one
+SQP iteration, and its hard and elastic QPs are compiled, so that cvxpy's one-off
+canonicalisation (0.01–0.4 s per QP, once per process) is not timed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+import warnings
+
+import numpy as np
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import T_BOUNDS, build_segment, flat_pose
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.model.ik import solve_pose
+from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
+from flipkit.solvers.full_qp import subproblem_for
+from flipkit.solvers.sqp import SQPOptions, solve_sqp
+
+# Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
+# table), blade-centre positions (m) with the spatula flat, yaw 0. Grill: h_g = 0.072 m,
+# area x 0.60–0.88, y −0.50–0.16 -> blade 7.8 cm above it. Table: 0.10 m, area x 0.20–0.55,
+# y 0.45–0.80 -> blade 7–8 cm above it. All reachable; the order (grill, then the table point
+# farthest from it, ending at the one nearest) lets IK from each point find the next.
+TRANSLATE_KEY_POINTS = (
+    (0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
+    (0.45, 0.74, 0.17), (0.32, 0.62, 0.18), (0.50, 0.52, 0.18),
+)
+PAPER_PER_TRAJECTORY_S = 20.0  # Sec. I: < 20 s per trajectory
+PAPER_FIVE_BURGERS_S = 90.0  # Sec. I: 4–5 burgers within 90 s
+
+
+def machine() -> str:
+    """One line: CPU count, platform, Python, BLAS/OpenMP thread setting."""
+    return (f"machine: {os.cpu_count()} CPUs, {platform.platform()}, {platform.processor() or '?'}"
+            f", Python {platform.python_version()}, OMP_NUM_THREADS="
+            f"{os.environ.get('OMP_NUM_THREADS', 'unset')}")
+
+
+def warm_up(nlps) -> float:
+    """Compile the elastic (restoration) QP of each distinct structure (cvxpy, once per
+    process) and run one SQP iteration on it, which compiles the condensed hard QP;
+    returns the time (s)."""
+    t0, seen = time.perf_counter(), set()
+    for nlp in nlps:
+        if nlp.structure_key not in seen:
+            seen.add(nlp.structure_key)
+            subproblem_for(nlp, elastic=True).compile()
+            solve_sqp(nlp, options=SQPOptions(max_iter=1), raise_on_failure=False)
+    return time.perf_counter() - t0
+
+
+def _med(values) -> float:
+    values = [v for v in values if v is not None and np.isfinite(v)]
+    return statistics.median(values) if values else float("nan")
+
+
+def bench_translate(cell: CellConfig) -> dict:
+    """Solve the six translate segments with both solvers; print the table; return rows."""
+    models = models_for(cell)
+    robot = models.for_segment("translate")
+    pts = TRANSLATE_KEY_POINTS
+    nlps = []
+    for k, a in enumerate(pts):
+        q0 = solve_pose(robot, a, (0.0, 0.0, 0.0), robot.q_home)
+        nlps.append(build_segment("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)])))
+    print(machine())
+    print(f"warm-up: one SQP iteration on the translate structure (cvxpy compile): "
+          f"{warm_up(nlps[:1]):.1f} s, not counted below")
+    head = (f"{'seg':<6}{'SQP s':>8}{'it':>5}{'objective':>11}{'status':>11}{'T s':>6} |"
+            f"{'IPOPT s':>8}{'it':>5}{'objective':>11}{'status':>11}{'T s':>6} |{'rel dJ':>9}")
+    print(head, flush=True)
+    rows = []
+    for k, nlp in enumerate(nlps):
+        r = {"segment": f"{k + 1}->{(k + 1) % len(pts) + 1}"}
+        for name in ("sqp", "ipopt"):
+            res = solve_segment(nlp, name)
+            r[name] = {"time_s": res.wall_time_s, "iterations": res.iterations,
+                       "objective": res.objective, "status": res.status,
+                       "T_s": float(res.x[nlp.layout.T_index])}
+        s, i = r["sqp"], r["ipopt"]
+        both = s["status"] == i["status"] == "solved"
+        r["rel_objective_diff"] = ((s["objective"] - i["objective"]) / abs(i["objective"])
+                                   if both else None)
+        rows.append(r)
+        rel = f"{r['rel_objective_diff']:9.1e}" if both else f"{'-':>9}"
+        print(f"{r['segment']:<6}" + " |".join(
+            f"{d['time_s']:8.2f}{d['iterations']:5d}{d['objective']:11.4g}{d['status'][:10]:>11}"
+            f"{d['T_s']:6.2f}" for d in (s, i)) + f" |{rel}", flush=True)
+    med = {name: {key: _med([r[name][key] for r in rows])
+                  for key in ("time_s", "iterations", "T_s")} for name in ("sqp", "ipopt")}
+    med["rel_objective_diff"] = _med([r["rel_objective_diff"] for r in rows])
+    print(f"{'median':<6}" + " |".join(
+        f"{med[n]['time_s']:8.2f}{med[n]['iterations']:5.0f}{'':>22}{med[n]['T_s']:6.2f}"
+        for n in ("sqp", "ipopt")) + f" |{med['rel_objective_diff']:9.1e}")
+    solved = {n: sum(r[n]["status"] == "solved" for r in rows) for n in ("sqp", "ipopt")}
+    print(f"solved: SQP {solved['sqp']}/{len(rows)}, IPOPT {solved['ipopt']}/{len(rows)}; "
+          f"T = executed duration (s), bounds {T_BOUNDS['translate']} s; "
+          "rel dJ = (J_SQP − J_IPOPT)/J_IPOPT")
+    return {"machine": machine(), "key_points": pts, "rows": rows, "median": med}
+
+
+def _flip_row(plan) -> dict:
+    segs = plan.segments
+    return {"status": plan.status, "failure": plan.failure, "wall_s": plan.wall_time_s,
+            "solve_s": sum(s.solver.wall_time_s for s in segs),
+            "iterations": sum(s.solver.iterations for s in segs),
+            "objective": sum(s.solver.objective for s in segs),
+            "T_s": sum(s.T for s in segs), "segments": len(segs)}
+
+
+def bench_flip(cell: CellConfig, n_locations: int, n_batch: int) -> dict:
+    """Full pickup-and-flip at the first ``n_locations`` Table I locations with both
+    solvers, then a batch of the first ``n_batch`` with the SQP; print; return the rows."""
+    models, locs = models_for(cell), TABLE1_LOCATIONS[:n_locations]
+    q, qd, structures = models.bare.q_home, None, []
+    for name in tg.SUBBEHAVIORS:  # one NLP per structure, along the initial guesses
+        nlp = build_segment(name, models, q, qd, location=TABLE1_LOCATIONS[1])
+        structures.append(nlp)
+        x = nlp.layout.nodes(nlp.x0)
+        q, qd = x[-1, 0], x[-1, 1]
+    print(machine())
+    print(f"warm-up: one SQP iteration on each of the 5 segment structures (cvxpy compile): "
+          f"{warm_up(structures):.1f} s, not counted below")
+    print(f"{'loc':<4}{'p^b (m)':<25}{'SQP s':>8}{'it':>6}{'status':>8}{'T s':>6} |"
+          f"{'IPOPT s':>8}{'it':>6}{'status':>8}{'T s':>6} |{'rel dJ':>9} | paper budget",
+          flush=True)
+    rows = []
+    for k, loc in enumerate(locs, 1):
+        r = {"location": loc, **{n: _flip_row(plan_flip(loc, cell=cell, solver=n))
+                                 for n in ("sqp", "ipopt")}}
+        both = all(r[n]["status"] == "solved" for n in ("sqp", "ipopt"))
+        r["rel_objective_diff"] = ((r["sqp"]["objective"] - r["ipopt"]["objective"])
+                                   / abs(r["ipopt"]["objective"]) if both else float("nan"))
+        rows.append(r)
+        where = "(" + ", ".join(f"{v:.3f}" for v in loc) + ")"
+        print(f"{k:<4}{where:<25}" + " |".join(
+            f"{d['solve_s']:8.2f}{d['iterations']:6d}{d['status']:>8}{d['T_s']:6.2f}"
+            for d in (r["sqp"], r["ipopt"])) + f" |{r['rel_objective_diff']:9.1e}"
+            f" | < {PAPER_PER_TRAJECTORY_S:.0f} s", flush=True)
+        for n in ("sqp", "ipopt"):
+            if r[n]["failure"]:
+                print(f"    {n}: {r[n]['failure']}", flush=True)
+    med = {n: {key: _med([r[n][key] for r in rows]) for key in ("solve_s", "iterations", "T_s")}
+           for n in ("sqp", "ipopt")}
+    print(f"{'median':<29}" + " |".join(
+        f"{med[n]['solve_s']:8.2f}{med[n]['iterations']:6.0f}{'':>8}{med[n]['T_s']:6.2f}"
+        for n in ("sqp", "ipopt")))
+    solved = {n: sum(r[n]["status"] == "solved" for r in rows) for n in ("sqp", "ipopt")}
+    print(f"solved: SQP {solved['sqp']}/{len(rows)}, IPOPT {solved['ipopt']}/{len(rows)}; "
+          "s = solve time of the five segments, T = executed duration of the plan (s), "
+          "rel dJ = (ΣJ_SQP − ΣJ_IPOPT)/ΣJ_IPOPT over the five segments")
+    out = {"machine": machine(), "rows": rows, "median": med}
+    if n_batch:
+        t0 = time.perf_counter()
+        plans = plan_batch(TABLE1_LOCATIONS[:n_batch], cell=cell, solver="sqp", progress=False)
+        wall = time.perf_counter() - t0
+        batch = [_flip_row(p) for p in plans]
+        print(f"batch of {n_batch} (Table I 1..{n_batch}, SQP): "
+              f"{sum(b['status'] == 'solved' for b in batch)}/{n_batch} solved, solve "
+              f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s "
+              f"(paper: {PAPER_FIVE_BURGERS_S:.0f} s for 4-5 burgers)")
+        out["batch"] = {"n": n_batch, "wall_s": wall, "plans": batch}
+    return out
+
+
+def _plain(obj):
+    """``obj`` with NaN as None and numpy numbers as floats (strict JSON)."""
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if np.isfinite(obj) else None
+    return obj.item() if isinstance(obj, np.generic) else obj
+
+
+def main(argv=None) -> int:
+    """Command-line entry point (see the module docstring)."""
+    parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("which", choices=("translate", "flip"))
+    parser.add_argument("--locations", type=int, default=len(TABLE1_LOCATIONS), metavar="N",
+                        help="flip: the first N Table I locations (default all ten)")
+    parser.add_argument("--batch", type=int, default=5, metavar="K",
+                        help="flip: batch of the first K locations with the SQP (0: none)")
+    parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
+    args = parser.parse_args(argv)
+    if not 1 <= args.locations <= len(TABLE1_LOCATIONS) or not 0 <= args.batch <= 5:
+        parser.error(f"--locations must be 1..{len(TABLE1_LOCATIONS)} and --batch 0..5")
+    warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+    cell = CellConfig()
+    result = (bench_translate(cell) if args.which == "translate"
+              else bench_flip(cell, args.locations, args.batch))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(_plain(result), fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,177 @@
+"""Joint-space collocation against the end-effector-space + IK baseline, location by location.
+
+The paper's motivating claim (Sec. I) is that planning in end-effector space and tracking with
+inverse kinematics fails where joint-space collocation succeeds. :func:`compare_ik` runs both
+on each burger location — :func:`flipkit.planning.planner.plan_flip` (its plan re-checked by
+:func:`flipkit.planning.verify.verify_plan`) and :func:`flipkit.baseline.run_baseline` — on the sweep
+executor, and summarises success fractions, the baseline's failure reasons and the median
+wall time per subbehaviour of each method.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+from collections import Counter
+from pathlib import Path
+
+from flipkit.behaviors import targets as tg
+from flipkit.baseline.classify import REASONS
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.experiments.sweep import run_sweep
+
+LOCATION_SETS = {"table1": TABLE1_LOCATIONS}
+METHODS = ("collocation", "ee_ik")
+_PRIVATE = "_segment_time_s"  # per-segment solve times, used by the summary only
+
+
+def _number(x) -> float | None:
+    """``x`` as a float, or ``None`` when it is missing or not finite (JSON has no NaN)."""
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def plan_filename(location, solver: str) -> str:
+    """File name of the plan of ``location`` (m) made by ``solver``."""
+    return "plan_" + "_".join(f"{v:+.3f}" for v in location) + f"_{solver}.json"
+
+
+def _collocation(location, solver: str, plans_dir) -> dict:
+    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.verify import verify_plan
+
+    t0 = time.perf_counter()
+    try:
+        plan = plan_flip(location, solver=solver)
+    except FlipkitError as exc:
+        return {"status": "failed", "reason": str(exc), "time_s": time.perf_counter() - t0,
+                _PRIVATE: {}}
+    status, reason, report = plan.status, plan.failure, verify_plan(plan)
+    if status == "solved" and not report.ok:
+        status, reason = "failed", f"verify: {report.summary()}"
+    if plans_dir is not None:
+        plan.to_json(Path(plans_dir) / plan_filename(location, solver))
+    return {"status": status, "reason": reason, "time_s": float(plan.wall_time_s),
+            _PRIVATE: {s.name: float(s.solver.wall_time_s) for s in plan.segments}}
+
+
+def _ee_ik(location) -> dict:
+    from flipkit.baseline import run_baseline
+
+    res = run_baseline(location)
+    return {"status": res.status, "reason": res.reason, "subbehavior": res.subbehavior,
+            "amount": _number(res.amount), "time_s": res.time_s}
+
+
+def compare_location(job: dict) -> dict:
+    """Both methods at one location (the sweep worker).
+
+    Args:
+        job: ``{"location": [x, y, z] (m), "solver": "sqp" | "ipopt", "plans_dir": str or
+            None}``; with a directory the collocation plan is written there
+            (:func:`plan_filename`).
+
+    Returns:
+        ``{"location", "collocation": {status, reason, time_s (s, the whole planning call),
+        ...}, "ee_ik": {status, reason, subbehavior, amount, time_s: {subbehaviour: {"ee":
+        s, "ik": s}}}}``.
+    """
+    loc = [float(v) for v in job["location"]]
+    return {"location": loc, "collocation": _collocation(loc, job["solver"], job["plans_dir"]),
+            "ee_ik": _ee_ik(loc)}
+
+
+def _median(values) -> float | None:
+    values = [v for v in values if v is not None]
+    return float(statistics.median(values)) if values else None
+
+
+def summarize(records: list) -> dict:
+    """Success fraction per method, failure counts and median wall times (s) per subbehaviour.
+
+    ``collocation_failures`` counts the subbehaviour where each failed plan stopped (the
+    prefix of its reason; ``other`` when there is none).
+    """
+    n = len(records)
+    frac = {m: sum(r[m]["status"] == "solved" for r in records) / n if n else None
+            for m in METHODS}
+    reasons = Counter(r["ee_ik"]["reason"] for r in records if r["ee_ik"]["status"] != "solved")
+    stops = Counter()
+    for r in records:
+        c = r["collocation"]
+        if c["status"] != "solved":
+            head = (c["reason"] or "").split(":")[0]
+            stops[head if head in tg.SUBBEHAVIORS else "other"] += 1
+    coll = {s: _median(r["collocation"][_PRIVATE].get(s) for r in records)
+            for s in tg.SUBBEHAVIORS}
+    coll["total"] = _median(r["collocation"]["time_s"] for r in records)
+    ee = {s: {part: _median(r["ee_ik"]["time_s"].get(s, {}).get(part) for r in records)
+              for part in ("ee", "ik")} for s in tg.SUBBEHAVIORS}
+    return {"locations": n, "success_fraction": frac,
+            "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
+            "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
+                                        for s in tg.SUBBEHAVIORS},
+            "collocation_failures": dict(sorted(stops.items())),
+            "median_time_s": {"collocation": coll, "ee_ik": ee}}
+
+
+def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, plans_dir=None,
+               progress: bool = True, cell: CellConfig | None = None) -> dict:
+    """Run both methods at every location and summarise.
+
+    Args:
+        locations: Burger locations p^b (m), on the grill.
+        solver: Collocation solver, ``"sqp"`` or ``"ipopt"``.
+        executor: Sweep executor (:func:`flipkit.experiments.sweep.make_executor`); ``None`` runs here.
+        cache_dir: Sweep cache directory, or ``None``.
+        plans_dir: Directory to write the collocation plans to, or ``None``.
+        progress: Show a progress bar.
+        cell: Only used to check the locations (the methods plan in the default cell).
+
+    Returns:
+        ``{"locations": [{"location", "collocation": {status, reason, time_s}, "ee_ik":
+        {status, reason, subbehavior, amount, time_s}}, ...], "summary": summarize(...)}``.
+
+    Raises:
+        UnreachableError: A location off the grill (named by its index, from 1).
+        InvalidChoiceError: Unknown solver.
+    """
+    from flipkit.planning.planner import SOLVERS
+
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    cell, locs = cell or CellConfig(), []
+    for k, loc in enumerate(locations, 1):
+        try:
+            locs.append([float(v) for v in tg.check_location(cell, loc)])
+        except UnreachableError as exc:
+            raise UnreachableError(f"location {k}: {exc}") from None
+    if plans_dir is not None:
+        Path(plans_dir).mkdir(parents=True, exist_ok=True)
+        plans_dir = str(Path(plans_dir).resolve())
+    jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir} for loc in locs]
+    records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
+                        desc="compare-ik")
+    entries = [{"location": r["location"],
+                "collocation": {k: r["collocation"][k] for k in ("status", "reason", "time_s")},
+                "ee_ik": r["ee_ik"]} for r in records]
+    return {"locations": entries, "summary": summarize(records)}
+
+
+def format_summary(summary: dict) -> str:
+    """A few lines of text: success fractions, baseline failure reasons, median times (s)."""
+    f, t = summary["success_fraction"], summary["median_time_s"]
+    lines = [f"{summary['locations']} locations: collocation {f['collocation']:.0%} solved, "
+             f"EE+IK {f['ee_ik']:.0%} solved"]
+    bad = {k: v for k, v in summary["ik_failure_reasons"].items() if v}
+    lines.append("EE+IK failures: " + (", ".join(f"{k} {v}" for k, v in bad.items()) or "none"))
+    fmt = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
+    for s in tg.SUBBEHAVIORS:
+        lines.append(f"  {s:<13} collocation {fmt(t['collocation'][s]):>7} s   EE "
+                     f"{fmt(t['ee_ik'][s]['ee']):>7} s + IK {fmt(t['ee_ik'][s]['ik']):>7} s")
+    return "\n".join(lines)
+
+
+__all__ = ["LOCATION_SETS", "compare_location", "compare_ik", "summarize", "format_summary",
+           "plan_filename"]

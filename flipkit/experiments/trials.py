@@ -1,0 +1,396 @@
+"""Simulated execution of pickup-and-flip plans under perturbations (the paper's Table I trials).
+
+One trial (:func:`run_trial`): the plan is executed closed-loop in the MuJoCo cell
+(:func:`flipkit.simulation.execute.execute_plan`): the arm with its spatula is simulated with the
+burger lying on the grill, misplaced and with perturbed physics (:class:`Perturbations`,
+drawn from ``np.random.default_rng(seed + trial)``), the blade colliding with the grill and
+the burger; the joint controller is the job's ``mode`` (``"feedforward"``: plan torques plus
+PD; ``"position"``: the robot's own PD position control on servo-rate, delayed desired
+states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
+the previous ones succeeded, as in Table I.
+
+:func:`track_plan` (the older pinocchio-only tracking, whose poses drove the blade of
+:class:`flipkit.simulation.prescribed_blade.BurgerSim`) is kept for the figures that use it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import CARRIES_BURGER
+from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
+                                      judge_flip, judge_pickup, judge_scoop)
+from flipkit.config import CellConfig, with_parameter
+from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.planning.plan_file import Plan
+
+TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
+HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
+STAGES = ("scoop", "pickup", "flip")
+_PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
+              "cone", "segments", "created_by")
+
+
+@dataclass(frozen=True)
+class Perturbations:
+    """How each trial's real cell differs from the plan's model.
+
+    Attributes:
+        position_sigma: Standard deviation (m) of the Gaussian burger placement error, drawn
+            independently in x and in y. Default 5 mm (a burger put down by hand).
+        grill_offset: Half-width a (m) of the uniform grill-height offset U(−a, a).
+            Default 2 mm.
+        mu_scale: Range (lo, hi) of the uniform factor on the burger–spatula friction
+            coefficient μ (the burger–grill friction is unchanged). Default (0.8, 1.2).
+        mass_scale: Range (lo, hi) of the uniform factor on the burger mass, in MuJoCo and in
+            the arm's payload (not in the feed-forward). Default (0.9, 1.1).
+    """
+
+    position_sigma: float = 0.005
+    grill_offset: float = 0.002
+    mu_scale: tuple = (0.8, 1.2)
+    mass_scale: tuple = (0.9, 1.1)
+
+    def __post_init__(self):
+        for name in ("position_sigma", "grill_offset"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+                raise ConfigError(f"{name} must be a non-negative number (m)")
+        for name in ("mu_scale", "mass_scale"):
+            lo, hi = (float(v) for v in getattr(self, name))
+            if not (0 < lo <= hi < np.inf):
+                raise ConfigError(f"{name} must be a range 0 < lo <= hi, got {(lo, hi)}")
+            object.__setattr__(self, name, (lo, hi))
+
+    def draw(self, rng: np.random.Generator) -> dict:
+        """One trial's perturbation: ``dx_m``, ``dy_m``, ``grill_offset_m`` (m),
+        ``mu_factor``, ``mass_factor``, drawn in this order."""
+        dx, dy = rng.normal(0.0, self.position_sigma, 2)
+        return {"dx_m": float(dx), "dy_m": float(dy),
+                "grill_offset_m": float(rng.uniform(-self.grill_offset, self.grill_offset)),
+                "mu_factor": float(rng.uniform(*self.mu_scale)),
+                "mass_factor": float(rng.uniform(*self.mass_scale))}
+
+
+def plan_from_text(text: str) -> Plan:
+    """A plan from the text of a ``flipkit-plan/1`` file (already checked by Plan.load)."""
+    doc = json.loads(text)
+    return Plan(**{k: doc[k] for k in _PLAN_KEYS})
+
+
+def track_plan(plan: Plan, plant_cell: CellConfig | None = None, rate_hz=TRACK_RATE_HZ):
+    """Track every segment of ``plan`` with the PD controller, the plan's u as feed-forward.
+
+    Args:
+        plan: A flip plan. plant_cell: The real cell (burger mass); default the plan's.
+        rate_hz: Controller rate (Hz).
+
+    Returns:
+        ``(t, p, R, bounds, errors)``: tracked spatula poses on one clock from 0 (s, m,
+        N×3×3), ``{segment: (t_start, t_end)}`` (s) and ``{segment: {"max_m", "sum_sq_m2",
+        "n"}}``, the spatula position tracking error (m) of each segment.
+    """
+    from flipkit.model.robot import Robot
+    from flipkit.simulation.tracking import track
+
+    cell = plan.cell()
+    plant_cell = plant_cell or cell
+    plants = {w: Robot(plant_cell, with_burger=w) for w in (False, True)}
+    ts, ps, rs, bounds, errors, start, q0 = [], [], [], {}, {}, 0.0, None
+    for seg in plan.segments:
+        res = track(plan.robot_for(seg.name, cell), seg.t, seg.q, seg.qd, u_ff=seg.u,
+                    rate_hz=rate_hz, mismatch=plants[CARRIES_BURGER[seg.name]], q0=q0)
+        q0, e = res.q[-1], res.position_error
+        errors[seg.name] = {"max_m": float(e.max()), "sum_sq_m2": float(np.sum(e**2)),
+                            "n": int(e.size)}
+        t = start + res.t
+        keep = t > ts[-1][-1] + 1e-9 if ts else np.ones(t.size, bool)
+        ts.append(t[keep]), ps.append(res.p[keep]), rs.append(res.R[keep])
+        bounds[seg.name] = (start, start + seg.T)
+        start += seg.T
+    return np.concatenate(ts), np.concatenate(ps), np.concatenate(rs), bounds, errors
+
+
+def _failure(scoop, pickup, flip, run) -> dict | None:
+    """The first failed stage: stage, reason and the measured amount (units in the reason)."""
+    if not scoop.ok:
+        return {"stage": "scoop", "reason": "overlap" if scoop.overlap < SCOOP_OVERLAP
+                else "under_blade", "amount": scoop.overlap}
+    if not pickup.ok:
+        if not pickup.off_grill:
+            return {"stage": "pickup", "reason": "on_grill", "amount": pickup.clearance}
+        return {"stage": "pickup", "reason": "off_spatula", "amount": pickup.gap}
+    if flip.ok:
+        return None
+    if flip.contact_fraction < FLIP_CONTACT_FRACTION:
+        return {"stage": "flip", "reason": "contact", "amount": flip.contact_fraction}
+    if not flip.upside_down:
+        return {"stage": "flip", "reason": "not_flipped", "amount": flip.up_z}
+    if not flip.on_grill:
+        return {"stage": "flip", "reason": "not_on_grill",
+                "amount": float(run.burger_pos[-1, 2] - run.grill_height)}
+    miss = float(np.max(np.abs(flip.offset)))
+    return {"stage": "flip", "reason": "missed_spot" if miss > LANDING_TOL else "other",
+            "amount": miss}
+
+
+def landing_target(plan: Plan) -> np.ndarray:
+    """Where the flip should land the burger (x, y) (m): the flip segment's planned
+    ``landing["target"]`` when the plan has one (``flipkit plan flip --land X Y`` lands
+    elsewhere than the default), else :func:`flipkit.behaviors.targets.landing_spot` of the burger."""
+    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    landing = getattr(flip, "landing", None)
+    if landing is not None:
+        return np.asarray(landing["target"], float)
+    return np.asarray(tg.landing_spot(plan.cell(), np.asarray(plan.burger["location"], float)),
+                      float)[:2]
+
+
+def run_trial(job: dict) -> dict:
+    """One simulated execution (the sweep worker).
+
+    Args:
+        job: ``plan_text`` (a solved flip plan file's text), ``trial`` (index), ``seed``,
+            ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
+            rate, Hz), ``mode`` (:data:`flipkit.simulation.execute.MODES`; default ``"feedforward"``),
+            optionally ``replan`` (bool, see :func:`validate`) and ``physics``
+            (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
+            simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
+            and any replan keep the nominal model).
+
+    Returns:
+        ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` ({stage: bool}, each
+        judge on its own, whatever the earlier stages did), ``failure`` (first failed stage:
+        ``stage``, ``reason``, ``amount`` — scoop overlap fraction, pickup clearance above
+        the grill (``on_grill``) or gap above the blade (``off_spatula``) m, flip contact
+        fraction / up-axis z / height m / landing offset m — or ``None``),
+        ``perturbation`` (the draw), ``tracking`` (spatula position error per segment, see
+        :func:`track_plan`) and ``mode``.
+    """
+    from flipkit.simulation.execute import execute_plan
+
+    plan = plan_from_text(job["plan_text"])
+    mode = job.get("mode", "feedforward")
+    draw = Perturbations(**job["perturbations"]).draw(
+        np.random.default_rng(job["seed"] + job["trial"]))
+    cell = plan.cell()
+    for name, value in (job.get("physics") or {}).items():
+        cell = with_parameter(cell, name, value)
+    replan = None
+    if job.get("replan", False):
+        from flipkit.planning.planner import replan_flip
+
+        replan = replan_flip
+    ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
+                      replan=replan)
+    run, bounds, errors = ex.run, ex.bounds, ex.errors
+    scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
+    flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
+    ok = {"scoop": scoop.ok}
+    ok["pickup"] = ok["scoop"] and pickup.ok
+    ok["flip"] = ok["pickup"] and flip.ok
+    return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, flip, run),
+            "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
+            "perturbation": draw, "tracking": errors, "mode": mode,
+            "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
+            "predicted_landing_xy": _predicted(ex.plan),
+            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
+            if replan is not None else None, "physics": dict(job.get("physics") or {})}
+
+
+def _predicted(plan) -> list | None:
+    """The plan's predicted landing point (x, y) (m), or ``None`` without one."""
+    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    return None if flip is None or not flip.landing else [float(v) for v in flip.landing["point"][:2]]
+
+
+def merge_tracking(errors: list) -> dict:
+    """Per-segment {"max_m", "rms_m"} (m) over several :func:`track_plan` error dicts."""
+    out = {}
+    for name in dict.fromkeys(k for e in errors for k in e):
+        rows = [e[name] for e in errors if name in e]
+        n = sum(r["n"] for r in rows)
+        out[name] = {"max_m": max(r["max_m"] for r in rows),
+                     "rms_m": float(np.sqrt(sum(r["sum_sq_m2"] for r in rows) / n))}
+    return out
+
+
+def location_entry(location, trials: int, results: list, plan_info: dict) -> dict:
+    """The output of one location from its trial results (empty when the plan failed: every
+    trial then fails at stage ``plan``).
+
+    ``success`` counts cumulative stages (a pickup counts only after a successful scoop, as
+    in the paper's Table I); ``independent`` counts each judge's passes on its own;
+    ``landings`` lists each trial's final burger position (x, y) (m), whether it flipped, the
+    executed plan's predicted landing and, with ``replan``, what was sensed.
+    """
+    if not results:
+        fails = [{"trial": i, "stage": "plan", "reason": plan_info.get("reason"),
+                  "amount": None} for i in range(trials)]
+        return {"location": list(location), "plan": plan_info, "trials": trials,
+                "success": dict.fromkeys(STAGES, 0), "independent": dict.fromkeys(STAGES, 0),
+                "failures": fails, "tracking": {}, "landings": []}
+    return {"location": list(location), "plan": plan_info, "trials": trials,
+            "success": {s: sum(r["ok"][s] for r in results) for s in STAGES},
+            "independent": {s: sum(r["independent"][s] for r in results) for s in STAGES},
+            "failures": [{"trial": r["trial"], **r["failure"], "perturbation": r["perturbation"]}
+                         for r in results if r["failure"]],
+            "tracking": merge_tracking([r["tracking"] for r in results]),
+            "landings": [{"trial": r["trial"], "flipped": r["ok"]["flip"],
+                          "xy": r.get("landing_xy"), "predicted_xy": r.get("predicted_landing_xy"),
+                          "replan": r.get("replan")} for r in results]}
+
+
+def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
+               rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+               replan: bool = False, physics: dict | None = None) -> list:
+    """The :func:`run_trial` jobs of one plan (``physics``: see :func:`run_trial`; the key
+    is left out when empty, so the cache keys of nominal trials do not change)."""
+    extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
+    return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
+             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
+             "replan": bool(replan), **extra} for i in range(trials)]
+
+
+def trial_key(job: dict) -> dict:
+    """Cache key of a trial job: the plan's digest instead of its text."""
+    from flipkit.experiments.sweep import stable_hash
+
+    return {**{k: v for k, v in job.items() if k != "plan_text"},
+            "plan": stable_hash(job["plan_text"])}
+
+
+def plan_location(job: dict) -> dict:
+    """Plan pickup-and-flip at one location and write the plan file (a sweep worker).
+
+    Args:
+        job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``.
+
+    Returns:
+        ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
+    """
+    from flipkit.experiments.compare_ik import plan_filename
+    from flipkit.planning.planner import plan_flip
+
+    try:
+        plan = plan_flip(job["location"], solver=job["solver"])
+    except FlipkitError as exc:
+        return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
+    path = Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"])
+    plan.to_json(path)
+    return {"status": plan.status, "reason": plan.failure, "time_s": float(plan.wall_time_s),
+            "path": str(path)}
+
+
+def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
+             executor=None, cache_dir=None, progress: bool = True,
+             rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+             replan: bool = False) -> dict:
+    """Run ``trials`` simulated executions of each plan, all on one sweep.
+
+    Args:
+        targets: ``[(location, plan_info, plan_text or None), ...]``: the burger location
+            (m), a dict describing the plan (recorded as is) and the text of its solved plan
+            file (``None``: no plan, every trial fails at stage ``plan``).
+        trials: Trials per location (≥ 1). seed: Trial i draws from
+            ``np.random.default_rng(seed + i)``.
+        perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
+        mode: Joint controller, one of :data:`flipkit.simulation.execute.MODES`.
+        replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
+            and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planner.replan_flip`);
+            ``False`` runs the plans open loop.
+        executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
+
+    Returns:
+        ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
+        "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
+        "trials", "success": {stage: count}, "independent": {stage: count}}}``.
+    """
+    from flipkit.simulation.execute import MODES
+    from flipkit.experiments.sweep import run_sweep
+
+    if mode not in MODES:
+        raise InvalidChoiceError("execution mode", mode, MODES)
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
+        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    jobs, owner = [], []
+    for k, (_, _, text) in enumerate(targets):
+        if text is not None:
+            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan)
+            jobs, owner = jobs + new, owner + [k] * len(new)
+    results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
+    per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
+    entries = [location_entry(loc, int(trials), per[k], info)
+               for k, (loc, info, _) in enumerate(targets)]
+    return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
+            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "locations": entries,
+            "tracking": merge_tracking([r["tracking"] for r in results]),
+            "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
+                        "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},
+                        "independent": {s: sum(e["independent"][s] for e in entries)
+                                        for s in STAGES}}}
+
+
+def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
+    """:func:`validate` of one plan file; raises FlipkitError (one line) if it is missing,
+    malformed, not a flip plan or not solved. ``kwargs`` as :func:`validate`."""
+    plan = Plan.load(path)
+    if plan.behavior != "flip":
+        raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip plan")
+    if plan.status != "solved":
+        raise FlipkitError(f"{path}: plan status is {plan.status!r}; validate needs a solved plan")
+    info = {"status": plan.status, "file": str(path)}
+    return validate([(plan.burger["location"].tolist(), info, Path(path).read_text())], trials,
+                    seed, **kwargs)
+
+
+def validate_locations(locations, trials: int, solver: str = "auto", seed: int = 0, *,
+                       executor=None, cache_dir=None, plans_dir=None, progress: bool = True,
+                       **kwargs) -> dict:
+    """Plan every location (on the sweep, cached), then :func:`validate` the plans.
+
+    Args:
+        locations: Burger locations (m). solver: ``"sqp"`` or ``"ipopt"``.
+        plans_dir: Where to keep the plan files; default ``cache_dir/plans``, or a temporary
+            directory without a cache.
+        trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
+    """
+    import tempfile
+
+    from flipkit.planning.planner import SOLVERS
+    from flipkit.experiments.sweep import run_sweep
+
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
+        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    cell, locs = CellConfig(), []
+    for k, loc in enumerate(locations, 1):
+        try:
+            locs.append([float(v) for v in tg.check_location(cell, loc)])
+        except UnreachableError as exc:
+            raise UnreachableError(f"location {k}: {exc}") from None
+    with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
+        where = Path(plans_dir or (Path(cache_dir) / "plans" if cache_dir else tmp)).resolve()
+        where.mkdir(parents=True, exist_ok=True)
+        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where)} for loc in locs]
+        infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
+                          desc="plans")
+        stale = [i for i, r in enumerate(infos) if r["path"] and not Path(r["path"]).is_file()]
+        for i, r in zip(stale, run_sweep(plan_location, [jobs[i] for i in stale], executor,
+                                         None, progress=False)):
+            infos[i] = r  # a cached result whose plan file was deleted: plan again
+        targets = [(loc, {k: r[k] for k in ("status", "reason", "time_s")},
+                    Path(r["path"]).read_text() if r["status"] == "solved" else None)
+                   for loc, r in zip(locs, infos)]
+    return validate(targets, trials, seed, executor=executor, cache_dir=cache_dir,
+                    progress=progress, **kwargs)
+
+
+__all__ = ["Perturbations", "TRACK_RATE_HZ", "HOLD_S", "STAGES", "plan_from_text", "track_plan",
+           "landing_target", "run_trial", "merge_tracking", "location_entry", "trial_jobs", "trial_key",
+           "plan_location", "validate", "validate_plan_file", "validate_locations"]

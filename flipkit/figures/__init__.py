@@ -1,0 +1,23 @@
+"""Figure layer: every figure of DESIGN.md made by a papermill notebook.
+
+* :mod:`~flipkit.figures.catalog`: the figure ids and their notebooks;
+* :mod:`~flipkit.figures.style`: one matplotlib style, and :func:`save` (PDF, PNG, sidecar);
+* :mod:`~flipkit.figures.draw`: the drawing functions (panels, maps, statistics, the cell);
+* :mod:`~flipkit.figures.data` and :mod:`~flipkit.figures.runs`: the numbers a figure shows,
+  computed from plans and runs;
+* :mod:`~flipkit.figures.pipeline`: the notebook runner and ``manifest.json``;
+* :mod:`~flipkit.figures.macros`: ``paper/numbers.tex`` from the manifest.
+
+A notebook imports ``from flipkit import figures`` and calls ``figures.style()`` and
+``figures.save(...)``; the names below are the layer's public interface.
+"""
+
+from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR, REPO_ROOT
+from flipkit.figures.macros import flatten_numbers, format_number, tex_escape, write_macros
+from flipkit.figures.pipeline import NotebookError, RunReport, kernel_name, run_notebooks, write_manifest
+from flipkit.figures.style import COLORS, COLUMN_WIDTH, PAGE_WIDTH, PNG_DPI, save, style
+
+__all__ = ["COLORS", "COLUMN_WIDTH", "FIGURES", "FIGURE_IDS", "NOTEBOOKS_DIR", "PAGE_WIDTH",
+           "PNG_DPI", "REPO_ROOT", "NotebookError", "RunReport", "flatten_numbers",
+           "format_number", "kernel_name", "run_notebooks", "save", "style", "tex_escape",
+           "write_macros", "write_manifest"]

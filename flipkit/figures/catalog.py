@@ -1,0 +1,17 @@
+"""The figures of DESIGN.md and the notebooks that make them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+NOTEBOOKS_DIR = REPO_ROOT / "notebooks"
+FIGURES = {  # figure id -> notebook that makes it (DESIGN.md, "The figures"), in paper order
+    "cell": "cell.ipynb", "forces": "forces.ipynb", "subbehaviors": "subbehaviors.ipynb",
+    "defects": "defects.ipynb", "translate": "translate.ipynb", "flip": "flip.ipynb",
+    "table1": "table1.ipynb", "ik_failure": "ik_failure.ipynb",
+    "solve_times": "solve_times.ipynb", "cone_forms": "cone_forms.ipynb",
+    "landing": "landing.ipynb", "filmstrip": "landing.ipynb",
+    "sensitivity": "sensitivity.ipynb",
+}
+FIGURE_IDS = tuple(FIGURES)

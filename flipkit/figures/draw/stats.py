@@ -1,0 +1,174 @@
+"""Statistics panels: success ratios with Wilson intervals against the paper's, solve times,
+and the sensitivity study."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.figures.style import ACTUAL_COLOR, DESIRED_COLOR, SOLVER_COLORS, SOLVER_LABELS
+
+def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.ndarray]:
+    """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default)."""
+    k, n = np.asarray(successes, float), np.asarray(trials, float)
+    n_safe = np.where(n > 0, n, 1.0)
+    p = k / n_safe
+    den = 1 + z**2 / n_safe
+    mid = (p + z**2 / (2 * n_safe)) / den
+    half = z * np.sqrt(p * (1 - p) / n_safe + z**2 / (4 * n_safe**2)) / den
+    lo, hi = np.clip(mid - half, 0, 1), np.clip(mid + half, 0, 1)
+    return np.where(n > 0, lo, np.nan), np.where(n > 0, hi, np.nan)
+
+
+def plot_success(ax, labels, ours_k, ours_n, paper_k, paper_n, title: str = "",
+                 pooled: bool = True) -> None:
+    """Success ratios per location: ours (filled circles, 95 % Wilson interval) beside the
+    paper's (open squares); with ``pooled`` a last column "all" pools every location."""
+    labels = [str(v) for v in labels]
+    ours_k, ours_n = np.asarray(ours_k, float), np.asarray(ours_n, float)
+    paper_k, paper_n = np.asarray(paper_k, float), np.asarray(paper_n, float)
+    if pooled:
+        labels = labels + ["all"]
+        ours_k, ours_n = np.append(ours_k, ours_k.sum()), np.append(ours_n, ours_n.sum())
+        paper_k, paper_n = np.append(paper_k, paper_k.sum()), np.append(paper_n, paper_n.sum())
+    x = np.arange(len(labels), dtype=float)
+    if pooled:
+        x[-1] += 0.5
+        ax.axvline(x[-1] - 0.75, color="0.6", lw=0.6, ls=":")
+    lo, hi = wilson_interval(ours_k, ours_n)
+    ratio = np.where(ours_n > 0, ours_k / np.where(ours_n > 0, ours_n, 1), np.nan)
+    ax.errorbar(x + 0.12, ratio, yerr=[ratio - lo, hi - ratio], fmt="o", color=ACTUAL_COLOR,
+                ms=4, capsize=1.5, lw=0.8, label="ours (simulated), 95 % CI")
+    ax.plot(x - 0.12, paper_k / paper_n, "s", mfc="white", mec=DESIRED_COLOR, ms=4.5, mew=1.0,
+            label="paper (real robot)")
+    ax.set_xticks(x, labels)
+    ax.set_ylim(-0.05, 1.08)
+    ax.set_ylabel("success ratio")
+    if title:
+        ax.set_title(title)
+
+
+def plot_success_series(ax, labels, series, paper_k, paper_n, title: str = "",
+                        pooled: bool = True) -> None:
+    """Success ratios per location of several simulated pipelines side by side (each with a
+    95 % Wilson interval) beside the paper's (open squares); with ``pooled`` a last column
+    "all" pools every location.
+
+    Args:
+        ax: 2D axes. labels: Location labels.
+        series: ``[{"label", "k" (successes per location), "n" (trials per location),
+            optional "color", "marker", "open" (hollow marker)}]``, drawn left to right.
+        paper_k, paper_n: The paper's successes and trials per location.
+    """
+    labels = [str(v) for v in labels]
+    paper_k, paper_n = np.asarray(paper_k, float), np.asarray(paper_n, float)
+    if pooled:
+        labels = labels + ["all"]
+        paper_k, paper_n = np.append(paper_k, paper_k.sum()), np.append(paper_n, paper_n.sum())
+    x = np.arange(len(labels), dtype=float)
+    if pooled:
+        x[-1] += 0.5
+        ax.axvline(x[-1] - 0.75, color="0.6", lw=0.6, ls=":")
+    width = 0.7 / (len(series) + 1)
+    ax.plot(x - 0.35 + width / 2, paper_k / paper_n, "s", mfc="white", mec=DESIRED_COLOR,
+            ms=4, mew=1.0, label="paper (real robot)")
+    for j, sr in enumerate(series, 1):
+        k, n = np.asarray(sr["k"], float), np.asarray(sr["n"], float)
+        if pooled:
+            k, n = np.append(k, k.sum()), np.append(n, n.sum())
+        lo, hi = wilson_interval(k, n)
+        ratio = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
+        color = sr.get("color", f"C{j - 1}")
+        ax.errorbar(x - 0.35 + width * (j + 0.5), ratio, yerr=[ratio - lo, hi - ratio],
+                    fmt=sr.get("marker", "o"), color=color, mfc="white" if sr.get("open")
+                    else color, ms=3.5, capsize=1.2, lw=0.7, label=sr["label"])
+    ax.set_xticks(x, labels)
+    ax.set_ylim(-0.05, 1.08)
+    ax.set_ylabel("success ratio")
+    if title:
+        ax.set_title(title)
+
+
+def plot_solve_times(ax, names, times, budget: float | None = None, log: bool = True,
+                     failed=None) -> dict:
+    """Solve time per group (subbehaviour) and solver: points per location, box over them.
+
+    Args:
+        ax: 2D axes.
+        names: Group names along x (e.g. the subbehaviours and ``"total"``).
+        times: ``{solver: {name: [seconds per location]}}``; missing or None entries skipped.
+        budget: A horizontal budget line (s), e.g. the paper's 20 s per trajectory.
+        failed: Same form as ``times``: solves that did not converge, drawn as crosses.
+
+    Returns:
+        ``{solver: {name: median seconds}}``.
+    """
+    solvers = list(times)
+    width = 0.8 / max(len(solvers), 1)
+    rng = np.random.default_rng(0)
+    medians = {}
+    for k, solver in enumerate(solvers):
+        medians[solver] = {}
+        color = SOLVER_COLORS.get(solver, f"C{k}")
+        for j, name in enumerate(names):
+            vals = np.array([v for v in times[solver].get(name, []) if v is not None], float)
+            if vals.size == 0:
+                continue
+            pos = j - 0.4 + width * (k + 0.5)
+            ax.boxplot([vals], positions=[pos], widths=width * 0.8, showfliers=False,
+                       patch_artist=True, boxprops={"facecolor": color, "alpha": 0.25,
+                                                    "edgecolor": color},
+                       medianprops={"color": color, "lw": 1.5},
+                       whiskerprops={"color": color}, capprops={"color": color})
+            jitter = rng.uniform(-0.25, 0.25, vals.size) * width
+            ax.plot(pos + jitter, vals, "o", color=color, ms=2.5, alpha=0.9,
+                    label=SOLVER_LABELS.get(solver, solver) if j == 0 else None)
+            medians[solver][name] = float(np.median(vals))
+        for j, name in enumerate(names):
+            bad = np.array([v for v in (failed or {}).get(solver, {}).get(name, [])
+                            if v is not None], float)
+            if bad.size:
+                pos = j - 0.4 + width * (k + 0.5)
+                ax.plot(np.full(bad.size, pos), bad, "x", color=color, ms=4, mew=1.0,
+                        label=f"{SOLVER_LABELS.get(solver, solver)}: not converged"
+                        if not any(h.get_label().endswith(f"{SOLVER_LABELS.get(solver, solver)}"
+                                                          ": not converged")
+                                   for h in ax.lines) else None)
+    if budget is not None:
+        ax.axhline(budget, color="k", ls="--", lw=1.0,
+                   label=f"paper budget, {budget:g} s per trajectory")
+    if log:
+        ax.set_yscale("log")
+    ax.set_xticks(range(len(names)), [str(n).replace("_", " ") for n in names])
+    ax.set_xlim(-0.6, len(names) - 0.4)
+    ax.set_ylabel("solve time (s)")
+    return medians
+
+
+def plot_sensitivity(axes, result: dict, stages=("scoop", "pickup", "flip"),
+                     labels=None) -> list:
+    """One panel per stage: per parameter (rows), the success ratio at the low end
+    (down-triangle) and the high end (up-triangle) of its range, the nominal cell's ratio as
+    a vertical line. ``result`` is :func:`flipkit.experiments.sensitivity.run_sensitivity`'s.
+
+    Returns:
+        The parameter names, top to bottom.
+    """
+    names = list(result["parameters"])
+    y = np.arange(len(names))[::-1]
+    nominal = result.get("nominal")
+    for ax, stage in zip(axes, stages):
+        for end, marker, color in (("low", "v", DESIRED_COLOR), ("high", "^", ACTUAL_COLOR)):
+            r = [result["parameters"][n][end] for n in names]
+            ratio = np.array([c["success"][stage] / c["trials"] for c in r])
+            off = -0.12 if end == "low" else 0.12
+            ax.plot(ratio, y + off, marker, color=color, ms=3.5, ls="none",
+                    label=f"{end} end of range")
+        if nominal is not None:
+            ax.axvline(nominal["success"][stage] / nominal["trials"], color="0.3", lw=0.9,
+                       ls=":", label="nominal")
+        ax.set_xlim(-0.05, 1.05)
+        ax.set_ylim(-0.6, len(names) - 0.4)
+        ax.set_title(stage)
+        ax.set_xlabel("success ratio")
+        ax.set_yticks(y, labels or names)
+    return names

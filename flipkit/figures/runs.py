@@ -1,0 +1,274 @@
+"""The computations behind the figures that need plans, simulations or sweeps.
+
+* :func:`chain_translates` — the translate experiment of the paper's Fig. 6: one translate
+  plan per pair of consecutive key points, chained (each starts where the last ended, at
+  rest), gathered into one multi-segment translate :class:`~flipkit.planning.plan_file.Plan`.
+* :func:`track_plan` — simulated execution of a plan (as in the Table I trials of
+  :mod:`flipkit.experiments.trials`) beside the plan's desired spatula position.
+* :func:`nominal_trial` — one unperturbed Table I trial of a flip plan.
+* :func:`flip_solve_times` / :func:`solve_time_sweep` — solve time of every subbehaviour of
+  pickup-and-flip, per solver and location.
+* :func:`plan_targets` — the Table I plans, once, for several validations.
+* :func:`flip_execution` — one unperturbed execution (open loop or replanned) to render.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError
+from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
+
+
+def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None = None,
+                     closed: bool = True):
+    """Plan translate segments through ``points`` (m), each from the previous one's end.
+
+    Args:
+        points: Blade-centre key points (k, 3) (m), spatula flat, yaw 0.
+        solver: ``"sqp"`` or ``"ipopt"``.
+        cell: The cell (default :class:`~flipkit.config.CellConfig`).
+        closed: Return to the first point at the end (k segments instead of k − 1).
+
+    Returns:
+        ``(plan, plans)``: one translate plan holding every segment in order (status
+        ``solved`` only if every plan was solved and verified) and the individual plans
+        (each with ``failure``, ``wall_time_s`` and ``report``).
+    """
+    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.planner import plan_translate
+
+    cell = cell or CellConfig()
+    pts = [tuple(float(v) for v in p) for p in points]
+    if len(pts) < 2:
+        raise ConfigError(f"need at least two key points, got {len(pts)}")
+    goals = pts[1:] + (pts[:1] if closed else [])
+    plans, q = [], None
+    for goal in goals:
+        plan = plan_translate(pts[0] if q is None else None, goal, q_start=q, cell=cell,
+                              solver=solver)
+        plans.append(plan)
+        q = plan.segments[-1].q[-1]
+    status = "solved" if all(p.status == "solved" for p in plans) else "failed"
+    merged = Plan.from_segments("translate", cell, [p.segments[0] for p in plans],
+                                status=status)
+    return merged, plans
+
+
+@dataclass
+class Tracked:
+    """A simulated execution of a plan beside the plan itself (same samples).
+
+    Attributes:
+        t: Controller sample times (s), from 0. p, p_des: Tracked and desired blade-centre
+            positions (m), (n, 3). series: The plan's :class:`~flipkit.figures.data.PlanSeries`
+            (segment ``boundaries`` and ``names``).
+    """
+
+    t: np.ndarray
+    p: np.ndarray
+    p_des: np.ndarray
+    series: PlanSeries
+
+    def segment_errors(self) -> list[dict]:
+        """Per segment: ``name``, ``max_m`` and ``rms_m`` of |p − p_des| (m)."""
+        err = np.linalg.norm(self.p - self.p_des, axis=1)
+        b, out = self.series.boundaries, []
+        for k, name in enumerate(self.series.names):
+            sel = (self.t >= b[k] - 1e-9) & (self.t <= b[k + 1] + 1e-9)
+            out.append({"name": name, "max_m": float(err[sel].max()),
+                        "rms_m": float(np.sqrt(np.mean(err[sel] ** 2)))})
+        return out
+
+
+def track_plan(plan, rate_hz: float | None = None) -> Tracked:
+    """Simulated execution of ``plan`` exactly as the Table I trials execute it
+    (:func:`flipkit.experiments.trials.track_plan`: joint PD per segment with the plan's torques as
+    feed-forward, the arm carrying the burger where the segment does, each segment starting
+    from the previous one's tracked end), beside the desired spatula position.
+
+    The desired position is the spatula position along the cubic Hermite spline through
+    the nodes (q, q̇) — the controller's reference; the spline is local to each node
+    interval, so one spline through all segments' nodes equals the per-segment ones.
+    """
+    from scipy.interpolate import CubicHermiteSpline
+
+    from flipkit.model.robot import Robot
+    from flipkit.experiments.trials import TRACK_RATE_HZ
+    from flipkit.experiments.trials import track_plan as execute
+
+    series = plan_series(plan)
+    t, p, _, _, _ = execute(plan, rate_hz=rate_hz or TRACK_RATE_HZ)
+    q_des = CubicHermiteSpline(series.t, series.q, series.qd, axis=0)(t)
+    robot = Robot(plan.cell())
+    return Tracked(t, p, spatula_positions(robot, q_des), series)
+
+
+def nominal_trial(plan) -> dict:
+    """One Table I trial of a solved flip plan without perturbation (burger exactly at p^b,
+    nominal grill height, μ and mass): :func:`flipkit.experiments.trials.run_trial`'s result
+    (``ok`` per stage, ``failure``, ``tracking``)."""
+    import tempfile
+    from pathlib import Path
+
+    from flipkit.experiments.trials import TRACK_RATE_HZ, Perturbations, run_trial, trial_jobs
+
+    none = Perturbations(position_sigma=0.0, grill_offset=0.0, mu_scale=(1.0, 1.0),
+                         mass_scale=(1.0, 1.0))
+    with tempfile.TemporaryDirectory(prefix="flipkit-plan-") as tmp:
+        text = plan.to_json(Path(tmp) / "plan.json").read_text()
+    return run_trial(trial_jobs(text, 1, 0, none, TRACK_RATE_HZ)[0])
+
+
+# ------------------------------------------------------------------ solve times
+_WARMED: set = set()
+
+
+def _warm_sqp(cell: CellConfig, location) -> float:
+    """One SQP iteration on each of the five segment structures, once per process: cvxpy's
+    one-off compile of each QP (~2 s per structure) is set-up, not solve time (as in
+    :mod:`flipkit.experiments.bench`). Returns the time spent (s)."""
+    from flipkit.behaviors import targets as tg
+    from flipkit.behaviors.segments import build_segment
+    from flipkit.experiments.bench import warm_up
+    from flipkit.planning.planner import models_for
+
+    if cell in _WARMED:
+        return 0.0
+    models = models_for(cell)
+    q, qd, nlps = models.bare.q_home, None, []
+    for name in tg.SUBBEHAVIORS:  # the structures along the initial guesses
+        nlp = build_segment(name, models, q, qd, location=location)
+        nlps.append(nlp)
+        nodes = nlp.layout.nodes(nlp.x0)
+        q, qd = nodes[-1, 0], nodes[-1, 1]
+    spent = warm_up(nlps)
+    _WARMED.add(cell)
+    return spent
+
+
+def flip_solve_times(item) -> dict:
+    """Plan pickup-and-flip at one location with one solver and report the solve times.
+
+    Args:
+        item: ``{"location": [x, y, z], "solver": "sqp" | "ipopt"}``.
+
+    Returns:
+        JSON values: ``location``, ``solver``, ``status``, ``failure``, ``wall_time_s`` (the
+        whole call), ``warm_up_s`` (SQP compile excluded from the solve times) and
+        ``segments``: ``[{name, status, wall_time_s, iterations, T}]`` (solver wall time, s;
+        executed duration T, s) for the segments attempted.
+    """
+    from flipkit.planning.planner import plan_flip
+
+    location, solver = [float(v) for v in item["location"]], str(item["solver"])
+    cell = CellConfig()
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+        warm = _warm_sqp(cell, location) if solver == "sqp" else 0.0
+        t0 = time.perf_counter()
+        plan = plan_flip(location, cell=cell, solver=solver)
+        wall = time.perf_counter() - t0
+    return {"location": location, "solver": solver, "status": plan.status,
+            "failure": plan.failure, "wall_time_s": wall, "warm_up_s": warm,
+            "segments": [{"name": s.name, "status": s.solver.status,
+                          "wall_time_s": s.solver.wall_time_s,
+                          "iterations": s.solver.iterations, "T": s.T}
+                         for s in plan.segments]}
+
+
+def solve_time_sweep(locations, solvers=("sqp", "ipopt"), scheduler: str | None = None,
+                     progress: bool = False) -> list[dict]:
+    """:func:`flip_solve_times` for every (location, solver), location-major.
+
+    Locally the runs go one after the other in this process, so that no two solves compete
+    for the CPU and the times are those of one core; with a Dask ``scheduler`` address they
+    are spread over its workers.
+    """
+    from flipkit.experiments.sweep import make_executor, run_sweep
+
+    items = [{"location": [float(v) for v in loc], "solver": s}
+             for loc in locations for s in solvers]
+    executor = make_executor(scheduler) if scheduler else None
+    try:
+        return run_sweep(flip_solve_times, items, executor, progress=progress,
+                         desc="solve times")
+    finally:
+        if executor is not None:
+            executor.shutdown()
+
+
+def solve_time_table(rows, names) -> dict:
+    """Gather :func:`flip_solve_times` rows into the form of
+    :func:`~flipkit.figures.draw.plot_solve_times`.
+
+    Returns:
+        ``times`` and ``failed``: ``{solver: {name: [s, ...]}}`` for the segments that were
+        solved and those that were not (``"total"``: whole plans, solved ones only, in
+        ``times``); ``solved``: ``{solver: [plans solved, plans]}``.
+    """
+    times, failed, solved = {}, {}, {}
+    for r in rows:
+        s = r["solver"]
+        times.setdefault(s, {n: [] for n in names})
+        failed.setdefault(s, {n: [] for n in names})
+        solved.setdefault(s, [0, 0])
+        solved[s][1] += 1
+        for seg in r["segments"]:
+            if seg["name"] in names:
+                (times if seg["status"] == "solved" else failed)[s][seg["name"]].append(
+                    seg["wall_time_s"])
+        if r["status"] == "solved":
+            solved[s][0] += 1
+            if "total" in names:
+                times[s]["total"].append(sum(seg["wall_time_s"] for seg in r["segments"]))
+    return {"times": times, "failed": failed, "solved": solved}
+
+
+
+# ------------------------------------------------------------------ Table I plans and runs
+def plan_targets(locations, solver: str = "auto", executor=None, progress: bool = False):
+    """Plan pickup-and-flip at every location on the sweep (in a temporary directory) and
+    return the :func:`flipkit.experiments.trials.validate` targets ``[(location, plan_info, plan_text
+    or None)]``, so that one set of plans serves several validations."""
+    import tempfile
+    from pathlib import Path
+
+    from flipkit.experiments.sweep import run_sweep
+    from flipkit.experiments.trials import plan_location
+
+    with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
+        jobs = [{"location": [float(v) for v in loc], "solver": solver, "plans_dir": tmp}
+                for loc in locations]
+        infos = run_sweep(plan_location, jobs, executor, None, progress=progress, desc="plans")
+        return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},
+                 Path(r["path"]).read_text() if r["status"] == "solved" else None)
+                for job, r in zip(jobs, infos)]
+
+
+def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = True):
+    """One unperturbed execution of a plan file's text (the nominal cell), through the
+    sense-plan-act pipeline with ``replan``: ``(execution, ok)``, ``ok`` = {stage: bool}
+    (cumulative, the judges of Table I) — the run :mod:`flipkit.simulation.animate` renders."""
+    from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop
+    from flipkit.simulation.execute import execute_plan
+    from flipkit.experiments.trials import HOLD_S, landing_target, plan_from_text
+
+    replan_fn = None
+    if replan:
+        from flipkit.planning.planner import replan_flip as replan_fn
+    ex = execute_plan(plan_from_text(plan_text), mode, None, hold=HOLD_S, replan=replan_fn)
+    b = ex.bounds
+    ok = {"scoop": judge_scoop(ex.run, b["scoop"]).ok}
+    ok["pickup"] = ok["scoop"] and judge_pickup(ex.run, b["pickup"]).ok
+    ok["flip"] = ok["pickup"] and judge_flip(ex.run, b["flip"], landing_target(ex.plan)).ok
+    return ex, ok
+
+
+__all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
+           "solve_time_sweep", "solve_time_table", "plan_targets", "flip_execution"]

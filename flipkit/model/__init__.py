@@ -1,0 +1,2 @@
+"""Model layer: the arm (pinocchio), orientations, Bezier outputs, the contact cone, the
+burger's flight and inverse kinematics. Imports only :mod:`flipkit.config` and below."""

@@ -1,0 +1,200 @@
+"""The arm with its spatula: pinocchio model, spatula kinematics and inverse dynamics.
+
+Every derivative comes from pinocchio's analytic algorithms (forward-kinematics, frame
+velocity, point classical acceleration and RNEA derivatives); tests compare them with
+central finite differences.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError
+
+SPATULA_FRAME = "spatula"
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+def skew(w: np.ndarray) -> np.ndarray:
+    """3x3 matrix [w]× with [w]× v = w × v."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+@dataclass
+class SpatulaState:
+    """Spatula kinematics at one (q, q̇, q̈), world frame, with Jacobians.
+
+    Attributes:
+        p: Blade-centre position (m). R: Rotation spatula→world.
+        v: Velocity (m/s). a: Classical acceleration (m/s²).
+        dp_dq: ∂p/∂q (3x6). Jw: Angular Jacobian, dR = [Jw dq]× R (3x6).
+        dv_dq, dv_dqd: ∂v/∂q, ∂v/∂q̇. da_dq, da_dqd, da_dqdd: ∂a/∂(q, q̇, q̈).
+    """
+
+    p: np.ndarray
+    R: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    dp_dq: np.ndarray
+    Jw: np.ndarray
+    dv_dq: np.ndarray
+    dv_dqd: np.ndarray
+    da_dq: np.ndarray
+    da_dqd: np.ndarray
+    da_dqdd: np.ndarray
+
+
+class Robot:
+    """Pinocchio model of the arm plus a spatula frame and payload bodies.
+
+    Args:
+        cell: Cell configuration (robot, spatula, burger, gravity).
+        with_burger: Add the burger to the payload (it rides on the blade).
+    """
+
+    def __init__(self, cell: CellConfig | None = None, with_burger: bool = False):
+        self.cell = cell or CellConfig()
+        rc = self.cell.robot
+        self.urdf = rc.urdf_path
+        model = pin.buildModelFromUrdf(self.urdf)
+        if not model.existFrame(rc.tool_frame):
+            names = ", ".join(f.name for f in model.frames)
+            raise ConfigError(f"tool frame {rc.tool_frame!r} not in URDF; frames: {names}")
+        base = pin.SE3(np.asarray(rc.base_in_world, dtype=float))
+        for j in range(1, model.njoints):  # joints hanging from the universe move with the base
+            if model.parents[j] == 0:
+                model.jointPlacements[j] = base * model.jointPlacements[j]
+        model.gravity = pin.Motion(np.array(self.cell.gravity), np.zeros(3))
+        tool = model.frames[model.getFrameId(rc.tool_frame)]
+        self.spatula_in_parent = np.asarray(self.cell.spatula.placement_in_tool())
+        in_joint = tool.placement * pin.SE3(self.spatula_in_parent)
+        self.joint_id = tool.parentJoint
+        model.addFrame(pin.Frame(SPATULA_FRAME, tool.parentJoint, model.getFrameId(rc.tool_frame),
+                                 in_joint, pin.FrameType.OP_FRAME))
+        self.payload = self._payload(with_burger)
+        for body in self.payload:
+            model.inertias[self.joint_id] += in_joint.act(body["inertia_obj"])
+        self.model, self.data = model, model.createData()
+        self.frame_id = model.getFrameId(SPATULA_FRAME)
+        self.spatula_in_joint = in_joint
+        self.nq = model.nq
+        if self.nq != len(rc.q_home):
+            raise ConfigError(f"q_home has {len(rc.q_home)} entries, robot has {self.nq} joints")
+        self.q_home = np.array(rc.q_home)
+        self.q_min, self.q_max = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
+        self.qd_max = model.velocityLimit.copy()
+        self.u_max = model.effortLimit.copy()
+        self.qdd_max = np.full(self.nq, rc.accel_limit)
+
+    def _payload(self, with_burger: bool) -> list[dict]:
+        """Payload bodies in the spatula frame: the blade (thin plate) and the burger (disc)."""
+        sp, bg = self.cell.spatula, self.cell.burger
+        bodies = [("spatula", sp.mass, np.zeros(3),
+                   pin.Inertia.FromBox(sp.mass, sp.length, sp.width, sp.thickness))]
+        if with_burger:
+            com = np.array([0.0, 0.0, (sp.thickness + bg.thickness) / 2])
+            bodies.append(("burger", bg.mass, com, pin.Inertia.FromCylinder(
+                bg.mass, bg.diameter / 2, bg.thickness)))
+        out = []
+        for name, mass, com, inertia in bodies:
+            body = pin.Inertia(mass, com, inertia.inertia)
+            out.append({"name": name, "parent_frame": SPATULA_FRAME, "mass": mass,
+                        "com": com, "inertia": body.inertia.copy(), "inertia_obj": body})
+        return out
+
+    # ----------------------------------------------------------------- kinematics
+    def placement(self, q) -> pin.SE3:
+        """World placement of the spatula frame at q."""
+        pin.framesForwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
+        return self.data.oMf[self.frame_id].copy()
+
+    def position(self, q) -> np.ndarray:
+        """Blade-centre position p(q) (m)."""
+        return self.placement(q).translation
+
+    def rotation(self, q) -> np.ndarray:
+        """Rotation R(q) of the spatula frame in the world."""
+        return self.placement(q).rotation
+
+    def pose_jacobians(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """p, R, ∂p/∂q and the angular Jacobian Jw (dR = [Jw dq]× R) at q."""
+        q = np.asarray(q, dtype=float)
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
+        J = pin.getFrameJacobian(self.model, self.data, self.frame_id, LWA)
+        M = self.data.oMf[self.frame_id]
+        return M.translation.copy(), M.rotation.copy(), J[:3].copy(), J[3:].copy()
+
+    def state(self, q, qd, qdd, point=None) -> SpatulaState:
+        """Spatula position, orientation, velocity, classical acceleration and Jacobians.
+
+        Args:
+            q, qd, qdd: Joint state (rad, rad/s, rad/s²).
+            point: A point of the blade in the spatula frame (m) whose position, velocity
+                and acceleration to give instead of the blade centre's (e.g. where the burger
+                lies); the rotation is the spatula's either way.
+        """
+        m, d = self.model, self.data
+        q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
+        pin.computeForwardKinematicsDerivatives(m, d, q, qd, qdd)
+        pin.computeJointJacobians(m, d, q)
+        pin.updateFramePlacements(m, d)
+        J = pin.getFrameJacobian(m, d, self.frame_id, LWA)
+        M = d.oMf[self.frame_id]
+        placement = self.spatula_in_joint
+        if point is not None:
+            placement = placement * pin.SE3(np.eye(3), np.asarray(point, dtype=float))
+        v_dq, a_dq, a_dqd, a_dqdd = pin.getPointClassicAccelerationDerivatives(
+            m, d, self.joint_id, placement, LWA)
+        acc = pin.getFrameClassicalAcceleration(m, d, self.frame_id, LWA).linear
+        Jv, p, v = J[:3].copy(), M.translation.copy(), J[:3] @ qd
+        if point is not None:  # rigid-body transport from the blade centre to the point
+            r, w = M.rotation @ np.asarray(point, dtype=float), J[3:] @ qd
+            alpha = pin.getFrameAcceleration(m, d, self.frame_id, LWA).angular
+            acc = acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+            Jv, p, v = Jv - skew(r) @ J[3:], p + r, v + np.cross(w, r)
+        return SpatulaState(p=p, R=M.rotation.copy(), v=v, a=np.array(acc), dp_dq=Jv,
+                            Jw=J[3:].copy(), dv_dq=np.array(v_dq), dv_dqd=Jv.copy(),
+                            da_dq=np.array(a_dq), da_dqd=np.array(a_dqd),
+                            da_dqdd=np.array(a_dqdd))
+
+    def angular_velocity_jacobian(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+        """Spatula angular velocity ω = J_ω q̇ (world, rad/s) and ∂ω/∂q (3×nq); ∂ω/∂q̇ = J_ω.
+
+        From pinocchio's frame velocity derivatives; only their angular rows are used (the
+        linear rows of the LOCAL_WORLD_ALIGNED derivative are not ∂v/∂q of the frame origin —
+        :meth:`state` gives that one)."""
+        m, d = self.model, self.data
+        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+        pin.computeForwardKinematicsDerivatives(m, d, q, qd, np.zeros(self.nq))
+        pin.updateFramePlacements(m, d)
+        dv_dq, _ = pin.getFrameVelocityDerivatives(m, d, self.frame_id, LWA)
+        w = pin.getFrameVelocity(m, d, self.frame_id, LWA).angular
+        return np.array(w), np.array(dv_dq[3:])
+
+    # ----------------------------------------------------------------- dynamics
+    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
+        """D(q)q̈ + C(q,q̇)q̇ + G(q) by RNEA (N·m), payload included."""
+        return pin.rnea(self.model, self.data, *(np.asarray(x, float) for x in (q, qd, qdd))).copy()
+
+    def dynamics_residual(self, q, qd, qdd, u) -> np.ndarray:
+        """Residual r = D q̈ + C q̇ + G − B u of eq. (1)/(7), with B = I (N·m)."""
+        return self.inverse_dynamics(q, qd, qdd) - np.asarray(u, dtype=float)
+
+    def dynamics_residual_jacobians(self, q, qd, qdd):
+        """r and ∂r/∂q, ∂r/∂q̇, ∂r/∂q̈ (= D), ∂r/∂u (= −I) from RNEA derivatives."""
+        q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
+        dq, dqd, dqdd = pin.computeRNEADerivatives(self.model, self.data, q, qd, qdd)
+        tau = self.data.tau.copy()
+        return tau, np.array(dq), np.array(dqd), np.array(dqdd), -np.eye(self.nq)
+
+    def payload_json(self) -> list[dict]:
+        """The payload list of the plan file."""
+        return [{"name": b["name"], "parent_frame": b["parent_frame"], "mass": float(b["mass"]),
+                 "com": [float(x) for x in b["com"]],
+                 "inertia": [[float(x) for x in row] for row in b["inertia"]]}
+                for b in self.payload]

@@ -1,0 +1,265 @@
+"""The plan file ``flipkit-plan/1`` (JSON): a planned trajectory with everything needed to
+check or execute it without the objects that made it (DESIGN.md, "Plan file").
+
+:class:`Plan` and :class:`Segment` mirror the file key for key. Constructors validate their
+arguments and raise :class:`~flipkit.errors.ConfigError` naming the field;
+:meth:`Plan.load` turns every problem (missing file, not JSON, wrong format, missing key,
+wrong shape, non-finite number, unknown name) into a one-line
+:class:`~flipkit.errors.PlanFileError` naming the file and the key path, e.g.
+``plan.json: segments[2].q: expected shape (21, 6), got (20, 6)``.
+
+The format is documented in ``docs/plan-format.md`` (JSON Schema beside it). Beyond
+DESIGN.md's seed: ``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a
+``translate`` segment (optional) — and, on a flip segment, ``release`` (node, time) and the
+predicted ``landing`` (target, r_land, point, offset, tilt_deg, time_of_flight), checked by
+:mod:`flipkit.planning.verify`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from flipkit import __version__
+from flipkit.behaviors.segments import CARRIES_BURGER
+from flipkit.config import BurgerConfig, CellConfig, GrillConfig, RobotConfig, SpatulaConfig
+from flipkit.model.contact import CONE_FORMS
+from flipkit.errors import ConfigError, PlanFileError
+from flipkit.behaviors.targets import SUBBEHAVIORS
+from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
+                                          check_number, check_text, dumps)
+from flipkit.planning.segment import SEGMENT_KEYS, Segment
+from flipkit.provenance import git_commit
+
+FORMAT = "flipkit-plan/1"
+PLAN_BEHAVIORS = ("translate", "flip")
+PLAN_STATUSES = ("solved", "failed")
+PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
+
+
+
+def _created_by() -> dict:
+    return {"flipkit": __version__, "git": git_commit()}
+
+
+_ROBOT_KEYS = ("urdf", "base_in_world", "tool_parent_frame", "spatula_in_parent", "payload",
+               "q_home")
+_BURGER_KEYS = ("location", "diameter", "thickness", "mass", "mu")
+
+
+@dataclass
+class Plan:
+    """A plan file in memory; attribute names and nesting are the file's (DESIGN.md).
+
+    Attributes:
+        behavior: ``translate`` or ``flip``. status: ``solved`` or ``failed``.
+        robot: ``urdf`` (path), ``base_in_world`` and ``spatula_in_parent`` (4x4, m),
+            ``tool_parent_frame``, ``payload`` (bodies: mass kg, com m, inertia kg·m² in the
+            spatula frame) and ``q_home`` (rad). The payload is that of the model carrying
+            the burger; segments that do not carry it (CARRIES_BURGER) omit the burger body.
+        gravity: (3,) m/s². grill_height: h_g (m). spatula: ``length``, ``width`` (m).
+        burger: ``location`` p^b (3,) m or None, ``diameter``, ``thickness`` (m), ``mass``
+            (kg), ``mu``. cone: Friction-cone form. segments: The :class:`Segment` list.
+        created_by: ``{"flipkit": version, "git": commit or None}``. format: FORMAT.
+    """
+
+    behavior: str
+    status: str
+    robot: dict
+    gravity: np.ndarray
+    grill_height: float
+    spatula: dict
+    burger: dict
+    cone: str
+    segments: list
+    created_by: dict = field(default_factory=_created_by)
+    format: str = FORMAT
+
+    def __post_init__(self):
+        check_choice("format", self.format, (FORMAT,))
+        check_choice("behavior", self.behavior, PLAN_BEHAVIORS)
+        check_choice("status", self.status, PLAN_STATUSES)
+        check_choice("cone", self.cone, CONE_FORMS)
+        cb = check_keys(self.created_by, "created_by", ("flipkit", "git"))
+        check_text("created_by.flipkit", cb["flipkit"])
+        if cb["git"] is not None:
+            check_text("created_by.git", cb["git"])
+        r = check_keys(self.robot, "robot", _ROBOT_KEYS)
+        for key in ("urdf", "tool_parent_frame"):
+            check_text(f"robot.{key}", r[key])
+        for key, shape in (("base_in_world", (4, 4)), ("spatula_in_parent", (4, 4)),
+                           ("q_home", (None,))):
+            r[key] = check_array(f"robot.{key}", r[key], shape)
+        if not isinstance(r["payload"], list):
+            raise ConfigError("robot.payload: expected a list of bodies")
+        r["payload"] = [self._body(k, body) for k, body in enumerate(r["payload"])]
+        self.robot = {**self.robot, **r}
+        self.gravity = check_array("gravity", self.gravity, (3,))
+        self.grill_height = check_number("grill_height", self.grill_height)
+        self.spatula = {k: check_number(f"spatula.{k}", v, positive=True)
+                        for k, v in check_keys(self.spatula, "spatula", ("length", "width")).items()}
+        b = check_keys(self.burger, "burger", _BURGER_KEYS)
+        self.burger = {k: check_number(f"burger.{k}", b[k], positive=True) for k in _BURGER_KEYS[1:]}
+        self.burger["location"] = None if b["location"] is None else check_array(
+            "burger.location", b["location"], (3,))
+        self._check_segments()
+
+    @staticmethod
+    def _body(k: int, body) -> dict:
+        """A payload body as plain JSON values (name optional)."""
+        where = f"robot.payload[{k}]"
+        b = check_keys(body, where, ("parent_frame", "mass", "com", "inertia"))
+        out = {"name": check_text(f"{where}.name", body["name"])} if "name" in body else {}
+        return {**out, "parent_frame": check_text(f"{where}.parent_frame", b["parent_frame"]),
+                "mass": check_number(f"{where}.mass", b["mass"], positive=True),
+                "com": check_array(f"{where}.com", b["com"], (3,)).tolist(),
+                "inertia": check_array(f"{where}.inertia", b["inertia"], (3, 3)).tolist()}
+
+    def _check_segments(self) -> None:
+        if not isinstance(self.segments, list) or not self.segments:
+            raise ConfigError("segments: expected a non-empty list of segments")
+        nq, names = self.robot["q_home"].size, []
+        for k, seg in enumerate(self.segments):
+            if isinstance(seg, dict):
+                keys = SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing")
+                                             if k in seg)
+                seg = self.segments[k] = check_nested(f"segments[{k}]", Segment, seg, keys)
+            if not isinstance(seg, Segment):
+                raise ConfigError(f"segments[{k}]: expected a segment")
+            if seg.q.shape[1] != nq:
+                raise ConfigError(f"segments[{k}].q: {seg.q.shape[1]} joints, "
+                                  f"robot.q_home has {nq}")
+            names.append(seg.name)
+        allowed = ("translate",) if self.behavior == "translate" else SUBBEHAVIORS
+        order = [allowed.index(n) if n in allowed else -1 for n in names]
+        if -1 in order or (self.behavior == "flip" and order != sorted(set(order))):
+            raise ConfigError(f"segments: names {names} do not fit behavior {self.behavior!r} "
+                              f"(expected {', '.join(allowed)}"
+                              f"{' in this order' if len(allowed) > 1 else ''})")
+        if self.behavior == "flip" and self.burger["location"] is None:
+            raise ConfigError("burger.location: a flip plan needs the burger location")
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def from_segments(cls, behavior: str, cell: CellConfig, segments: list, *, location=None,
+                      cone: str = "physical", status: str | None = None) -> "Plan":
+        """A plan of ``segments`` planned in ``cell``; status ``solved`` if every segment's
+        solver says so (check it with :func:`flipkit.planning.verify.verify_plan` before writing)."""
+        from flipkit.model.robot import Robot
+
+        robot = Robot(cell, with_burger=True)
+        if status is None:
+            status = "solved" if all(s.solver.status == "solved" for s in segments) else "failed"
+        return cls(behavior, status, {
+            "urdf": robot.urdf, "base_in_world": np.asarray(cell.robot.base_in_world, float),
+            "tool_parent_frame": cell.robot.tool_frame,
+            "spatula_in_parent": robot.spatula_in_parent, "payload": robot.payload_json(),
+            "q_home": robot.q_home},
+            np.asarray(cell.gravity, float), cell.grill.height,
+            {"length": cell.spatula.length, "width": cell.spatula.width},
+            {"location": None if location is None else list(location),
+             **{k: getattr(cell.burger, k) for k in _BURGER_KEYS[1:]}}, cone, list(segments))
+
+    def cell(self) -> CellConfig:
+        """The cell the plan was made in, rebuilt from the file (task-space limits, grill and
+        table areas and the acceleration limit are not recorded: defaults are used).
+
+        Raises:
+            PlanFileError: The URDF is missing here, or the spatula cannot be rebuilt.
+        """
+        r, w = self.robot, self.spatula["width"]
+        spatula = next((b for b in r["payload"] if b.get("name", "spatula") == "spatula"), None)
+        if spatula is None:
+            raise PlanFileError("robot.payload: no spatula body")
+        m, Ixx = float(spatula["mass"]), float(np.asarray(spatula["inertia"])[0][0])
+        thickness2 = 12 * Ixx / m - w**2  # thin box: I_xx = m (w² + t²) / 12
+        try:
+            return CellConfig(
+                robot=RobotConfig(urdf=r["urdf"], tool_frame=r["tool_parent_frame"],
+                                  base_in_world=tuple(map(tuple, r["base_in_world"])),
+                                  q_home=tuple(r["q_home"])),
+                spatula=SpatulaConfig(self.spatula["length"], w, np.sqrt(max(thickness2, 0.0)),
+                                      float(r["spatula_in_parent"][2, 3]), m),
+                burger=BurgerConfig(**{k: self.burger[k] for k in _BURGER_KEYS[1:]}),
+                grill=GrillConfig(height=self.grill_height), gravity=tuple(self.gravity))
+        except ConfigError as exc:
+            raise PlanFileError(f"cannot rebuild the cell from the plan: {exc}") from None
+
+    def robot_for(self, name: str, cell: CellConfig | None = None):
+        """The dynamics model of segment ``name`` (burger on the blade per CARRIES_BURGER),
+        checked against the recorded mount and payload.
+
+        Raises:
+            PlanFileError: The rebuilt model's spatula mount or payload differs from the file's.
+        """
+        from flipkit.model.robot import Robot
+
+        robot = Robot(cell or self.cell(), with_burger=CARRIES_BURGER[name])
+        if not np.allclose(robot.spatula_in_parent, self.robot["spatula_in_parent"], atol=1e-9):
+            raise PlanFileError("robot.spatula_in_parent: not the flipkit spatula mount")
+        recorded, mine = self.robot["payload"], robot.payload_json()
+        if len(recorded) < len(mine) or (CARRIES_BURGER[name] and len(recorded) != len(mine)):
+            raise PlanFileError(f"robot.payload: {len(recorded)} bodies, the model of segment "
+                                f"{name!r} has {len(mine)}")
+        for k, body in enumerate(mine):
+            if not all(np.allclose(body[key], recorded[k][key], rtol=PAYLOAD_RTOL, atol=1e-12)
+                       for key in ("mass", "com", "inertia")):
+                raise PlanFileError(f"robot.payload[{k}]: does not match the {body['name']} "
+                                    "rebuilt from the spatula and burger of the plan")
+        return robot
+
+    # ------------------------------------------------------------------ file
+    def to_json(self, path) -> Path:
+        """Write the plan to ``path`` (atomically) and return the path."""
+        """Write the plan to ``path`` (atomically: a temporary file, then renamed).
+
+        Raises:
+            PlanFileError: The file cannot be written.
+        """
+        robot = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                 for k, v in ((k, self.robot[k]) for k in _ROBOT_KEYS)}
+        loc = self.burger["location"]
+        doc = {"format": self.format, "behavior": self.behavior, "status": self.status,
+               "created_by": dict(self.created_by), "robot": robot,
+               "gravity": self.gravity.tolist(), "grill_height": self.grill_height,
+               "spatula": dict(self.spatula),
+               "burger": {"location": None if loc is None else loc.tolist(),
+                          **{k: self.burger[k] for k in _BURGER_KEYS[1:]}},
+               "cone": self.cone, "segments": [s.to_json() for s in self.segments]}
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        try:
+            tmp.write_text(dumps(doc) + "\n")
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise PlanFileError(f"{path}: cannot write plan file ({exc.strerror or exc})") from None
+        return path
+
+    @classmethod
+    def load(cls, path) -> "Plan":
+        """Read and validate a plan file.
+
+        Raises:
+            PlanFileError: Missing or unreadable file, not JSON, or not ``flipkit-plan/1``
+                (the one-line message names the file and the offending key).
+        """
+        path = Path(path)
+        try:
+            doc = json.loads(path.read_text())
+        except OSError as exc:
+            raise PlanFileError(f"{path}: cannot read plan file ({exc.strerror or exc})") from None
+        except (UnicodeDecodeError, ValueError) as exc:
+            msg = str(exc).splitlines()[0]
+            raise PlanFileError(f"{path}: not a JSON file ({msg})") from None
+        try:
+            if isinstance(doc, dict) and doc.get("format") != FORMAT:
+                raise ConfigError(f"format: expected {FORMAT!r}, got {doc.get('format')!r}")
+            keys = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
+                    "cone", "segments", "created_by")
+            return cls(**check_keys(doc, "", keys))
+        except ConfigError as exc:
+            raise PlanFileError(f"{path}: {exc}") from None

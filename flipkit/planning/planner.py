@@ -1,0 +1,383 @@
+"""Planning front end: translate, pickup-and-flip and batches of burgers, checked plans.
+
+Each entry point builds the segment NLPs (:mod:`flipkit.behaviors.segments`), solves them with the
+SQP or IPOPT (:func:`solve_segment`), wraps them in a :class:`~flipkit.planning.plan_file.Plan` and runs
+the independent check :func:`~flipkit.planning.verify.verify_plan`. A plan's ``status`` is
+``"solved"`` only if every segment's solver converged *and* the check passes; otherwise it
+is ``"failed"`` and the attribute ``plan.failure`` (not written to the file) holds a one-line
+reason, e.g. ``"pickup: cone violated by 3.2e-04 (sqp: stalled)"``. Every plan returned also
+carries ``plan.report`` (the verification report) and ``plan.wall_time_s`` (s, the whole
+call: IK, building, solving, checking).
+
+Bad input (non-finite or out-of-area positions, poses out of reach, joint vectors of the
+wrong size or outside the limits) raises a one-line :class:`~flipkit.errors.FlipkitError`
+before anything is solved.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.model.ik import solve_pose
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.segment import Segment
+from flipkit.solvers.result import SolveResult
+from flipkit.planning.verify import verify_plan
+
+SOLVERS = ("sqp", "ipopt", "auto")
+MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
+_MODELS: dict = {}
+
+
+def models_for(cell: CellConfig) -> Models:
+    """The :class:`~flipkit.behaviors.segments.Models` of ``cell``, built once per cell and cached."""
+    try:
+        models = _MODELS.get(cell)
+    except TypeError:  # unhashable (lists inside the config): build without caching
+        return Models(cell)
+    if models is None:
+        models = _MODELS[cell] = Models(cell)
+    return models
+
+
+def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
+    """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
+
+    ``auto`` runs the SQP and, when it fails, IPOPT from the same start; the segment's
+    ``solver.name`` in the plan file records which one produced it and the wall time counts
+    both.
+
+    Returns the result whatever its status (``result.success`` tells); the worst constraint
+    group of a failure is ``nlp.worst_group(result.x)``.
+
+    Raises:
+        InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
+    """
+    if solver == "sqp":
+        import cvxpy as cp
+
+        from flipkit.solvers.sqp import solve_sqp
+
+        try:
+            return solve_sqp(nlp, x0, raise_on_failure=False)
+        except cp.error.SolverError:  # OSQP broke down inside a subproblem
+            x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
+            return SolveResult(x=x, status="qp_solver_error", iterations=0, wall_time_s=0.0,
+                               objective=nlp.objective(x), max_violation=float(
+                                   nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
+    if solver == "ipopt":
+        from flipkit.solvers.ipopt import solve_ipopt
+
+        return solve_ipopt(nlp, x0, raise_on_failure=False)
+    if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
+        first = solve_segment(nlp, "sqp", x0)
+        if first.success:
+            return first
+        second = solve_segment(nlp, "ipopt", x0)
+        second.wall_time_s += first.wall_time_s
+        return second
+    raise InvalidChoiceError("solver", solver, SOLVERS)
+
+
+def _position(what: str, value, cell: CellConfig) -> np.ndarray:
+    """``value`` as a finite 3-vector (m) inside the task-space box of ``cell``."""
+    try:
+        p = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{what} must be three numbers (m), got {value!r}") from None
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ConfigError(f"{what} must be three finite numbers (m), got {np.ravel(p).tolist()}")
+    lo, hi = np.asarray(cell.limits.p_min), np.asarray(cell.limits.p_max)
+    if np.any(p < lo) or np.any(p > hi):
+        box = ", ".join(f"{a} in [{lo[k]:g}, {hi[k]:g}]" for k, a in enumerate("xyz"))
+        raise UnreachableError(f"{what} ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) m is outside the "
+                               f"reachable task area {box} m")
+    return p
+
+
+def _joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
+    """``value`` as a finite joint vector of len(lo) within [lo, hi]."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{what} must be {len(lo)} numbers ({unit}), got {value!r}") from None
+    if v.shape != np.shape(lo):
+        raise ConfigError(f"{what} must have {len(lo)} values ({unit}), got {v.size}")
+    if not np.all(np.isfinite(v)):
+        raise ConfigError(f"{what} must be finite, got {v.tolist()}")
+    bad = np.flatnonzero((v < lo) | (v > hi))
+    if bad.size:
+        j = int(bad[0])
+        raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
+                          f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
+    return v
+
+
+def _finish(plan: Plan, failure: str | None, t0: float) -> Plan:
+    """Verify ``plan``; set status, ``failure``, ``report`` and ``wall_time_s``."""
+    plan.report = verify_plan(plan)
+    if failure is None and not plan.report.ok:
+        group, k, amount = plan.report.worst()
+        failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"
+    plan.status, plan.failure = ("failed", failure) if failure else ("solved", None)
+    plan.wall_time_s = time.perf_counter() - t0
+    return plan
+
+
+def _solver_failure(name: str, nlp, result) -> str:
+    group, amount = nlp.worst_group(result.x)
+    return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status})"
+
+
+def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "auto",
+                   q_start=None, yaw: float = 0.0,
+                   options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Carry the burger on a flat spatula from ``start`` to ``goal`` (paper eq. 9), at rest
+    at both ends.
+
+    Args:
+        start: Blade-centre start position (m); the start configuration is the IK solution
+            near q_home for a flat spatula with heading ``yaw``. May be ``None`` if
+            ``q_start`` is given.
+        goal: Blade-centre goal position (m); the spatula ends flat with heading ``yaw``.
+        cell: The cell (default :class:`~flipkit.config.CellConfig`).
+        solver: ``"auto"`` (default: the SQP, then IPOPT from the same start where the SQP
+            fails), ``"sqp"`` or ``"ipopt"``.
+        q_start: Start configuration (rad) instead of the IK one; must lie within the joint
+            limits and, if ``start`` is given too, put the blade within 1 mm of it.
+        yaw: Heading o_z of the spatula (rad).
+        options: Transcription options.
+
+    Raises:
+        ConfigError: Malformed input. UnreachableError: A position outside the task area or
+            out of reach. InvalidChoiceError: Unknown solver.
+    """
+    t0, cell = time.perf_counter(), cell or CellConfig()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    models = models_for(cell)
+    robot = models.for_segment("translate")
+    p_goal = _position("translate goal", goal, cell)
+    if not np.isfinite(yaw):
+        raise ConfigError(f"yaw must be finite (rad), got {yaw!r}")
+    if q_start is None:
+        if start is None:
+            raise ConfigError("translate needs a start position or a start configuration")
+        p_start = _position("translate start", start, cell)
+        try:
+            q0 = solve_pose(robot, p_start, (0.0, 0.0, yaw), robot.q_home)
+        except UnreachableError as exc:
+            raise UnreachableError(f"translate start: {exc}") from None
+    else:
+        q0 = _joint_vector("start configuration", q_start, robot.q_min, robot.q_max, "rad")
+        if start is not None:
+            gap = np.linalg.norm(robot.position(q0) - _position("translate start", start, cell))
+            if gap > 1e-3:
+                raise ConfigError(f"start configuration puts the blade {gap * 1e3:.1f} mm from "
+                                  "the start position; give one of them")
+    try:
+        solve_pose(robot, p_goal, (0.0, 0.0, yaw), q0)  # reachability, clear message
+        nlp = build_segment("translate", models, q0, location=None,
+                            goal=flat_pose(p_goal, yaw), options=options)
+    except UnreachableError as exc:
+        raise UnreachableError(f"translate goal: {exc}") from None
+    result = solve_segment(nlp, solver)
+    plan = Plan.from_segments("translate", cell, [Segment.from_solution(nlp, result)],
+                              cone=options.cone, status="failed")
+    return _finish(plan, None if result.success else _solver_failure("translate", nlp, result), t0)
+
+
+def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
+              solver: str = "auto", land=None, on_blade=(0.0, 0.0),
+              options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Pick up and flip the burger at ``location``: the five subbehaviours of
+    :data:`~flipkit.behaviors.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
+    previous segment's final (q, q̇).
+
+    Args:
+        location: Burger location p^b (m), on the grill (:func:`~flipkit.behaviors.targets.check_location`).
+        q_start: Start configuration (rad), default q_home.
+        qd_start: Start joint velocities (rad/s), default rest.
+        land: Landing spot (x, y) (m) on the grill; default where the burger was picked up.
+            The flipped burger's centre must land within ``options.r_land`` of it.
+        on_blade: Where the burger's centre will sit on the blade (x, y) (blade frame, m)
+            when it is released; default the blade centre.
+        cell, solver, options: As :func:`plan_translate`.
+
+    Returns:
+        The plan. On a segment failure the chain stops there: the plan holds the segments
+        up to and including the failed one, and ``plan.failure`` names it, the worst
+        constraint group and its violation.
+
+    Raises:
+        UnreachableError: Location off the grill, or the first segment out of reach.
+        ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
+    """
+    t0, cell = time.perf_counter(), cell or CellConfig()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    pb = tg.check_location(cell, location)
+    spot = None if land is None else tg.check_spot(cell, land)
+    on_blade = _on_blade(on_blade, cell)
+    models = models_for(cell)
+    robot = models.bare
+    q = robot.q_home.copy() if q_start is None else _joint_vector(
+        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
+    qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
+        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0)
+
+
+def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
+    """(x, y) (m) of the burger's centre on the blade, on the blade, or ConfigError."""
+    xy = np.asarray(on_blade, dtype=float).ravel()
+    sp = cell.spatula
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or abs(xy[0]) > sp.length / 2 or abs(
+            xy[1]) > sp.width / 2:
+        raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
+                          f", ±{sp.width / 2} m, got {on_blade!r}")
+    return xy
+
+
+def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0) -> Plan:
+    """Solve the subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
+    segments, failure = list(done), None
+    for name in tg.SUBBEHAVIORS[len(done):]:
+        try:
+            nlp = build_segment(name, models, q, qd, location=pb, land=spot, on_blade=on_blade,
+                                options=options)
+        except FlipkitError as exc:
+            if not segments:
+                raise
+            failure = f"{name}: cannot build the initial guess ({exc})"
+            break
+        result = solve_segment(nlp, solver)
+        seg = Segment.from_solution(nlp, result)
+        segments.append(seg)
+        if not result.success:
+            failure = _solver_failure(name, nlp, result)
+            break
+        q, qd = seg.q[-1], seg.qd[-1]
+    plan = Plan.from_segments("flip", cell, segments, location=pb, cone=options.cone,
+                              status="failed")
+    return _finish(plan, failure, t0)
+
+
+def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
+                options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
+    ``on_blade`` on the blade after the scoop (sense, plan, act).
+
+    The scoop ends at rest with the blade flat on the grill and the burger on it, so the cell
+    can measure where the burger lies on the blade (a scoop drags it forward, by 2–7 cm in
+    simulation) and wait there while this runs. Go to burger, scoop and pickup are kept (the
+    pickup's constraints do not depend on where the burger lies); the flip is solved again
+    with the release state of a burger at ``on_blade``, to the plan's landing target, then the
+    turn back from its end; the result is checked like any plan. (Starting the flip from the
+    plan's own flip instead of the usual initial guess did not save iterations: 23 vs 20 at
+    Table I location 7, measured.)
+
+    Args:
+        plan: A solved flip plan. on_blade: (x, y) of the burger's centre in the blade frame
+            (m). solver, options: As :func:`plan_flip` (``r_land`` from the plan's landing).
+
+    Raises:
+        ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
+    """
+    t0 = time.perf_counter()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    if plan.behavior != "flip" or plan.status != "solved":
+        raise ConfigError("replan_flip needs a solved flip plan")
+    cell = plan.cell()
+    flip = next(s for s in plan.segments if s.name == "flip")
+    on_blade = _on_blade(on_blade, cell)
+    options = replace(options, r_land=flip.landing["r_land"], cone=plan.cone)
+    done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
+    return _chain(np.asarray(plan.burger["location"], float), done[-1].q[-1], done[-1].qd[-1],
+                  done, models_for(cell), cell, solver, np.asarray(flip.landing["target"]),
+                  on_blade, options, t0)
+
+
+def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
+               progress: bool = True, options: SegmentOptions = SegmentOptions()) -> list[Plan]:
+    """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
+
+    Burger k starts where the last *solved* plan ended (a solved flip ends at q_home at
+    rest); a failed plan is not executed, so it does not move the start of the next one.
+
+    Args:
+        locations: Burger locations p^b (m), in order.
+        q_start: Start configuration of the first burger (rad), default q_home.
+        progress: Show a tqdm progress bar (stderr).
+        cell, solver, options: As :func:`plan_flip`.
+
+    Raises:
+        ConfigError: No location, more than :data:`MAX_BATCH`, or a malformed start.
+        UnreachableError: A location off the grill (named by its index, from 1).
+    """
+    from tqdm import tqdm
+
+    cell = cell or CellConfig()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    locs = list(locations)
+    if not 1 <= len(locs) <= MAX_BATCH:
+        raise ConfigError(f"a batch takes 1 to {MAX_BATCH} burger locations, got {len(locs)}")
+    checked = []
+    for k, loc in enumerate(locs, 1):
+        try:
+            checked.append(tg.check_location(cell, loc))
+        except UnreachableError as exc:
+            raise UnreachableError(f"burger {k}: {exc}") from None
+    q, qd, plans = q_start, None, []
+    bar = tqdm(checked, desc="burgers", unit="burger", disable=not progress)
+    for k, pb in enumerate(bar, 1):
+        try:
+            plan = plan_flip(pb, q, qd, cell=cell, solver=solver, options=options)
+        except FlipkitError as exc:
+            raise type(exc)(f"burger {k}: {exc}") from None
+        plans.append(plan)
+        bar.set_postfix_str(f"burger {k}: {plan.status}")
+        if plan.status == "solved":
+            q, qd = plan.segments[-1].q[-1], plan.segments[-1].qd[-1]
+    return plans
+
+
+SUMMARY_HEADER = ("burger", "location_m", "status", "solve_time_s", "iterations",
+                  "max_violation")
+
+
+def summary_table(plans) -> list[tuple]:
+    """One row per plan (:data:`SUMMARY_HEADER`): burger index (from 1), location (m),
+    status, solve time (s, sum over segments), iterations (sum) and the largest max scaled
+    violation reported by the solvers."""
+    rows = []
+    for k, plan in enumerate(plans, 1):
+        loc = plan.burger["location"]
+        rows.append((k, None if loc is None else tuple(float(v) for v in loc), plan.status,
+                     sum(s.solver.wall_time_s for s in plan.segments),
+                     sum(s.solver.iterations for s in plan.segments),
+                     max(s.solver.max_violation for s in plan.segments)))
+    return rows
+
+
+def format_summary(rows) -> str:
+    """:func:`summary_table` rows as an aligned text table."""
+    lines = [f"{'burger':>6}  {'location (m)':<24}{'status':<8}{'solve s':>9}{'iters':>7}"
+             f"{'max viol':>10}"]
+    for k, loc, status, t, its, viol in rows:
+        where = "-" if loc is None else "(" + ", ".join(f"{v:.3f}" for v in loc) + ")"
+        lines.append(f"{k:>6}  {where:<24}{status:<8}{t:>9.2f}{its:>7d}{viol:>10.1e}")
+    return "\n".join(lines)
+
+
+__all__ = ["SOLVERS", "MAX_BATCH", "SUMMARY_HEADER", "models_for", "solve_segment",
+           "plan_translate", "plan_flip", "plan_batch", "summary_table", "format_summary"]

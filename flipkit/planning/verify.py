@@ -1,0 +1,288 @@
+"""Independent residual check of a plan: recomputed from the plan's arrays alone.
+
+Nothing here uses :mod:`flipkit.transcription.nlp` or :mod:`flipkit.transcription.constraints`; kinematics and dynamics
+come from pinocchio through :class:`~flipkit.model.robot.Robot` rebuilt from the plan file, targets
+from :mod:`flipkit.behaviors.targets`, and from :mod:`flipkit.behaviors.segments` only the tables T_BOUNDS,
+CARRIES_BURGER, SCOOP_PRESS, SCOOP_TIP_BAND and grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+
+=================  ==========================================================  ==============
+group              what                                                        tolerance
+=================  ==========================================================  ==============
+time_grid          t_i = iT/N; T within the behaviour's T_BOUNDS (s)           1e-9 s; tol
+dynamics           RNEA(q_i, q̇_i, q̈_i) − u_i, payload per segment (N·m)        tol·u_max/10
+defects            Hermite–Simpson interpolation and Simpson defects (rad,     tol
+                   rad/s) at the odd nodes, x = (q, q̇), ẋ = (q̇, q̈)
+q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         tol, tol,
+                                                                               10·tol,
+                                                                               tol·u_max/10
+endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
+                   both ends, o_x = o_y = 0 and the ``goal`` if recorded
+behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip   tol
+                   normal, x axis, height band
+continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
+cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
+                   (flip: nodes ≤ max(0.6 N, release node))
+grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m):  tol
+                   h_g, pressed SCOOP_PRESS into it on scoop and pickup,
+                   a burger's thickness above it on turn back (grill_floor)
+landing            flip: landing recomputed (:mod:`flipkit.planning.verify_flight`):    0.1 mm,
+                   within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
+flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
+=================  ==========================================================  ==============
+
+``tol`` (:data:`TOL` = 1e-5) is in the solver's scaled units, so every group's tolerance is
+10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
+and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
+duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
+Task-space bounds (cell.limits) are not recorded in the plan file and not checked.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flipkit.behaviors.targets import SUBBEHAVIORS
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, grill_floor
+from flipkit.model.contact import make_cone
+from flipkit.errors import ConfigError, VerificationError
+from flipkit.model.orientation import rpy
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.verify_flight import check_flight
+
+TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
+TIME_TOL = 1e-9  # s, node times against i T / N
+GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
+          "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
+          "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
+          "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
+          "flight_clearance": "m", "completeness": "segments"}
+
+
+@dataclass
+class GroupResult:
+    """Worst row of a check group — the largest violation relative to its tolerance — with
+    both in the group's unit, and where (segment index, node; ``None`` if no row was checked)."""
+
+    name: str
+    unit: str
+    violation: float = 0.0
+    tolerance: float = math.inf
+    segment: int | None = None
+    node: int | None = None
+
+    @property
+    def ratio(self) -> float:
+        """violation / tolerance of the worst row (≤ 1 passes; NaN counts as infinite)."""
+        ratio = self.violation / self.tolerance
+        return math.inf if math.isnan(ratio) else ratio
+
+    @property
+    def ok(self) -> bool:
+        """Whether every row of the group is within its tolerance."""
+        return self.ratio <= 1.0
+
+
+@dataclass
+class VerificationReport:
+    """Per-group results of :func:`verify_plan`; ``segments`` lists the segment names."""
+
+    tol: float
+    segments: list
+    groups: dict = field(default_factory=lambda: {g: GroupResult(g, u) for g, u in GROUPS.items()})
+
+    def add(self, group: str, segment: int, violation, tolerance, node: int | None = None):
+        """Record the rows ``violation`` (≥ 0) against ``tolerance`` (broadcast)."""
+        v = np.atleast_1d(np.asarray(violation, float))
+        if v.size == 0:
+            return
+        ratio = v / np.broadcast_to(tolerance, v.shape)
+        ratio = np.where(np.isnan(ratio), np.inf, ratio)
+        k = int(np.argmax(ratio))
+        res = self.groups[group]
+        if res.segment is None or ratio[k] > res.ratio:
+            res.violation, res.segment, res.node = float(v[k]), segment, node
+            res.tolerance = float(np.broadcast_to(tolerance, v.shape)[k])
+
+    @property
+    def ok(self) -> bool:
+        """Whether every group passes."""
+        return all(g.ok for g in self.groups.values())
+
+    def worst(self) -> tuple[str, int | None, float]:
+        """(group, segment index, violation) of the group with the largest violation/tolerance."""
+        g = max(self.groups.values(), key=lambda r: r.ratio)
+        return g.name, g.segment, g.violation
+
+    def summary(self) -> str:
+        """One line: pass, or the worst group, where, and by how much."""
+        if self.ok:
+            return f"plan verified: {len(self.groups)} check groups pass"
+        name, k, amount = self.worst()
+        g = self.groups[name]
+        at = f" at node {g.node}" if g.node is not None else ""
+        return (f"plan fails {name!r} in segment {k} ({self.segments[k]}){at}: violation "
+                f"{amount:.3g} {g.unit} > tolerance {g.tolerance:.3g}")
+
+    def table(self) -> str:
+        """The groups as a text table: unit, max violation, tolerance, where, ok/FAIL."""
+        rows = [f"{'group':<16}{'unit':<16}{'max violation':>14}{'tolerance':>11}  "
+                f"{'segment':<16}status"]
+        for g in self.groups.values():
+            where = "-" if g.segment is None else f"{g.segment}:{self.segments[g.segment]}"
+            tol = "-" if math.isinf(g.tolerance) else f"{g.tolerance:.2e}"
+            rows.append(f"{g.name:<16}{g.unit:<16}{g.violation:>14.3e}{tol:>11}  "
+                        f"{where:<16}{'ok' if g.ok else 'FAIL'}")
+        return "\n".join(rows)
+
+    def to_json(self) -> dict:
+        """The report as JSON values (non-finite numbers as null)."""
+        finite = lambda x: x if math.isfinite(x) else None  # noqa: E731
+        return {"ok": self.ok, "tol": self.tol, "segments": self.segments, "groups": [
+            {"name": g.name, "unit": g.unit, "max_violation": finite(g.violation),
+             "tolerance": finite(g.tolerance),
+             "segment": g.segment, "node": g.node, "ok": g.ok} for g in self.groups.values()]}
+
+    def write_json(self, path) -> None:
+        """Write :meth:`to_json` to ``path``."""
+        with open(path, "w") as fh:
+            json.dump(self.to_json(), fh, indent=1)
+
+    def raise_if_failed(self) -> None:
+        """Raise :class:`VerificationError` with :meth:`summary` when the plan fails."""
+        if not self.ok:
+            raise VerificationError(self.summary())
+
+
+def _outside(x, lo, hi) -> np.ndarray:
+    """Distance of x outside the box [lo, hi] (0 inside)."""
+    return np.maximum(np.maximum(np.asarray(lo) - x, x - np.asarray(hi)), 0.0)
+
+
+def _angle(a, b) -> np.ndarray:
+    """|a − b| wrapped to [0, π] (rad)."""
+    return np.abs((np.asarray(a) - np.asarray(b) + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _point_height(st, r_local) -> float:
+    """World height (m) of the blade point at r_local in the spatula frame."""
+    return float(st.p[2] + (st.R @ np.asarray(r_local, float))[2])
+
+
+def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
+    """Check every segment of ``plan`` and the joints between them.
+
+    Args:
+        plan: The plan (e.g. :meth:`Plan.load`).
+        tol: Tolerance in the solver's scaled units (see the module docstring).
+
+    Raises:
+        PlanFileError: The plan's model cannot be rebuilt (URDF missing, payload mismatch).
+        ConfigError: ``tol`` is not positive and finite.
+    """
+    if not (math.isfinite(tol) and tol > 0):
+        raise ConfigError(f"tol must be a positive finite number, got {tol!r}")
+    cell = plan.cell()
+    report = VerificationReport(tol, [s.name for s in plan.segments])
+    if plan.cone == "paper":
+        report.groups["cone"].unit = "1"  # cosine margin, dimensionless
+    # A flip plan is the five subbehaviours in order (a plan cut short by a failed segment
+    # must not pass); a translate plan has at least one segment.
+    names = [s.name for s in plan.segments]
+    expected = list(SUBBEHAVIORS) if plan.behavior == "flip" else None
+    missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
+               if expected is not None else int(not names))
+    report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
+    robots = {}
+    for k, seg in enumerate(plan.segments):
+        if seg.name not in robots:
+            robots[seg.name] = plan.robot_for(seg.name, cell)
+        _check_segment(report, k, seg, robots[seg.name], plan, cell, tol)
+        if k:
+            prev = plan.segments[k - 1]
+            jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))
+            report.add("continuity", k, jump, tol, 0)
+    return report
+
+
+def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
+    """Time grid, dynamics, limits, defects, clearance, cone and behaviour of segment k."""
+    N, T, add = seg.N, seg.T, report.add
+    add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
+    add("time_grid", k, _outside(T, *T_BOUNDS[seg.name]), tol)
+    dyn_tol = tol * robot.u_max / 10
+    for i in range(N + 1):
+        tau = robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
+        add("dynamics", k, np.abs(tau - seg.u[i]), dyn_tol, i)
+        for group, x, lo, hi, scale in (
+                ("q_limits", seg.q, robot.q_min, robot.q_max, 1.0),
+                ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
+                ("qdd_limits", seg.qdd, -robot.qdd_max, robot.qdd_max, 10.0),
+                ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
+            add(group, k, _outside(x[i], lo, hi), tol * scale, i)
+    for i in range(1, N, 2):
+        dt = seg.t[i + 1] - seg.t[i - 1]
+        for x, xd in ((seg.q, seg.qd), (seg.qd, seg.qdd)):
+            interp = x[i] - (x[i - 1] + x[i + 1]) / 2 - dt * (xd[i - 1] - xd[i + 1]) / 8
+            simpson = x[i + 1] - x[i - 1] - dt * (xd[i - 1] + 4 * xd[i] + xd[i + 1]) / 6
+            add("defects", k, np.abs(np.concatenate([interp, simpson])), tol, i)
+
+    states = [robot.state(seg.q[i], seg.qd[i], seg.qdd[i]) for i in range(N + 1)]
+    l, w = cell.spatula.length / 2, cell.spatula.width / 2
+    floor = grill_floor(seg.name, cell, N)
+    for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
+        heights = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
+        add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
+    cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
+    release = seg.release["node"] if seg.release else 0
+    required = {"translate": range(N + 1), "pickup": range(N + 1),
+                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)]}
+    on_blade = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
+    for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
+        st = states[i]  # the flip's cone holds where the burger lies on the blade
+        if np.any(on_blade):
+            st = robot.state(seg.q[i], seg.qd[i], seg.qdd[i], (*on_blade, 0.0))
+        add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
+    _check_behavior(report, k, seg, robot, plan, cell, states, tol)
+
+
+def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
+    """Endpoint and path constraints of the segment's behaviour (paper eqs. 9, 22–27)."""
+    N, add, end = seg.N, report.add, states[-1]
+    hg, pb = cell.grill.height, plan.burger["location"]
+
+    def pose(target: tg.Pose) -> None:
+        add("endpoints", k, np.abs(end.p - np.asarray(target.p)), tol, N)
+        add("endpoints", k, _angle(rpy(end.R), target.o), tol, N)
+
+    if seg.name in ("translate", "go_to_burger", "turn_back"):
+        add("endpoints", k, np.abs(seg.qd[-1]), tol, N)  # at rest at the end
+    if seg.name == "translate":
+        add("endpoints", k, np.abs(seg.qd[0]), tol, 0)
+        add("endpoints", k, _angle(rpy(end.R)[:2], 0.0), tol, N)  # flat
+        if seg.goal is not None:
+            pose(seg.goal)
+    elif seg.name == "go_to_burger":
+        pose(tg.scoop_ready(cell, pb))
+    elif seg.name == "scoop":
+        pose(tg.scoop_end(cell, pb))
+        for i, st in enumerate(states):  # tip pressed into the grill, within the band
+            tip = _point_height(st, (cell.spatula.length / 2, 0, 0))
+            add("behavior_path", k, _outside(tip, hg - SCOOP_PRESS - SCOOP_TIP_BAND,
+                                             hg - SCOOP_PRESS + SCOOP_TIP_BAND), tol, i)
+    elif seg.name == "pickup":
+        pose(tg.pickup_end(cell, pb))
+    elif seg.name == "flip":
+        add("behavior_path", k, _outside(end.R[:, 2], *tg.FLIP_NORMAL_BOUNDS), tol, N)
+        lo, hi = tg.FLIP_HEIGHT_BAND
+        add("behavior_path", k, _outside(end.p[2], hg + lo, hg + hi), tol, N)
+        for i, st in enumerate(states):
+            add("behavior_path", k, _outside(st.R[:, 0], *tg.FLIP_XAXIS_BOUNDS), tol, i)
+        check_flight(report, k, seg, robot, cell, states)
+    elif seg.name == "turn_back":
+        add("endpoints", k, np.abs(seg.q[-1] - robot.q_home), tol, N)

@@ -1,0 +1,101 @@
+"""Independent check of a flip's release, flight and landing, from the plan's arrays alone.
+
+Nothing here uses :mod:`flipkit.model.flight` or the NLP's blocks. The release state comes from
+pinocchio (:class:`~flipkit.model.robot.Robot` rebuilt from the plan file) at the recorded release
+node; the flight is integrated numerically (``scipy.integrate.solve_ivp`` on the centre's
+ballistic ODE with a ground event, the attitude as ``Rotation.from_rotvec(ω τ)`` applied to
+the blade's attitude at release); the blade–burger clearance after the release is a distance
+query between the blade (a box of the spatula's length, width and thickness under its
+carrying face) and the burger (a cylinder) with coal, the collision library shipped with
+pinocchio.
+
+Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt short
+of :data:`TILT_MIN_DEG` (deg), and the recorded prediction against the recomputed one (point
+m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.verify.LANDING_TOL`). Group
+``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes
+after the release.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.spatial.transform import Rotation
+
+TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
+_LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
+
+
+def recompute_landing(robot, seg, cell) -> dict | None:
+    """Release state and ballistic landing of ``seg``'s burger; ``None`` without a release.
+
+    Returns:
+        ``c0``, ``v0`` (centre and its velocity at release, m, m/s), ``w`` (rad/s), ``R0``
+        (burger attitude at release), ``point`` (m), ``tilt_deg``, ``time_of_flight`` (s).
+    """
+    if not seg.release:
+        return None
+    r = seg.release["node"]
+    st = robot.state(seg.q[r], seg.qd[r], seg.qdd[r])
+    _, _, _, Jw = robot.pose_jacobians(seg.q[r])
+    w = Jw @ seg.qd[r]
+    h, g = cell.burger.thickness, np.asarray(cell.gravity, float)
+    bx, by = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
+    arm = st.R @ np.array([bx, by, h / 2])
+    c0, v0 = st.p + arm, st.v + np.cross(w, arm)
+    z_land = cell.grill.height + h / 2
+
+    def ground(_, y):
+        return y[2] - z_land
+
+    ground.terminal, ground.direction = True, -1
+    sol = solve_ivp(lambda _, y: np.concatenate([y[3:], g]), (0.0, 10.0),
+                    np.concatenate([c0, v0]), events=ground, rtol=1e-10, atol=1e-12)
+    if not sol.t_events[0].size:
+        return None
+    tf = float(sol.t_events[0][0])
+    n = Rotation.from_rotvec(w * tf).apply(st.R[:, 2])
+    return {"c0": c0, "v0": v0, "w": w, "R0": st.R, "point": sol.y_events[0][0][:3],
+            "tilt_deg": math.degrees(math.acos(float(np.clip(n[2], -1.0, 1.0)))),
+            "time_of_flight": tf}
+
+
+def blade_burger_distance(blade_pose, burger_pose, cell) -> float:
+    """coal distance (m) between the blade box and the burger cylinder (negative: overlap
+    depth as coal reports it). Poses are (p, R) in the world."""
+    import coal
+
+    sp, bg = cell.spatula, cell.burger
+    blade = coal.Box(sp.length, sp.width, sp.thickness)
+    burger = coal.Cylinder(bg.diameter / 2, bg.thickness)
+    (pb, Rb), (pc, Rc) = blade_pose, burger_pose
+    tb = coal.Transform3s(np.asarray(Rb), np.asarray(pb) - np.asarray(Rb)[:, 2] * sp.thickness / 2)
+    tc = coal.Transform3s(np.asarray(Rc), np.asarray(pc))
+    req, res = coal.DistanceRequest(), coal.DistanceResult()
+    return float(coal.distance(blade, tb, burger, tc, req, res))
+
+
+def check_flight(report, k, seg, robot, cell, states) -> None:
+    """Add the ``landing`` and ``flight_clearance`` rows of flip segment k to ``report``."""
+    add, tol = report.add, _LANDING_TOL
+    rec = seg.landing
+    pred = recompute_landing(robot, seg, cell)
+    if rec is None or pred is None:  # no release recorded, or a burger that never comes down
+        add("landing", k, [math.inf], tol["m"], seg.release["node"] if seg.release else None)
+        return
+    r = seg.release["node"]
+    offset = float(np.linalg.norm(pred["point"][:2] - np.asarray(rec["target"])))
+    add("landing", k, [max(offset - rec["r_land"], 0.0)], tol["m"], r)
+    add("landing", k, [max(TILT_MIN_DEG - pred["tilt_deg"], 0.0)], tol["deg"], r)
+    add("landing", k, np.abs(pred["point"] - np.asarray(rec["point"])), tol["m"], r)
+    add("landing", k, [abs(pred["tilt_deg"] - rec["tilt_deg"])], tol["deg"], r)
+    add("landing", k, [abs(pred["time_of_flight"] - rec["time_of_flight"])], tol["s"], r)
+    add("landing", k, [abs(seg.release["time"] - seg.t[r])], tol["s"], r)
+    for i in range(r + 1, seg.N + 1):
+        tau = seg.t[i] - seg.t[r]
+        c = pred["c0"] + pred["v0"] * tau + 0.5 * np.asarray(cell.gravity) * tau**2
+        Rc = Rotation.from_rotvec(pred["w"] * tau).as_matrix() @ pred["R0"]
+        d = blade_burger_distance((states[i].p, states[i].R), (c, Rc), cell)
+        add("flight_clearance", k, [max(-d, 0.0)], tol["m"], i)

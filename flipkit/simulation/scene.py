@@ -1,0 +1,297 @@
+"""The whole cell as one MuJoCo model: the UR10 with its spatula, the grill, the burger, a table.
+
+The arm is converted from the pinocchio model of :class:`~flipkit.model.robot.Robot` built *without*
+the burger payload (the burger is its own free body here): one body per joint, placed by
+``model.jointPlacements``, a hinge about the joint's axis, and the inertia ``model.inertias``
+(the spatula's mass is already lumped into the last one). Inverse dynamics of the two models
+agree to round-off (tests/test_scene.py), so the planner's torques mean the same here.
+
+Geometry (DESIGN.md conventions): the spatula frame has x along the blade toward the tip and z
+along its normal; its xy-plane is the blade's top (carrying) face — the zero-thickness plate of
+the planner. The blade is a convex mesh below that plane: ``blade_thickness`` thick, its
+leading edge (x = +l/2) ground on the underside over ``bevel_length`` down to
+``edge_thickness``, so the planned tip point (l/2, 0, 0) is the top of the edge.
+
+Contacts are explicit pairs only (every geom has contype = conaffinity = 0): blade-grill
+(steel on steel, ``mu_blade_grill``; compliant: the blade's flex, below), burger-blade (``burger.mu``) and burger-grill
+(``mu_grill``) with the patty's softness (:meth:`PhysicsConfig.burger_timeconst`); the
+burger is a convex disc with rounded rims (``burger_edge_radius``); condim 3,
+elliptic cones, ``noslip`` iterations against soft-contact creep. Links are capsules for
+rendering only.
+
+Blade-grill compliance. A real turner's tip pressed onto the grill is held by the thin blade
+flexing as a cantilever from its neck, not by the grill's steel: the pair is a spring-damper
+of the physical stiffness k (:meth:`PhysicsConfig.blade_stiffness`, N/m) and damping b
+(:meth:`PhysicsConfig.blade_damping`, N s/m); the rigid blade's penetration of the grill
+stands for the tip's flex. MuJoCo's direct form ``solref = (−s, −c)`` is *not* in N/m: with a
+constant impedance d (``solimp = d d …``) the solver gives (MuJoCo Computation chapter,
+soft constraints: a₁ + d (B v + K r) = (1 − d) a₀, K = s/d², B = c/d, regulariser
+R = (1 − d)/d · D) a contact force f = [A F + d (K d x + B ẋ)] / (A + R), with x the
+penetration, A the true inverse inertia along the normal, F the load pushing in and D the
+model's approximate inverse inertia (``efc_diagApprox``: the blade body's
+``body_invweight0``). For small d (R ≫ A) this is f = (s x + c ẋ)/((1 − d) D): so s and c are
+set to k (1 − d) D / n and b (1 − d) D / n after compiling, d = :data:`BLADE_IMPEDANCE`, with
+n = :data:`BLADE_EDGE_CONTACTS` contact points sharing the edge's load; the static
+force is exactly k x whatever A is (tests/test_scene.py), and the instantaneous share of the
+push the constraint takes is A/(A + R) < 0.1 %. Friction on this pair stays Coulomb through
+the ``noslip`` iterations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.model.robot import Robot
+
+NOSLIP_ITERATIONS = 10  # post-solve iterations: static friction holds without creep
+ARM_JOINTS = 6
+LINK_RADIUS = 0.045  # m, capsule visuals
+# Constant impedance of the blade-grill contact (module docstring): small, so that the contact
+# is the blade's spring-damper and not MuJoCo's stiff-constraint blend; with D ≈ 33 /kg and
+# A ≈ 1.3-2.9 /kg at the scoops, A/R = A d/((1 − d) D) ≈ 0.1 %.
+BLADE_IMPEDANCE = 0.01
+# MuJoCo's convex collider puts one blade-grill contact at each end of the leading edge when the
+# edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
+# spring-damper, so that the pressed edge meets k and b in all.
+BLADE_EDGE_CONTACTS = 2
+
+
+def _vec(v) -> str:
+    return " ".join(f"{float(x):.12g}" for x in np.ravel(v))
+
+
+def _quat(R) -> str:
+    q = np.empty(4)
+    mujoco.mju_mat2Quat(q, np.asarray(R, float).reshape(9))
+    return _vec(q)
+
+
+def blade_vertices(length: float, width: float, thickness: float, bevel: float,
+                   edge: float) -> np.ndarray:
+    """Vertices (m, spatula frame, 10×3) of the convex blade: top face z = 0, flat underside
+    z = −thickness, bevelled on the underside over ``bevel`` to ``edge`` at x = +length/2."""
+    l2, w2 = length / 2, width / 2
+    out = []
+    for y in (-w2, w2):
+        out += [(-l2, y, 0.0), (l2, y, 0.0), (-l2, y, -thickness), (l2 - bevel, y, -thickness),
+                (l2, y, -edge)]
+    return np.array(out)
+
+
+def burger_vertices(diameter: float, thickness: float, edge_radius: float,
+                    n_around: int = 32, n_arc: int = 4) -> np.ndarray:
+    """Vertices (m, burger frame, axis z) of a disc with rounded rims: flat faces at
+    z = ±thickness/2, rims of radius ``edge_radius`` (clipped to half the thickness)."""
+    r, h2 = diameter / 2, thickness / 2
+    rho = min(edge_radius, h2)
+    prof = []  # (radius, z) around the rim, top to bottom
+    for zc, sgn in ((h2 - rho, 1.0), (-h2 + rho, -1.0)):
+        for a in np.linspace(0.0, np.pi / 2, n_arc + 1):
+            prof.append((r - rho + rho * np.sin(a), zc + sgn * rho * np.cos(a)))
+    prof = np.unique(np.round(prof, 12), axis=0)
+    phi = 2 * np.pi * np.arange(n_around) / n_around
+    return np.array([(rr * np.cos(f), rr * np.sin(f), z) for rr, z in prof for f in phi])
+
+
+@dataclass
+class Scene:
+    """A compiled cell: MuJoCo model, data and the ids the simulation needs.
+
+    Attributes:
+        model, data: MuJoCo model and data. xml: The MJCF it was compiled from.
+        robot: The pinocchio arm it mirrors (no burger payload).
+        blade_site: Site id of the spatula frame (top-face centre). grill_height: Actual
+            surface height (m). geoms: ``{"blade", "grill", "burger"}`` geom ids.
+        burger_qpos, burger_qvel: Slices of the burger's free joint in qpos / qvel.
+        blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
+            (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
+    """
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    xml: str
+    robot: Robot
+    blade_site: int
+    grill_height: float
+    geoms: dict
+    blade_contact: dict
+
+    burger_qpos = slice(ARM_JOINTS, ARM_JOINTS + 7)  # class constants, not fields
+    burger_qvel = slice(ARM_JOINTS, ARM_JOINTS + 6)
+
+    def blade_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """World position (m) and rotation of the spatula frame (after mj_kinematics)."""
+        return (self.data.site_xpos[self.blade_site].copy(),
+                self.data.site_xmat[self.blade_site].reshape(3, 3).copy())
+
+
+def _joint_axis(joint) -> np.ndarray:
+    """Unit rotation axis of a revolute pinocchio joint (in its own frame)."""
+    name = joint.shortname()
+    if name in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+        return np.eye(3)["XYZ".index(name[-1])]
+    if name == "JointModelRevoluteUnaligned":
+        return np.asarray(joint.extract().axis, float)
+    from flipkit.errors import ConfigError
+    raise ConfigError(f"scene supports revolute joints only, got {name}")
+
+
+def _arm_bodies(robot: Robot, sp_xml: str) -> str:
+    """Nested <body> elements of the six joints; ``sp_xml`` goes into the last one."""
+    m = robot.model
+    if m.njoints - 1 != ARM_JOINTS or any(m.parents[j] != j - 1 for j in range(1, m.njoints)):
+        from flipkit.errors import ConfigError
+        raise ConfigError(f"scene needs a serial {ARM_JOINTS}-joint arm, got {m.njoints - 1}")
+    opened, close = [], []
+    for j in range(1, m.njoints):
+        M, I = m.jointPlacements[j], m.inertias[j]
+        axis = _joint_axis(m.joints[j])
+        full = I.inertia
+        fi = _vec([full[0, 0], full[1, 1], full[2, 2], full[0, 1], full[0, 2], full[1, 2]])
+        child = m.jointPlacements[j + 1].translation if j + 1 < m.njoints else np.zeros(3)
+        link = "" if np.linalg.norm(child) < 1e-6 else (
+            f'<geom type="capsule" fromto="0 0 0 {_vec(child)}" size="{LINK_RADIUS}" '
+            f'contype="0" conaffinity="0" rgba="0.55 0.6 0.65 1" mass="0"/>')
+        opened.append(
+            f'<body name="{m.names[j]}" pos="{_vec(M.translation)}" quat="{_quat(M.rotation)}">'
+            f'<joint name="{m.names[j]}" type="hinge" axis="{_vec(axis)}" '
+            f'limited="false"/>'
+            f'<inertial pos="{_vec(I.lever)}" mass="{I.mass:.12g}" fullinertia="{fi}"/>{link}')
+        close.append("</body>")
+    return "\n".join(opened) + sp_xml + "".join(close)
+
+
+def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
+                grill_offset: float = 0.0, burger_xy=None, mu: float | None = None,
+                mass: float | None = None) -> Scene:
+    """Compile the cell.
+
+    Args:
+        robot: Arm model; default ``Robot(cell, with_burger=False)``. It must not carry the
+            burger (the burger is simulated as its own body).
+        cell: Cell configuration; default ``robot.cell``.
+        grill_offset: Grill surface error (m), added to ``cell.grill.height``.
+        burger_xy: Where the burger lies (m); default the grill centre. Set later with
+            :func:`place_burger`.
+        mu: Burger-blade friction; default ``cell.burger.mu``.
+        mass: Burger mass (kg); default ``cell.burger.mass``.
+    """
+    robot = robot or Robot(cell, with_burger=False)
+    cell = cell or robot.cell
+    ph, sp, bg, gr, tb = cell.physics, cell.spatula, cell.burger, cell.grill, cell.table
+    mu = bg.mu if mu is None else float(mu)
+    mass = bg.mass if mass is None else float(mass)
+    h_g = gr.height + float(grill_offset)
+    verts = blade_vertices(sp.length, sp.width, ph.blade_thickness, ph.bevel_length,
+                           ph.edge_thickness)
+    S = robot.spatula_in_joint
+    sp_pos, sp_quat = _vec(S.translation), _quat(S.rotation)
+    flange = robot.model.frames[robot.model.getFrameId(cell.robot.tool_frame)].placement
+    back = S.act(np.array([-sp.length / 2, 0.0, 0.0]))
+    sp_xml = (
+        f'<geom type="capsule" fromto="{_vec(flange.translation)} {_vec(back)}" size="0.008" '
+        f'contype="0" conaffinity="0" rgba="0.15 0.15 0.15 1" mass="0"/>'
+        f'<body name="spatula" pos="{sp_pos}" quat="{sp_quat}">'
+        f'<site name="spatula" size="0.005" rgba="1 0 0 1"/>'
+        f'<geom name="blade" type="mesh" mesh="blade" contype="0" conaffinity="0" mass="0" '
+        f'rgba="0.78 0.8 0.84 1"/></body>')
+    tau_b = ph.burger_timeconst(bg, mass)
+    r, h2 = bg.diameter / 2, bg.thickness / 2
+    gx, gy = np.mean(gr.x_range), np.mean(gr.y_range)
+    gsx, gsy = np.ptp(gr.x_range) / 2 + 0.15, np.ptp(gr.y_range) / 2 + 0.15
+    xy = (gx, gy) if burger_xy is None else tuple(np.asarray(burger_xy, float)[:2])
+    tx, ty, tsx, tsy = np.mean(tb.x_range), np.mean(tb.y_range), np.ptp(tb.x_range) / 2, \
+        np.ptp(tb.y_range) / 2
+
+    def pair(g1, g2, f, solref, imp=None):
+        solimp = "" if imp is None else f' solimp="{imp} {imp} 0.001 0.5 2"'
+        return (f'<pair name="{g1}_{g2}" geom1="{g1}" geom2="{g2}" condim="3" '
+                f'friction="{f} {f} 0.001 0.0001 0.0001" '
+                f'solref="{solref[0]:.6g} {solref[1]:.6g}"{solimp}/>')
+
+    xml = f"""<mujoco model="flipkit_cell">
+  <compiler angle="radian" inertiafromgeom="false"/>
+  <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
+          noslip_iterations="{NOSLIP_ITERATIONS}"/>
+  <visual><global offwidth="1280" offheight="960"/><quality shadowsize="2048"/>
+    <headlight ambient="0.35 0.35 0.35" diffuse="0.5 0.5 0.5"/><rgba haze="0.85 0.88 0.92 1"/>
+  </visual>
+  <asset>
+    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.9 0.95" rgb2="0.4 0.5 0.6"
+             width="32" height="32"/>
+    <mesh name="blade" vertex="{_vec(verts)}"/>
+    <mesh name="burger" vertex="{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>
+  </asset>
+  <worldbody>
+    <light pos="0.6 -0.2 2.0" dir="0 0 -1" diffuse="0.8 0.8 0.8"/>
+    <camera name="side" pos="{gx + 0.2:.3f} {gy - 1.6:.3f} 0.9" xyaxes="1 -0.1 0 0.05 0.4 1"/>
+    <geom name="floor" type="plane" size="2 2 0.1" pos="0 0 -0.6" contype="0" conaffinity="0"
+          rgba="0.9 0.9 0.88 1"/>
+    <geom name="grill" type="box" size="{gsx:.6g} {gsy:.6g} 0.02"
+          pos="{gx:.6g} {gy:.6g} {h_g - 0.02:.9g}" contype="0" conaffinity="0"
+          rgba="0.25 0.25 0.27 1"/>
+    <geom name="table" type="box" size="{tsx:.6g} {tsy:.6g} 0.02"
+          pos="{tx:.6g} {ty:.6g} {tb.height - 0.02:.6g}" contype="0" conaffinity="0"
+          rgba="0.6 0.45 0.3 1"/>
+    {_arm_bodies(robot, sp_xml)}
+    <body name="burger" pos="{xy[0]:.9g} {xy[1]:.9g} {h_g + h2:.9g}">
+      <freejoint name="burger"/>
+      <inertial pos="0 0 0" mass="{mass:.9g}" diaginertia="{_vec(_disc_inertia(mass, r, 2 * h2))}"/>
+      <geom name="burger" type="mesh" mesh="burger" contype="0" conaffinity="0"
+            rgba="0.45 0.25 0.15 1"/>
+      <geom type="cylinder" size="{r * 0.8:.4g} 0.0005" pos="0 0 {h2}" contype="0"
+            conaffinity="0" rgba="0.3 0.15 0.08 1" mass="0"/>
+    </body>
+  </worldbody>
+  <contact>
+    {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
+    {pair("burger", "blade", mu, (tau_b, ph.burger_dampratio))}
+    {pair("burger", "grill", ph.mu_grill, (tau_b, ph.burger_dampratio))}
+  </contact>
+</mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    contact = _blade_contact(model, cell)
+    pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "blade_grill")
+    model.pair_solref[pid] = contact["solref"]
+    xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
+    data = mujoco.MjData(model)
+    gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
+    scene = Scene(model, data, xml, robot,
+                  mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
+                  {n: gid(n) for n in ("blade", "grill", "burger")}, contact)
+    mujoco.mj_forward(model, data)
+    return scene
+
+
+def _blade_contact(model: mujoco.MjModel, cell: CellConfig) -> dict:
+    """The blade-grill pair's direct-form solref (−s, −c) for the physical stiffness and
+    damping of the blade (module docstring): s = k (1 − d) D / n, c = b (1 − d) D / n
+    (n :data:`BLADE_EDGE_CONTACTS` contact points on the leading edge), D the blade
+    body's translational ``body_invweight0`` (the contact rows' ``efc_diagApprox``; the grill
+    is the world's, weight 0)."""
+    ph, sp = cell.physics, cell.spatula
+    k, b = ph.blade_stiffness(sp), ph.blade_damping(sp)
+    blade = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "spatula")
+    scale = (1.0 - BLADE_IMPEDANCE) * float(model.body_invweight0[blade, 0]) / BLADE_EDGE_CONTACTS
+    return {"stiffness": k, "damping": b, "impedance": BLADE_IMPEDANCE,
+            "solref": (-k * scale, -b * scale)}
+
+
+def _disc_inertia(m: float, r: float, h: float) -> np.ndarray:
+    """Principal inertia (kg m²) of a uniform cylinder, axis z."""
+    ixx = m * (3 * r**2 + h**2) / 12
+    return np.array([ixx, ixx, m * r**2 / 2])
+
+
+def place_burger(scene: Scene, xy, q=None) -> None:
+    """Put the burger upright on the grill at ``xy`` (m), at rest; the arm at ``q`` (rad)."""
+    d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
+    if q is not None:
+        d.qpos[:ARM_JOINTS] = q
+    d.qpos[scene.burger_qpos] = [*np.asarray(xy, float)[:2], scene.grill_height + h2, 1, 0, 0, 0]
+    d.qvel[scene.burger_qvel] = 0.0
+    mujoco.mj_forward(scene.model, d)

@@ -1,0 +1,190 @@
+"""The hard SQP subproblem in null-space (condensed) form, written in cvxpy, solved by OSQP.
+
+The equality rows of a segment (dynamics, Hermite–Simpson defects, Bezier outputs, endpoint
+states: 516–528 of 547 variables) leave a null space of only 19–31 dimensions. Split the
+variables into basic B and free N columns of the scaled equality Jacobian E = [E_B E_N]
+(E_B square and nonsingular, chosen by a column-pivoted QR); every step that satisfies the
+linearised equalities E d = −r_E is then
+
+    d = d_p + Z w,   Z = [−E_B⁻¹E_N; I],   d_p = [−E_B⁻¹ r_E; 0]     (B rows first)
+
+With RᵀR = Zᵀ diag(h) Z (Cholesky, r × r) and T = Z R⁻¹, w = R⁻¹v and the subproblem of
+:mod:`flipkit.solvers.full_qp` becomes
+
+    minimise ½‖v‖² + g_vᵀv   s.t.  lo ≤ [J_I T; T] v ≤ hi
+
+with g_v = Tᵀ(g + h ⊙ d_p) and the inequality rows J_I and the step box d_lo ≤ d ≤ d_hi
+shifted by d_p. OSQP sees an identity Hessian and no equality rows: the linearised equalities
+hold to the accuracy of a sparse LU solve whatever its ADMM tolerance, and its iterations are
+spent on the active inequality rows (measured on the first linearisations of a Table I chain at
+eps 1e-8: 150–620 ADMM iterations where the full-space QP needed 150–5 120; the flip's
+infeasible linearisation detected in 760 where the full-space QP ran out at 20 000).
+
+Multipliers of the equality rows, which the SQP's penalty update needs, are recovered from the
+full-space stationarity condition restricted to B: E_Bᵀ y_E = −(g + h ⊙ d + J_Iᵀy_I + y_box)_B.
+"""
+
+from __future__ import annotations
+
+import cvxpy as cp
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from flipkit.errors import ConfigError
+from flipkit.transcription.nlp import NLP
+from flipkit.solvers.osqp_driver import OSQPDriver
+from flipkit.solvers.full_qp import QPSolution, run_osqp
+
+
+class ReducedQP:
+    """The condensed hard subproblem for NLPs sharing one structure.
+
+    Args:
+        nlp: An NLP of the structure (its pattern and bound types are used, not its values).
+
+    Raises:
+        ConfigError: As many equality rows as variables or more (nothing left to optimise).
+    """
+
+    elastic = False
+
+    def __init__(self, nlp: NLP):
+        n, m = nlp.n, nlp.m
+        eq = nlp.c_lo == nlp.c_hi
+        self.n, self.m = n, m
+        self.eq_rows, self.ineq_rows = np.flatnonzero(eq), np.flatnonzero(~eq)
+        self.r = n - len(self.eq_rows)
+        if self.r <= 0:
+            raise ConfigError(f"segment {nlp.name!r}: {len(self.eq_rows)} equality rows for {n} "
+                              "variables leave no null space to optimise in")
+        # Jacobian entries of the equality / inequality rows, and their row numbers there.
+        self._eq_entries = eq[nlp.jac_rows]
+        rank = np.full(m, -1)
+        rank[self.eq_rows] = np.arange(len(self.eq_rows))
+        rank[self.ineq_rows] = np.arange(len(self.ineq_rows))
+        self._sub_rows = rank[nlp.jac_rows]
+        self._cols = nlp.jac_cols
+        ineq_lo, ineq_hi = np.isfinite(nlp.c_lo[self.ineq_rows]), np.isfinite(nlp.c_hi[self.ineq_rows])
+        self.lo_sel, self.hi_sel = np.flatnonzero(ineq_lo), np.flatnonzero(ineq_hi)
+        self.v = cp.Variable(self.r, name="v")
+        self.g = cp.Parameter(self.r, name="reduced_gradient")
+        self.G_lo = cp.Parameter((len(self.lo_sel), self.r), name="rows_lo")
+        self.G_hi = cp.Parameter((len(self.hi_sel), self.r), name="rows_hi")
+        self.b_lo = cp.Parameter(len(self.lo_sel), name="lo_minus_row")
+        self.b_hi = cp.Parameter(len(self.hi_sel), name="hi_minus_row")
+        self.T = cp.Parameter((n, self.r), name="null_space_basis")
+        self.box_lo = cp.Parameter(n, name="box_lo")
+        self.box_hi = cp.Parameter(n, name="box_hi")
+        self.rows = {"lo": self.G_lo @ self.v >= self.b_lo, "hi": self.G_hi @ self.v <= self.b_hi,
+                     "box_lo": self.T @ self.v >= self.box_lo, "box_hi": self.T @ self.v <= self.box_hi}
+        obj = 0.5 * cp.sum_squares(self.v) + self.g @ self.v
+        self.problem = cp.Problem(cp.Minimize(obj), list(self.rows.values()))
+        if not self.problem.is_dpp():  # pragma: no cover - a programming error
+            raise RuntimeError("the reduced subproblem must be DPP")
+        self.basis: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ basis
+    def _split(self, jac: np.ndarray):
+        """(E, J_I) as sparse matrices from scaled Jacobian entries on the NLP's pattern."""
+        e = self._eq_entries
+        E = sp.csc_matrix((jac[e], (self._sub_rows[e], self._cols[e])), shape=(len(self.eq_rows), self.n))
+        JI = sp.csr_matrix((jac[~e], (self._sub_rows[~e], self._cols[~e])),
+                           shape=(len(self.ineq_rows), self.n))
+        return E, JI
+
+    def choose_basis(self, jac: np.ndarray) -> None:
+        """Basic columns B from a column-pivoted QR of E at these Jacobian values."""
+        E, _ = self._split(jac)
+        _, piv = sla.qr(E.toarray(), mode="r", pivoting=True)
+        self.basis = np.sort(piv[: len(self.eq_rows)])
+        self.free = np.sort(piv[len(self.eq_rows):])
+
+    def _factor(self, E):
+        """Sparse LU of E_B, or None if it is singular or its pivots span more than 1e12."""
+        try:
+            lu = spla.splu(E[:, self.basis])
+        except RuntimeError:
+            return None
+        pivots = np.abs(lu.U.diagonal())
+        return lu if pivots.min() > 1e-12 * pivots.max() else None
+
+    def reset(self) -> None:
+        """Forget OSQP's state and the basis."""
+        self.basis = None
+        if hasattr(self, "_driver"):
+            self._driver.reset()
+
+    def cold(self) -> None:
+        """Drop OSQP's warm start and working set (the next solve starts from zero)."""
+        if hasattr(self, "_driver"):
+            self._driver.reset()
+
+    def compile(self) -> OSQPDriver:
+        """Canonicalise with cvxpy (once) and return the OSQP driver."""
+        if not hasattr(self, "_driver"):
+            self._driver = OSQPDriver(self.problem, compact=True)
+        return self._driver
+
+    # ------------------------------------------------------------------ values
+    def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
+               d_lo: np.ndarray, d_hi: np.ndarray) -> None:
+        """Condense the subproblem of a linearisation (scaled units, as
+        :meth:`flipkit.solvers.full_qp.QPSubproblem.update`; ``hess`` must be positive)."""
+        E, JI = self._split(jac)
+        if self.basis is None:
+            self.choose_basis(jac)
+        lu = self._factor(E)
+        if lu is None:  # E_B (nearly) singular here: pivot again at this point
+            self.choose_basis(jac)
+            lu = self._factor(E)
+            if lu is None:
+                raise ConfigError("the equality rows' Jacobian is rank deficient")
+        B, N, n, r = self.basis, self.free, self.n, self.r
+        lo_s, hi_s = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+        Z = np.zeros((n, r))
+        Z[B] = -lu.solve(E[:, N].toarray())
+        Z[N, np.arange(r)] = 1.0
+        d_p = np.zeros(n)
+        d_p[B] = -lu.solve(c[self.eq_rows] - lo_s[self.eq_rows])
+        R = sla.cholesky(Z.T @ (hess[:, None] * Z))  # upper: RᵀR = Zᵀ H Z
+        T = sla.solve_triangular(R, Z.T, trans="T").T  # Z R⁻¹
+        self._state = (lu, T, d_p, JI, grad, hess)
+        I = self.ineq_rows
+        G = np.asarray(JI @ T)
+        base = c[I] + JI @ d_p
+        self.g.value = T.T @ (grad + hess * d_p)
+        self.G_lo.value, self.b_lo.value = G[self.lo_sel], (lo_s[I] - base)[self.lo_sel]
+        self.G_hi.value, self.b_hi.value = G[self.hi_sel], (hi_s[I] - base)[self.hi_sel]
+        self.T.value = T
+        self.box_lo.value, self.box_hi.value = d_lo - d_p, np.maximum(d_hi, d_lo) - d_p
+
+    def solve(self, eps: float | None = None, max_iter: int | None = None) -> QPSolution:
+        """Solve with OSQP and map back: the full-space step d and row multipliers y (m,), in
+        the sign convention of :class:`~flipkit.solvers.full_qp.QPSolution`."""
+        res, iterations, status, solved = run_osqp(self.compile(), self.problem, eps, max_iter)
+        y = np.zeros(self.m)
+        if not solved:
+            return QPSolution(np.zeros(self.n), status, iterations, y, False)
+        lu, T, d_p, JI, grad, hess = self._state
+        d = d_p + T @ self.v.value
+        dual = {k: np.asarray(con.dual_value) for k, con in self.rows.items()}
+        y_I = np.zeros(len(self.ineq_rows))
+        y_I[self.lo_sel] -= dual["lo"]
+        y_I[self.hi_sel] += dual["hi"]
+        residual = grad + hess * d + JI.T @ y_I + dual["box_hi"] - dual["box_lo"]
+        y[self.eq_rows] = -lu.solve(residual[self.basis], trans="T")
+        y[self.ineq_rows] = y_I
+        return QPSolution(d, status, iterations, y, res.info.status_polish == 1)
+
+
+_CACHE: dict[str, ReducedQP] = {}
+
+
+def reduced_subproblem_for(nlp: NLP) -> ReducedQP:
+    """The condensed subproblem for the NLP's structure, built on first use and then reused."""
+    qp = _CACHE.get(nlp.structure_key)
+    if qp is None:
+        qp = _CACHE[nlp.structure_key] = ReducedQP(nlp)
+    return qp

@@ -1,0 +1,52 @@
+"""An SQP iterate in scaled units, and the minimum-norm Newton correction onto its rows."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from flipkit.transcription.nlp import NLP
+
+
+class Iterate:
+    """Z with its scaled cost, constraint values, violation and (on first use) the scaled
+    Jacobian J̃ = c_scale · ∂c/∂Z · Z_scale on the NLP's pattern.
+
+    Args:
+        nlp: The NLP. x: Z (unscaled). jscale: Scale of each Jacobian entry (pattern order).
+    """
+
+    def __init__(self, nlp: NLP, x: np.ndarray, jscale: np.ndarray):
+        self.x, self._nlp, self._J = x, nlp, None
+        self.c, jac = nlp.evaluate(x)
+        self.jac = jac * jscale  # scaled entries, pattern order
+        self.cs = nlp.c_scale * self.c
+        self.f = nlp.objective(x) * nlp.obj_scale
+        self.v = nlp.scaled_violation(self.c)
+
+    @property
+    def J(self) -> sp.csr_matrix:
+        if self._J is None:
+            n = self._nlp
+            self._J = sp.csr_matrix((self.jac, (n.jac_rows, n.jac_cols)), shape=(n.m, n.n))
+        return self._J
+
+    @property
+    def v_max(self) -> float:
+        return float(self.v.max(initial=0.0))
+
+    def merit(self, rho: float) -> float:
+        """ℓ1 merit φ = J̃ + ρ‖v‖₁."""
+        return self.f + rho * float(self.v.sum())
+
+
+def newton_correction(nlp: NLP, p: Iterate) -> np.ndarray:
+    """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
+    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound."""
+    r = p.cs - np.clip(p.cs, nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi)
+    rows = np.flatnonzero((nlp.c_lo == nlp.c_hi) | (r != 0))
+    JR = p.J[rows]
+    K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
+    delta = -(JR.T @ spla.spsolve(K, r[rows]))
+    return np.where(np.isfinite(delta), delta, 0.0)

@@ -1,0 +1,147 @@
+"""Dynamics (eq. 7), Hermite–Simpson collocation (eqs. 8–9) and Bezier outputs (eq. 18)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.transcription.constraints.base import Block
+
+
+class Dynamics(Block):
+    """Implicit dynamics D(q_i)q̈_i + C q̇_i + G − u_i = 0 at every node (eq. 7).
+
+    Args:
+        layout: Variable layout. robot: Model (its RNEA, payload included).
+        torque_scale: Per-joint torque scale (N·m); rows are divided by it.
+    """
+
+    def __init__(self, layout, torque_scale):
+        super().__init__("dynamics", layout)
+        nq = layout.nq
+        for i in range(layout.n_nodes):
+            cols = np.concatenate([layout.iq(i), layout.iqd(i), layout.iqdd(i), layout.iu(i)])
+            self._add(i * nq, nq, cols)
+        self.m = nq * layout.n_nodes
+        self._finish(0.0, 0.0, np.tile(1.0 / np.asarray(torque_scale), layout.n_nodes))
+
+    def project(self, x: np.ndarray, robot) -> np.ndarray:
+        """x with u_i = RNEA(q_i, q̇_i, q̈_i) at every node: these rows hold exactly.
+
+        u enters eq. (7) alone and linearly, so this is the exact nonlinear correction of
+        the dynamics rows (the SQP applies it to every trial point).
+        """
+        x = np.array(x, float)
+        nodes = self.layout.nodes(x)
+        for i in range(self.layout.n_nodes):
+            nodes[i, 3] = robot.inverse_dynamics(nodes[i, 0], nodes[i, 1], nodes[i, 2])
+        return x
+
+    def evaluate(self, ev):
+        vals, jac = [], []
+        for i in range(self.layout.n_nodes):
+            tau, dq, dqd, dqdd, du = ev.rnea(i)
+            vals.append(tau - ev.node(i)[3])
+            jac.append(np.hstack([dq, dqd, dqdd, du]).ravel())
+        return np.concatenate(vals), np.concatenate(jac)
+
+
+class HermiteSimpson(Block):
+    """Hermite–Simpson collocation with defects at the odd (midpoint) nodes i (eqs. 8–9).
+
+    For x ∈ {q, q̇} with ẋ ∈ {q̇, q̈} and Δt_i = t_{i+1} − t_{i−1} = 2T/N:
+
+    * interpolation defect δ_i = x_i − (x_{i−1} + x_{i+1})/2 − Δt_i (ẋ_{i−1} − ẋ_{i+1})/8,
+    * Simpson defect σ_i = x_{i+1} − x_{i−1} − Δt_i (ẋ_{i−1} + 4ẋ_i + ẋ_{i+1})/6.
+
+    σ_i = 0 is the paper's ξ_i = ẋ_i − ẋ̄_i = 0 multiplied by −2Δt_i/3 (the Hermite
+    interpolant's midpoint slope is ẋ̄_i = 3(x_{i+1} − x_{i−1})/(2Δt_i) − (ẋ_{i−1} + ẋ_{i+1})/4),
+    so imposing both would repeat one equation; σ keeps the constraint polynomial in T.
+    """
+
+    def __init__(self, layout, qd_scale: float = 1.0):
+        super().__init__("hermite_simpson", layout)
+        nq, row = layout.nq, 0
+        self.terms = []  # per 6-row group: (list of (cols_fn, coefficient kind)), T
+        for i in range(1, layout.N, 2):
+            for xf, dxf in ((layout.iq, layout.iqd), (layout.iqd, layout.iqdd)):
+                a, b = i - 1, i + 1
+                for cols in ((xf(i), xf(a), xf(b), dxf(a), dxf(b)),  # δ
+                             (xf(b), xf(a), dxf(a), dxf(i), dxf(b))):  # σ
+                    for c in cols:
+                        self._rows.append(np.arange(row, row + nq))
+                        self._cols.append(c)
+                    self._add(row, nq, [layout.T_index])
+                    row += nq
+        self.m = row
+        group = np.concatenate([np.ones(2 * nq), np.full(2 * nq, qd_scale)])
+        self._finish(0.0, 0.0, np.tile(group, layout.N // 2))
+
+    def evaluate(self, ev):
+        L, nodes, T = self.layout, self.layout.nodes(ev.x), ev.T
+        dt, ddt = 2 * T / L.N, 2 / L.N
+        one = np.ones(L.nq)
+        vals, jac = [], []
+        for i in range(1, L.N, 2):
+            for k in (0, 1):  # x = q (k=0) or q̇ (k=1); ẋ is the next field
+                xa, xi, xb = nodes[i - 1, k], nodes[i, k], nodes[i + 1, k]
+                da, di, db = nodes[i - 1, k + 1], nodes[i, k + 1], nodes[i + 1, k + 1]
+                vals.append(xi - (xa + xb) / 2 - dt * (da - db) / 8)
+                jac += [one, -one / 2, -one / 2, -one * dt / 8, one * dt / 8, -ddt * (da - db) / 8]
+                s = da + 4 * di + db
+                vals.append(xb - xa - dt * s / 6)
+                jac += [one, -one, -one * dt / 6, -one * 4 * dt / 6, -one * dt / 6, -ddt * s / 6]
+        return np.concatenate(vals), np.concatenate(jac)
+
+
+class BezierOutput(Block):
+    """Output dynamics ÿ + 2εẏ + ε²y = 0 at every node with y(0) = ẏ(0) = 0 (eqs. 17–18).
+
+    y = q − P(t), P the degree-M Bezier polynomial with coefficients α and duration T.
+
+    Args:
+        layout: Variable layout. epsilon: Convergence rate ε (1/s).
+    """
+
+    def __init__(self, layout, epsilon: float):
+        super().__init__("bezier_output", layout)
+        self.eps = float(epsilon)
+        nq, b = layout.nq, layout.bezier
+        self.B = [b.basis(layout.s, r) for r in range(3)]  # (N+1, M+1) each
+        row = 0
+        for i in range(layout.n_nodes):
+            for f in (layout.iq, layout.iqd, layout.iqdd):
+                self._rows.append(np.arange(row, row + nq))
+                self._cols.append(f(i))
+            for j in range(nq):
+                self._add(row + j, 1, np.append(layout.ialpha(j), layout.T_index))
+            row += nq
+        for j in range(nq):  # y(0) = q_0 − α_j0
+            self._add(row + j, 1, [layout.iq(0)[j], layout.ialpha(j)[0]])
+        for j in range(nq):  # ẏ(0) = q̇_0 − M(α_j1 − α_j0)/T
+            self._add(row + nq + j, 1, [layout.iqd(0)[j], *layout.ialpha(j)[:2], layout.T_index])
+        self.m = row + 2 * nq
+        scale = np.concatenate([np.full(row, 1 / self.eps**2), np.ones(nq), np.full(nq, 0.1)])
+        self._finish(0.0, 0.0, scale)
+
+    def evaluate(self, ev):
+        L, e, T = self.layout, self.eps, ev.T
+        nodes, alpha = L.nodes(ev.x), L.alpha(ev.x)
+        B0, B1, B2 = self.B
+        one = np.ones(L.nq)
+        vals, jac = [], []
+        for i in range(L.n_nodes):
+            q, qd, qdd, _ = nodes[i]
+            c = B2[i] / T**2 + 2 * e * B1[i] / T + e**2 * B0[i]
+            dc = -2 * B2[i] / T**3 - 2 * e * B1[i] / T**2
+            vals.append(qdd + 2 * e * qd + e**2 * q - alpha @ c)
+            jac += [e**2 * one, 2 * e * one, one]
+            for j in range(L.nq):
+                jac.append(np.append(-c, -alpha[j] @ dc))
+        M = L.bezier.degree
+        q0, qd0 = nodes[0, 0], nodes[0, 1]
+        vals.append(q0 - alpha[:, 0])
+        jac += [np.array([1.0, -1.0])] * L.nq
+        vals.append(qd0 - M * (alpha[:, 1] - alpha[:, 0]) / T)
+        for j in range(L.nq):
+            jac.append(np.array([1.0, M / T, -M / T, M * (alpha[j, 1] - alpha[j, 0]) / T**2]))
+        return np.concatenate(vals), np.concatenate(jac)

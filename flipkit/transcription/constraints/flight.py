@@ -1,0 +1,135 @@
+"""Release, flight and landing of the flip (flipkit's addition to eq. 26).
+
+Design choice: the release is a fixed node r of the flip segment (default ⌈0.7 N⌉, so that
+the burger is on the blade for 70 % of the flip, above the paper's 60 % success threshold).
+Contact is imposed up to the release — the friction cone holds on nodes 0..r, so the contact
+force presses the burger onto the blade — and separation after it: on nodes r+1..N the
+burger, flying ballistically from its state at node r (:mod:`flipkit.model.flight`), stays on the
+carrying side of the blade's plane (:class:`FlightClearance`). Since the blade must fall away
+from the ballistic burger faster than gravity right after node r, the contact force vanishes
+between nodes r and r+1: the release. :class:`Landing` bounds where and how the burger comes
+down. The release time is then t_r = r T / N, a variable through T.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flipkit.errors import ConfigError
+from flipkit.model.flight import TILT_MIN_DEG, clearance_function, gravity_magnitude, landing_function
+from flipkit.transcription.constraints.base import Block
+
+
+def _release_inputs(ev, r: int):
+    """(x_r = (p, v, δ, ω), R, ∂x_r/∂q_r, ∂x_r/∂q̇_r) at node r, computed once per
+    evaluation point (Landing and FlightClearance share it)."""
+    key = ("release", r)
+    if key not in ev._states:
+        ev._states[key] = _release_state(ev, r)
+    return ev._states[key]
+
+
+def _release_state(ev, r: int):
+    q, qd = ev.node(r)[:2]
+    st = ev.state(r)
+    w, dw_dq = ev.robot.angular_velocity_jacobian(q, qd)
+    nq = len(q)
+    dq = np.vstack([st.dp_dq, st.dv_dq, st.Jw, dw_dq])
+    dqd = np.vstack([np.zeros((3, nq)), st.dv_dqd, np.zeros((3, nq)), st.Jw])
+    return np.concatenate([st.p, st.v, np.zeros(3), w]), st.R, dq, dqd
+
+
+class Landing(Block):
+    """Landing of the burger released at node r: within ``r_land`` of ``target`` (x, y) and
+    upside down (top-face normal ≥ :data:`~flipkit.model.flight.TILT_MIN_DEG` from +z).
+
+    Rows: landing distance from the target (m) ≤ r_land; z of the landed top-face normal ≤
+    cos(150°).
+
+    Args:
+        layout: Variable layout. release: Release node r.
+        target: Landing spot (x, y) (m). r_land: Allowed distance (m).
+        thickness: Burger thickness h (m). grill_height: h_g (m). gravity: (3,) m/s².
+        on_blade: Where the burger's centre sits on the blade (x, y), blade frame (m).
+    """
+
+    def __init__(self, layout, release: int, target, r_land: float, *, thickness: float,
+                 grill_height: float, gravity, on_blade=(0.0, 0.0)):
+        super().__init__("landing", layout)
+        if not (math.isfinite(r_land) and r_land > 0):
+            raise ConfigError(f"r_land must be a positive distance (m), got {r_land!r}")
+        if not 0 < release < layout.N:
+            raise ConfigError(f"release node must be inside the segment, got {release}")
+        self.release = int(release)
+        self.on_blade = [float(v) for v in np.asarray(on_blade, float)[:2]]
+        self.par = [thickness, gravity_magnitude(gravity), grill_height + thickness / 2,
+                    *np.asarray(target, float)[:2], *self.on_blade]
+        self._add(0, 2, np.concatenate([layout.iq(release), layout.iqd(release)]))
+        self.m = 2
+        self._finish([-np.inf, -np.inf], [r_land, math.cos(math.radians(TILT_MIN_DEG))],
+                     [1.0, 1.0])
+
+    def record(self, robot, x) -> tuple[dict, dict]:
+        """The plan file's ``release`` and ``landing`` records at the solution ``x``."""
+        from flipkit.transcription.layout import Evaluation
+        from flipkit.model.flight import predict_landing
+
+        ev = Evaluation(self.layout, robot, np.asarray(x, float))
+        st, r = ev.state(self.release), self.release
+        w, _ = robot.angular_velocity_jacobian(*ev.node(r)[:2])
+        h, g = self.par[0], self.par[1]
+        pred = predict_landing(st.p, st.v, st.R, w, thickness=h, grill_height=self.par[2] - h / 2,
+                               gravity=(0.0, 0.0, -g), target=self.par[3:5],
+                               on_blade=self.on_blade)
+        return ({"node": r, "time": float(self.layout.s[r] * ev.T)},
+                {"target": [float(v) for v in self.par[3:5]], "r_land": float(self.hi[0]),
+                 **pred, "burger_on_blade": list(self.on_blade)})
+
+    def evaluate(self, ev):
+        x, R, dq, dqd = _release_inputs(ev, self.release)
+        y, J = (np.asarray(a) for a in landing_function()(x, R, self.par))
+        J = J[:2]
+        return y[:2, 0], np.hstack([J @ dq, J @ dqd]).ravel()
+
+
+class FlightClearance(Block):
+    """After the release at node r, the blade plane at nodes r+1..N separates the blade from
+    the flying burger by at least ``margin`` (m) (see :func:`~flipkit.model.flight.clearance_function`).
+
+    Args:
+        layout: Variable layout. release: Release node r. margin: Clearance (m) per node
+            after the release (scalar or N − r values).
+        thickness, diameter: Burger size (m). gravity: (3,) m/s².
+        on_blade: Where the burger's centre sits on the blade (x, y), blade frame (m).
+    """
+
+    def __init__(self, layout, release: int, margin, *, thickness: float, diameter: float,
+                 gravity, on_blade=(0.0, 0.0)):
+        super().__init__("flight_clearance", layout)
+        self.release = int(release)
+        self.nodes = list(range(self.release + 1, layout.N + 1))
+        self.par = [thickness, diameter / 2, gravity_magnitude(gravity),
+                    *np.asarray(on_blade, float)[:2]]
+        r = self.release
+        for k, i in enumerate(self.nodes):
+            self._add(k, 1, np.concatenate([layout.iq(r), layout.iqd(r), layout.iq(i),
+                                             [layout.T_index]]))
+        self.m = len(self.nodes)
+        self._finish(margin, np.inf, 1.0)
+
+    def evaluate(self, ev):
+        L, r = self.layout, self.release
+        x_r, R_r, dq_r, dqd_r = _release_inputs(ev, r)
+        f, T = clearance_function(), ev.T
+        vals, jac = [], []
+        for i in self.nodes:
+            st = ev.state(i)
+            ds = L.s[i] - L.s[r]
+            x = np.concatenate([x_r, [ds * T], st.p, np.zeros(3)])
+            d, J = (np.asarray(a).ravel() for a in f(x, R_r, st.R, self.par))
+            vals.append(d[0])
+            jac.append(np.concatenate([J[:12] @ dq_r, J[:12] @ dqd_r,
+                                       J[13:16] @ st.dp_dq + J[16:19] @ st.Jw, [J[12] * ds]]))
+        return np.array(vals), np.concatenate(jac)

@@ -1,0 +1,151 @@
+"""Spatula task-space constraints at chosen nodes: poses, bounds, cone, grill contact.
+
+A :class:`KinematicBlock` applies one *quantity* of the spatula state — a vector function
+of (q, q̇, q̈) with analytic Jacobians — at a list of nodes with bounds lo ≤ value ≤ hi.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.model.contact import ConeForm
+from flipkit.errors import InvalidChoiceError
+from flipkit.model.orientation import axis_jacobian, rpy_jacobian
+from flipkit.model.robot import SpatulaState, skew
+from flipkit.transcription.constraints.base import Block
+
+
+def _point_height(st: SpatulaState, r_local) -> tuple[np.ndarray, np.ndarray]:
+    """Height of the blade point p + R r and its ∂/∂q (1 row)."""
+    r = st.R @ np.asarray(r_local, float)
+    return np.array([st.p[2] + r[2]]), (st.dp_dq[2] - (skew(r) @ st.Jw)[2])[None]
+
+
+class Quantity:
+    """A spatula quantity of derivative order 0 (q), 1 (q, q̇) or 2 (q, q̇, q̈)."""
+
+    order = 0
+    size = 3
+
+    def __call__(self, st: SpatulaState, ctx) -> tuple:
+        """(value, ∂/∂q[, ∂/∂q̇[, ∂/∂q̈]])."""
+        raise NotImplementedError
+
+
+class Position(Quantity):
+    def __call__(self, st, ctx):
+        return st.p, st.dp_dq
+
+
+class Height(Quantity):
+    size = 1
+
+    def __call__(self, st, ctx):
+        return st.p[2:], st.dp_dq[2:]
+
+
+class Rpy(Quantity):
+    def __call__(self, st, ctx):
+        return rpy_jacobian(st.R, st.Jw)
+
+
+class Normal(Quantity):
+    def __call__(self, st, ctx):
+        return axis_jacobian(st.R, st.Jw, 2)
+
+
+class XAxis(Quantity):
+    def __call__(self, st, ctx):
+        return axis_jacobian(st.R, st.Jw, 0)
+
+
+class TipHeight(Quantity):
+    """Height of the blade tip, p_z − (l_l/2) sin o_y for a level blade (eq. 24)."""
+
+    size = 1
+
+    def __call__(self, st, ctx):
+        return _point_height(st, (ctx["length"] / 2, 0.0, 0.0))
+
+
+class BladeEdgeHeights(Quantity):
+    """Heights of the blade's tip, heel and two side edges (the spatula stays above the grill)."""
+
+    size = 4
+
+    def __call__(self, st, ctx):
+        l, w = ctx["length"] / 2, ctx["width"] / 2
+        parts = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
+        return np.concatenate([p[0] for p in parts]), np.vstack([p[1] for p in parts])
+
+
+class Velocity(Quantity):
+    order = 1
+
+    def __call__(self, st, ctx):
+        return st.v, st.dv_dq, st.dv_dqd
+
+
+class Acceleration(Quantity):
+    order = 2
+
+    def __call__(self, st, ctx):
+        return st.a, st.da_dq, st.da_dqd, st.da_dqdd
+
+
+class Cone(Quantity):
+    """Friction-cone margin h ≥ 0 of a :class:`~flipkit.model.contact.ConeForm`, for the burger
+    resting over the blade point ``point`` (spatula frame, m; default the blade centre)."""
+
+    order = 2
+
+    def __init__(self, cone: ConeForm, point=None):
+        self.cone, self.size = cone, cone.rows
+        self.point = None if point is None or not np.any(point) else np.asarray(point, float)
+
+    def __call__(self, st, ctx):
+        return self.cone.jacobians(st)
+
+
+QUANTITIES = {"position": Position, "height": Height, "rpy": Rpy, "normal": Normal,
+              "xaxis": XAxis, "tip_height": TipHeight, "blade_heights": BladeEdgeHeights,
+              "velocity": Velocity, "acceleration": Acceleration}
+
+
+class KinematicBlock(Block):
+    """lo ≤ quantity(q_i, q̇_i, q̈_i) ≤ hi at each node i in ``nodes``.
+
+    Args:
+        name: Group name. layout: Variable layout.
+        quantity: A key of :data:`QUANTITIES` or a :class:`Quantity` (e.g. :class:`Cone`).
+        nodes: Node indices. lo, hi: Bounds, broadcast to (len(nodes), size).
+        scale: Row scale. ctx: Geometry the quantity needs (blade length, width).
+    """
+
+    def __init__(self, name, layout, quantity, nodes, lo, hi, scale=1.0, ctx=None):
+        super().__init__(name, layout)
+        if isinstance(quantity, str):
+            if quantity not in QUANTITIES:
+                raise InvalidChoiceError("spatula quantity", quantity, QUANTITIES)
+            quantity = QUANTITIES[quantity]()
+        self.quantity, self.nodes, self.ctx = quantity, [int(i) for i in nodes], ctx or {}
+        k = quantity.size
+        fields = (layout.iq, layout.iqd, layout.iqdd)[: quantity.order + 1]
+        for r, i in enumerate(self.nodes):
+            self._add(r * k, k, np.concatenate([f(i) for f in fields]))
+        self.m = k * len(self.nodes)
+        shape = (len(self.nodes), k)
+        self._finish(np.broadcast_to(lo, shape).ravel(), np.broadcast_to(hi, shape).ravel(),
+                     np.broadcast_to(scale, shape).ravel())
+
+    def evaluate(self, ev):
+        vals, jac = [], []
+        point = getattr(self.quantity, "point", None)
+        for i in self.nodes:
+            st = ev.state(i) if point is None else ev.point_state(i, point)
+            out = self.quantity(st, self.ctx)
+            vals.append(out[0])
+            jac.append(np.hstack(out[1:]).ravel())
+        if not vals:
+            return np.zeros(0), np.zeros(0)
+        return np.concatenate(vals), np.concatenate(jac)
