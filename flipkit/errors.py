@@ -37,7 +37,7 @@ class UnreachableError(FlipkitError):
 
 
 class PlanFileError(FlipkitError):
-    """A plan file that is missing, not JSON, or not in the ``flipkit-plan/1`` format."""
+    """A plan file that is missing, not JSON, or not in a readable ``flipkit-plan`` format."""
 
 
 class NoSolutionFound(FlipkitError):
@@ -57,6 +57,17 @@ class NoSolutionFound(FlipkitError):
             problem, status, group, amount, result)
         where = f"; worst constraint group {group!r} violated by {amount:.3g}" if group else ""
         super().__init__(f"no solution found ({status}){where}")
+
+
+class SolverError(FlipkitError):
+    """A numerical solver that broke down, as opposed to a problem without a solution
+    (:class:`NoSolutionFound`): OSQP failing inside cvxpy, or a factorisation that cannot be
+    formed. The SQP reports it as the status ``qp_solver_error`` of its segment."""
+
+
+class SingularBasisError(SolverError):
+    """The condensed subproblem's equality-row Jacobian is rank deficient at the iterate: no
+    basis of its columns can be factorised."""
 
 
 class VerificationError(FlipkitError):

@@ -31,7 +31,7 @@ from flipkit.behaviors.segments import T_BOUNDS, build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
-from flipkit.solvers.full_qp import subproblem_for
+from flipkit.solvers.compiled import SUBPROBLEMS
 from flipkit.solvers.sqp import SQPOptions, solve_sqp
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
@@ -62,7 +62,7 @@ def warm_up(nlps) -> float:
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
-            subproblem_for(nlp, elastic=True).compile()
+            SUBPROBLEMS.get(nlp, "elastic").compile()
             solve_sqp(nlp, options=SQPOptions(max_iter=1), raise_on_failure=False)
     return time.perf_counter() - t0
 

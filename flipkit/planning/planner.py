@@ -24,11 +24,12 @@ import numpy as np
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.errors import (ConfigError, FlipkitError, InvalidChoiceError, SolverError,
+                            UnreachableError)
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
-from flipkit.solvers.result import SolveResult
+from flipkit.solvers.result import SolveResult, Status
 from flipkit.planning.verify import verify_plan
 
 SOLVERS = ("sqp", "ipopt", "auto")
@@ -61,15 +62,13 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
         InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
     """
     if solver == "sqp":
-        import cvxpy as cp
-
         from flipkit.solvers.sqp import solve_sqp
 
         try:
             return solve_sqp(nlp, x0, raise_on_failure=False)
-        except cp.error.SolverError:  # OSQP broke down inside a subproblem
+        except SolverError:  # OSQP or a factorisation broke down inside a subproblem
             x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
-            return SolveResult(x=x, status="qp_solver_error", iterations=0, wall_time_s=0.0,
+            return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
                                objective=nlp.objective(x), max_violation=float(
                                    nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
     if solver == "ipopt":

@@ -1,7 +1,8 @@
-"""The hard SQP subproblem in null-space (condensed) form, written in cvxpy, solved by OSQP.
+"""The condensed SQP subproblem: the hard QP in the null space of its equality rows, in cvxpy,
+solved by OSQP.
 
 The equality rows of a segment (dynamics, Hermite–Simpson defects, Bezier outputs, endpoint
-states: 516–528 of 547 variables) leave a null space of only 19–31 dimensions. Split the
+states: 516–528 of 547 variables) leave a null space of only 19–31 dimensions, where the condensed problem lives. Split the
 variables into basic B and free N columns of the scaled equality Jacobian E = [E_B E_N]
 (E_B square and nonsingular, chosen by a column-pivoted QR); every step that satisfies the
 linearised equalities E d = −r_E is then
@@ -32,14 +33,15 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from flipkit.errors import ConfigError
+from flipkit.errors import ConfigError, SingularBasisError, SolverError
+from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
+from flipkit.solvers.subproblem import QPSolution
 from flipkit.transcription.nlp import NLP
-from flipkit.solvers.osqp_driver import OSQPDriver
-from flipkit.solvers.full_qp import QPSolution, run_osqp
 
 
-class ReducedQP:
-    """The condensed hard subproblem for NLPs sharing one structure.
+class CondensedQP:
+    """The condensed hard subproblem (a :class:`~flipkit.solvers.subproblem.Subproblem`) for
+    NLPs sharing one structure.
 
     Args:
         nlp: An NLP of the structure (its pattern and bound types are used, not its values).
@@ -69,7 +71,7 @@ class ReducedQP:
         ineq_lo, ineq_hi = np.isfinite(nlp.c_lo[self.ineq_rows]), np.isfinite(nlp.c_hi[self.ineq_rows])
         self.lo_sel, self.hi_sel = np.flatnonzero(ineq_lo), np.flatnonzero(ineq_hi)
         self.v = cp.Variable(self.r, name="v")
-        self.g = cp.Parameter(self.r, name="reduced_gradient")
+        self.g = cp.Parameter(self.r, name="condensed_gradient")
         self.G_lo = cp.Parameter((len(self.lo_sel), self.r), name="rows_lo")
         self.G_hi = cp.Parameter((len(self.hi_sel), self.r), name="rows_hi")
         self.b_lo = cp.Parameter(len(self.lo_sel), name="lo_minus_row")
@@ -82,7 +84,7 @@ class ReducedQP:
         obj = 0.5 * cp.sum_squares(self.v) + self.g @ self.v
         self.problem = cp.Problem(cp.Minimize(obj), list(self.rows.values()))
         if not self.problem.is_dpp():  # pragma: no cover - a programming error
-            raise RuntimeError("the reduced subproblem must be DPP")
+            raise SolverError("the condensed subproblem must be DPP")
         self.basis: np.ndarray | None = None
 
     # ------------------------------------------------------------------ basis
@@ -140,7 +142,7 @@ class ReducedQP:
             self.choose_basis(jac)
             lu = self._factor(E)
             if lu is None:
-                raise ConfigError("the equality rows' Jacobian is rank deficient")
+                raise SingularBasisError("the equality rows' Jacobian is rank deficient")
         B, N, n, r = self.basis, self.free, self.n, self.r
         lo_s, hi_s = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
         Z = np.zeros((n, r))
@@ -162,7 +164,7 @@ class ReducedQP:
 
     def solve(self, eps: float | None = None, max_iter: int | None = None) -> QPSolution:
         """Solve with OSQP and map back: the full-space step d and row multipliers y (m,), in
-        the sign convention of :class:`~flipkit.solvers.full_qp.QPSolution`."""
+        the sign convention of :class:`~flipkit.solvers.subproblem.QPSolution`."""
         res, iterations, status, solved = run_osqp(self.compile(), self.problem, eps, max_iter)
         y = np.zeros(self.m)
         if not solved:
@@ -177,14 +179,3 @@ class ReducedQP:
         y[self.eq_rows] = -lu.solve(residual[self.basis], trans="T")
         y[self.ineq_rows] = y_I
         return QPSolution(d, status, iterations, y, res.info.status_polish == 1)
-
-
-_CACHE: dict[str, ReducedQP] = {}
-
-
-def reduced_subproblem_for(nlp: NLP) -> ReducedQP:
-    """The condensed subproblem for the NLP's structure, built on first use and then reused."""
-    qp = _CACHE.get(nlp.structure_key)
-    if qp is None:
-        qp = _CACHE[nlp.structure_key] = ReducedQP(nlp)
-    return qp

@@ -25,51 +25,14 @@ alone.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
+from flipkit.errors import SolverError
+from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
+from flipkit.solvers.subproblem import QPSolution
 from flipkit.transcription.nlp import NLP
-from flipkit.solvers.osqp_driver import OSQPDriver
-
-# OSQP: polishing turns an ADMM iterate into the exact solution of the identified active set;
-# the SQP passes its own tolerance per solve (this eps is the default for a direct solve).
-# Deterministic: a fixed adaptive-rho interval (interval 0 would time the setup and adapt rho
-# after a fraction of it, which varies run to run).
-OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
-                     polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
-
-
-def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_iter: int | None):
-    """Solve ``problem`` through its driver with :data:`OSQP_SETTINGS` (``eps`` and
-    ``max_iter`` overriding); returns (OSQP result, ADMM iterations, status, solved), status
-    cvxpy's, or ``osqp:<status>`` when cvxpy could not unpack it, solved for (inaccurately)
-    optimal."""
-    settings = dict(OSQP_SETTINGS)
-    if eps is not None:
-        settings.update(eps_abs=eps, eps_rel=eps)
-    if max_iter is not None:
-        settings.update(max_iter=int(max_iter))
-    res, iterations = driver.solve(settings)
-    ok = res.info.status_val in (1, 2, 3, 4)
-    status = str(problem.status) if ok else f"osqp:{res.info.status}"
-    return res, iterations, status, res.info.status_val in (1, 2)
-
-
-@dataclass
-class QPSolution:
-    """d (scaled step), OSQP status and iterations, and the row multipliers y (m,) in scaled
-    row units with ∇(gᵀd + ½dᵀHd) + Jᵀy + (box multipliers) = 0 at the solution: y ≥ 0 on an
-    active upper bound, ≤ 0 on an active lower bound, free on an equality."""
-
-    d: np.ndarray
-    status: str
-    iterations: int
-    multipliers: np.ndarray
-    polished: bool = False
-
 
 class _SparseRows:
     """A sparse cvxpy Parameter holding the Jacobian rows ``rows`` on the NLP's pattern
@@ -92,7 +55,7 @@ class _SparseRows:
 
 
 class QPSubproblem:
-    """The convex subproblem for NLPs sharing one structure (pattern and bound types).
+    """The full-space subproblem (a :class:`~flipkit.solvers.subproblem.Subproblem`) for NLPs sharing one structure (pattern and bound types).
 
     Args:
         nlp: An NLP of the structure; its values are not used, only the pattern.
@@ -142,7 +105,7 @@ class QPSubproblem:
             obj = obj + 0.5 * self.slack_reg * sum(cp.sum_squares(s) for s in slacks)
         self.problem = cp.Problem(cp.Minimize(obj), cons)
         if not self.problem.is_dpp():  # pragma: no cover - a programming error
-            raise RuntimeError("the SQP subproblem must be DPP")
+            raise SolverError("the SQP subproblem must be DPP")
 
     def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
                d_lo: np.ndarray, d_hi: np.ndarray, slack_reg: float = 1e2) -> None:
@@ -184,8 +147,8 @@ class QPSubproblem:
         fixed pattern, warm start, working set of inequality rows).
 
         Args:
-            eps: Absolute/relative tolerance overriding :data:`OSQP_SETTINGS`.
-            max_iter: ADMM iteration cap overriding :data:`OSQP_SETTINGS`.
+            eps: Absolute/relative tolerance overriding :data:`~flipkit.solvers.osqp_driver.OSQP_SETTINGS`.
+            max_iter: ADMM iteration cap overriding :data:`~flipkit.solvers.osqp_driver.OSQP_SETTINGS`.
         """
         res, iterations, status, solved = run_osqp(self.compile(), self.problem, eps, max_iter)
         d = self.d.value if solved else None
@@ -199,15 +162,3 @@ class QPSubproblem:
         return QPSolution(d=np.zeros(self.d.shape) if d is None else np.asarray(d),
                           status=status, iterations=iterations,
                           multipliers=y, polished=res.info.status_polish == 1)
-
-
-_CACHE: dict[tuple[str, bool], QPSubproblem] = {}
-
-
-def subproblem_for(nlp: NLP, elastic: bool = False) -> QPSubproblem:
-    """The compiled subproblem for the NLP's structure, built on first use and then reused."""
-    key = (nlp.structure_key, elastic)
-    qp = _CACHE.get(key)
-    if qp is None:
-        qp = _CACHE[key] = QPSubproblem(nlp, elastic)
-    return qp

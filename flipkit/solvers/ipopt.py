@@ -41,7 +41,7 @@ import numpy as np
 
 from flipkit.errors import NoSolutionFound
 from flipkit.transcription.nlp import NLP
-from flipkit.solvers.result import SolveResult
+from flipkit.solvers.result import SolveResult, Status
 
 #: IPOPT return statuses treated as convergence (the violation is checked independently).
 IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -300,7 +300,7 @@ def solve_ipopt(nlp: NLP, x0=None, options: IpoptOptions = IpoptOptions(),
     crossed = _inconsistent_bounds(nlp)
     if crossed is not None:
         c, _ = nlp.evaluate(x_start)
-        result = IpoptResult(x=x_start, status="inconsistent_bounds", iterations=0,
+        result = IpoptResult(x=x_start, status=Status.INCONSISTENT_BOUNDS, iterations=0,
                              wall_time_s=time.perf_counter() - t0,
                              objective=nlp.objective(x_start),
                              max_violation=max(float(nlp.scaled_violation(c).max(initial=0.0)),
@@ -329,14 +329,15 @@ def solve_ipopt(nlp: NLP, x0=None, options: IpoptOptions = IpoptOptions(),
     c, _ = nlp.evaluate(x)
     violation = float(nlp.scaled_violation(c).max(initial=0.0))
     if return_status in IPOPT_SUCCESS:
-        status = "solved" if violation <= options.constr_viol_tol else "violation_above_tol"
+        status = (Status.SOLVED if violation <= options.constr_viol_tol
+                  else Status.VIOLATION_ABOVE_TOL)
     else:
-        status = return_status
+        status = Status.from_ipopt(return_status)
     result = IpoptResult(x=x, status=status, iterations=int(stats.get("iter_count", 0)),
                          wall_time_s=time.perf_counter() - t0, objective=nlp.objective(x),
                          max_violation=violation, solver="ipopt", log=_iteration_log(stats),
                          return_status=return_status, evaluations=cache.evaluations)
-    if status != "solved" and raise_on_failure:
+    if status != Status.SOLVED and raise_on_failure:
         group, amount = nlp.worst_group(x)
         raise NoSolutionFound(nlp, status, group, amount, result)
     return result

@@ -23,15 +23,57 @@ fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import os
+import sys
 import warnings
 
 import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
+from flipkit.errors import SolverError
+
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 ADD_PER_ROUND = 10  # most violated dropped rows added per round
 INITIAL_SLACK = 1e-2  # first working set: inequality rows this close to a bound at d = 0
+try:
+    _LIBC = ctypes.CDLL(None)  # this process's C library, for fflush
+except OSError:  # pragma: no cover - not a POSIX process
+    _LIBC = None
+
+
+@contextlib.contextmanager
+def c_stdout_silenced():
+    """Discard what the solver writes to stdout meanwhile, from C or through Python.
+
+    OSQP 1.1's polish step prints "Polishing not needed - no active set detected at optimal
+    point" whatever its ``verbose`` setting — with C's printf, whose buffer is flushed at exit
+    when stdout is a pipe (the line then lands in the middle of a command's output), or through
+    ``sys.stdout`` when the extension is set to print through Python. Both are sent to
+    /dev/null: fd 1 (C's buffer flushed before fd 1 is restored) and ``sys.stdout``. Nothing
+    of flipkit prints inside a solve. fd 1 is process-wide: not for threads that print while
+    OSQP runs (flipkit's sweeps use processes).
+    """
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError, AttributeError):  # no fd 1 (e.g. closed)
+        saved = None
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        if saved is not None:
+            os.dup2(devnull, 1)
+        with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):
+            yield
+    finally:
+        if _LIBC is not None:
+            _LIBC.fflush(None)
+        if saved is not None:
+            os.dup2(saved, 1)
+            os.close(saved)
+        os.close(devnull)
 
 
 class OSQPDriver:
@@ -99,7 +141,7 @@ class OSQPDriver:
         pos = np.searchsorted(self._keys[k], keys)
         if np.any(pos >= len(self._keys[k])) or np.any(self._keys[k][np.minimum(
                 pos, len(self._keys[k]) - 1)] != keys):
-            raise RuntimeError("QP data outside the fixed sparsity pattern")  # pragma: no cover
+            raise SolverError("QP data outside the fixed sparsity pattern")  # pragma: no cover
         out = self._patterns[k].copy()
         out.data = np.zeros(len(self._keys[k]))
         np.add.at(out.data, pos, M.data)
@@ -184,3 +226,31 @@ class OSQPDriver:
         else:
             self.reset()  # next solve starts afresh
         return res, total
+
+
+# OSQP: polishing turns an ADMM iterate into the exact solution of the identified active set;
+# the SQP passes its own tolerance per solve (this eps is the default for a direct solve).
+# Deterministic: a fixed adaptive-rho interval (interval 0 would time the setup and adapt rho
+# after a fraction of it, which varies run to run).
+OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
+                     polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
+
+
+def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_iter: int | None):
+    """Solve ``problem`` through its driver with :data:`OSQP_SETTINGS` (``eps`` and
+    ``max_iter`` overriding); returns (OSQP result, ADMM iterations, status, solved), status
+    cvxpy's, or ``osqp:<status>`` when cvxpy could not unpack it, solved for (inaccurately)
+    optimal."""
+    settings = dict(OSQP_SETTINGS)
+    if eps is not None:
+        settings.update(eps_abs=eps, eps_rel=eps)
+    if max_iter is not None:
+        settings.update(max_iter=int(max_iter))
+    try:
+        with c_stdout_silenced():
+            res, iterations = driver.solve(settings)
+    except cp.error.SolverError as exc:  # OSQP broke down (cvxpy's error): ours, one line
+        raise SolverError(f"OSQP failed inside a subproblem: {' '.join(str(exc).split())}") from None
+    ok = res.info.status_val in (1, 2, 3, 4)
+    status = str(problem.status) if ok else f"osqp:{res.info.status}"
+    return res, iterations, status, res.info.status_val in (1, 2)

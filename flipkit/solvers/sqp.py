@@ -1,14 +1,14 @@
 """SQP: Gauss–Newton subproblems (cvxpy + OSQP), exact dynamics projection, ℓ1 merit.
 
 Model. Each iteration linearises the constraints at Z_k and solves the convex subproblem of
-:mod:`flipkit.solvers.full_qp` — in its null-space (condensed) form, :mod:`flipkit.solvers.condensed_qp`, by
+:mod:`flipkit.solvers.full_qp` — in its condensed form, :mod:`flipkit.solvers.condensed_qp`, by
 default: the 516–528 linearised equality rows are eliminated by a sparse LU, leaving 19–31
 variables with an identity Hessian and only inequality rows for OSQP (measured on the ten
 Table I pickup-and-flip chains: median 11.7 s → 1.6 s per burger). The model: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt
 weight ½μ‖d‖², every linearised row hard, and a box trust region |d|∞ ≤ Δ (scaled units).
 With the dynamics rows u = RNEA(q, q̇, q̈) hard this is the Gauss–Newton model of Σ‖RNEA‖²
 along the linearised constraints: no second derivatives, no quasi-Newton memory. Σu² is
-nearly flat along wrist motions (9 of the 19 reduced-Hessian eigenvalues below 4e-6, the
+nearly flat along wrist motions (9 of the 19 eigenvalues of the condensed Hessian below 4e-6, the
 largest 5e-3, measured), which μ regularises: μ is divided by 4 after a full step the
 model predicted well (actual/predicted ≥ ``good_ratio``) and multiplied by 4 when a step had to be
 shortened, within ``prox_range``.
@@ -36,7 +36,7 @@ Converged: the hard QP's predicted decrease ≤ ``ftol``·J̃ and max scaled vio
 ``ftol`` = 1e-4: on pickup the objective then creeps down ~5e-5 relative per iteration
 along a flat valley (IPOPT needs 130 iterations there too); a tighter ``ftol`` buys a few
 parts in 1e4 of Σu² for tens of iterations (measured objective gaps to IPOPT are printed by
-``python -m flipkit.experiments.bench``). An exact Lagrangian Hessian (finite differences, reduced
+``python -m flipkit.experiments.bench``). An exact Lagrangian Hessian (finite differences, condensed
 space) left that tail unchanged: the steps there are limited by the rows' curvature, not
 by the model of the cost (measured).
 
@@ -54,9 +54,9 @@ import numpy as np
 from flipkit.errors import ConfigError, NoSolutionFound
 from flipkit.solvers.iterate import Iterate, newton_correction
 from flipkit.transcription.nlp import NLP
-from flipkit.solvers.full_qp import QPSolution, subproblem_for
-from flipkit.solvers.condensed_qp import reduced_subproblem_for
-from flipkit.solvers.result import SolveResult
+from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.subproblem import QPSolution
+from flipkit.solvers.result import SolveResult, Status
 
 __all__ = ["SQPOptions", "SolveResult", "solve_sqp"]
 
@@ -80,7 +80,7 @@ class SQPOptions:
             curvature and creeps along curved active rows such as the flip's landing
             (measured at Table I loc 6: feasible after 11 iterations, then 0.3–1 % per 10
             iterations for 90 more, ending 1 % above IPOPT's exact-Hessian optimum).
-        condense: Solve the hard subproblem in null-space form (:mod:`flipkit.solvers.condensed_qp`);
+        condense: Solve the hard subproblem in condensed form (:mod:`flipkit.solvers.condensed_qp`);
             False solves the full-space QP of :mod:`flipkit.solvers.full_qp` (slower, same solution).
         max_iter: Cap on SQP iterations (QP solves).
         trust0, trust_min, trust_max: Initial, smallest and largest trust box Δ.
@@ -143,7 +143,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
     else the restoration QP. Returns (solution, QP object, μ, tries, ADMM iterations)."""
     admm = 0
     for attempt in range(3):
-        qp = reduced_subproblem_for(nlp) if o.condense else subproblem_for(nlp)
+        qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
         sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
         admm += sol.iterations
@@ -157,7 +157,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
     if sol.status == "optimal":
         return sol, qp, mu, attempt + 1, admm
     # Restoration: a least-squares (Levenberg–Marquardt) step on the rows.
-    qp = subproblem_for(nlp, elastic=True)
+    qp = SUBPROBLEMS.get(nlp, "elastic")
     qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), d_lo, d_hi,
               o.slack_reg)
     sol = qp.solve(eps=eps)
@@ -228,10 +228,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
             worst constraint group and its violation, and the result).
     """
     t0 = time.perf_counter()
-    for elastic in (False, True):  # no warm start from another NLP: results must not depend
-        subproblem_for(nlp, elastic).reset()  # on what was solved before in this process
-    if options.condense:
-        reduced_subproblem_for(nlp).reset()
+    SUBPROBLEMS.reset(nlp)  # no warm start from another NLP's solve in this process
     o, D = options, nlp.x_scale
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
@@ -239,7 +236,7 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
     correct = lambda q: point(q.x + D * newton_correction(nlp, q))  # noqa: E731
     p = point(nlp.x0 if x0 is None else x0)
     rho, trust, mu = o.rho_min, o.trust0, o.prox
-    log, qp_iters, status, it, pred, stalls = [], 0, "max_iter", 0, np.inf, 0
+    log, qp_iters, status, it, pred, stalls = [], 0, Status.MAX_ITER, 0, np.inf, 0
     while it < o.max_iter:
         it += 1
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
@@ -270,12 +267,12 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
                 if p.v_max <= o.tol:
                     break
         if stationary and p.v_max <= o.tol:
-            status = "solved"
+            status = Status.SOLVED
         elif sol.status in ("optimal", "optimal_inaccurate") and pred > 0:
             trial, step, ratio, accepted = _line_search(
                 o, p, D * sol.d, pred, rho, point, correct)
         d_len = float(np.abs(sol.d).max(initial=0.0))
-        if status != "solved":
+        if status != Status.SOLVED:
             trust, mu = _adapt(o, accepted, step, ratio, d_len, trust, mu)
         if not hard:  # restoration: count the steps that barely reduce the violation
             gain = float(p.v.sum()) - float(trial.v.sum()) if accepted else 0.0
@@ -287,18 +284,18 @@ def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_fa
                     "step": step if accepted else 0.0, "trust": trust, "prox": mu, "rho": rho,
                     "qp_iters": admm, "qp_tries": tries, "qp_status": sol.status,
                     "polished": sol.polished, "elastic": qp.elastic})
-        if status == "solved":
+        if status == Status.SOLVED:
             break
         if trust <= o.trust_min and not accepted:
-            status = "stalled"
+            status = Status.STALLED
             break
         if stalls >= o.stall_iterations:
-            status = "infeasible"
+            status = Status.INFEASIBLE
             break
     result = SolveResult(x=p.x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,
                          objective=nlp.objective(p.x), max_violation=p.v_max,
                          log=log, qp_iterations=qp_iters)
-    if status != "solved" and raise_on_failure:
+    if status != Status.SOLVED and raise_on_failure:
         group, amount = nlp.worst_group(p.x)
         raise NoSolutionFound(nlp, status, group, amount, result)
     return result

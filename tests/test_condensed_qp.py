@@ -1,4 +1,4 @@
-"""The condensed (null-space) subproblem: same step and multipliers as the full-space QP,
+"""The condensed subproblem: same step and multipliers as the full-space QP,
 linearised equalities exact, a compiled problem per structure, warm starts that pay."""
 
 import numpy as np
@@ -9,7 +9,8 @@ from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.full_qp import QPSubproblem
-from flipkit.solvers.condensed_qp import ReducedQP, reduced_subproblem_for
+from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.condensed_qp import CondensedQP
 from flipkit.solvers.sqp import SQPOptions, solve_sqp
 
 
@@ -46,7 +47,7 @@ def test_condensed_step_is_the_full_space_step(segments, name):
     g + H d + Jᵀy = 0 on the variables whose box is inactive."""
     nlp = segments[name]
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
-    full, red = QPSubproblem(nlp), ReducedQP(nlp)
+    full, red = QPSubproblem(nlp), CondensedQP(nlp)
     for qp in (full, red):
         qp.update(nlp, c, entries, g, h, lo, hi)
     a, b = full.solve(eps=1e-10, max_iter=50000), red.solve(eps=1e-10, max_iter=50000)
@@ -65,7 +66,7 @@ def test_condensed_step_is_the_full_space_step(segments, name):
 def test_null_space_dimension_and_basis(segments):
     """r = n − (equality rows); the basis T spans the null space of the equality Jacobian."""
     nlp = segments["scoop"]
-    qp = ReducedQP(nlp)
+    qp = CondensedQP(nlp)
     assert qp.r == nlp.n - int(np.sum(nlp.c_lo == nlp.c_hi))
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
     qp.update(nlp, c, entries, g, h, lo, hi)
@@ -73,14 +74,14 @@ def test_null_space_dimension_and_basis(segments):
     T = qp.T.value
     assert np.linalg.matrix_rank(T) == qp.r
     assert np.abs(E @ T).max() < 1e-9 * np.abs(T).max()
-    # The reduced Hessian is the identity: Tᵀ H T = I.
+    # The condensed Hessian is the identity: Tᵀ H T = I.
     assert np.allclose(T.T @ (h[:, None] * T), np.eye(qp.r), atol=1e-8)
 
 
 def test_structure_shares_one_compiled_problem(segments):
     nlp = segments["translate"]
-    assert reduced_subproblem_for(nlp) is reduced_subproblem_for(nlp)
-    assert reduced_subproblem_for(nlp).problem.is_dpp()
+    assert SUBPROBLEMS.get(nlp, "condensed") is SUBPROBLEMS.get(nlp, "condensed")
+    assert SUBPROBLEMS.get(nlp, "condensed").problem.is_dpp()
 
 
 def test_warm_start_cuts_iterations(segments):
@@ -88,7 +89,7 @@ def test_warm_start_cuts_iterations(segments):
     ADMM iterations than from scratch."""
     nlp = segments["scoop"]
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
-    qp = ReducedQP(nlp)
+    qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     qp.solve(eps=1e-8)
     qp.update(nlp, c, entries, 1.01 * g, h, lo, hi)
@@ -120,7 +121,7 @@ def test_infeasible_linearisation_is_reported_not_raised():
         end = nlp.layout.nodes(nlp.x0)[-1]
         q, qd = end[0], end[1]
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
-    qp = ReducedQP(nlp)
+    qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     sol = qp.solve(eps=1e-6, max_iter=20000)
     assert "infeasible" in sol.status
@@ -132,7 +133,7 @@ def test_singular_basis_is_pivoted_again(segments):
     entries zeroed), the update re-pivots at the current point instead of producing garbage."""
     nlp = segments["translate"]
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
-    qp = ReducedQP(nlp)
+    qp = CondensedQP(nlp)
     qp.choose_basis(entries)
     eq = np.flatnonzero(nlp.c_lo == nlp.c_hi)
     for dead in qp.basis[::-1]:  # a basic column whose loss leaves E with full row rank
