@@ -8,6 +8,7 @@ from test_plan import translate_plan
 from flipkit.cli import main
 from flipkit.errors import FlipkitError
 from flipkit.planning.export import resample, write_csv
+from flipkit.planning.plan_file import Plan
 
 RATE = 100.0  # Hz; the plan lasts 1.0 + 0.8 s
 
@@ -75,3 +76,23 @@ def test_cli(plan, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("flipkit: error:") and "rate must be" in err and "\n" not in err
     assert main(["export", str(tmp_path / "nope.json"), "--rate", "100", "--csv", str(out)]) == 2
+
+
+def test_a_tampered_plan_is_not_exported(plan, tmp_path, capsys):
+    """A joint angle moved by 0.01 rad: verify fails it, so export exits 1, names the failed
+    check and writes no file (a controller never gets an unverified trajectory)."""
+    import json
+
+    path = plan.to_json(tmp_path / "plan.json")
+    doc = json.loads(path.read_text())
+    doc["segments"][0]["q"][7][2] += 0.01
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "traj.csv"
+    assert main(["export", str(path), "--rate", "250", "--csv", str(out)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "plan fails" in err and "nothing written" in err
+    assert not out.exists()
+    assert main(["export", str(path), "--rate", "250", "--csv", str(out), "--force"]) == 1
+    assert not out.exists()
+    with pytest.raises(FlipkitError, match="plan fails 'dynamics'|plan fails 'defects'"):
+        write_csv(Plan.load(path), out, 250.0)

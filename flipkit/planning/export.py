@@ -1,4 +1,8 @@
-"""Resample a plan at a controller rate and write it as CSV.
+"""Resample a verified plan at a controller rate and write it as CSV.
+
+A controller only gets verified plans: :func:`write_csv` runs
+:func:`flipkit.planning.verify.verify_plan` first and writes nothing if the plan fails it
+(``--force`` waives the plan's *status*, never the verification).
 
 Within a segment the collocation fixes (q, q̇, q̈) at the nodes; between two consecutive
 nodes q is the cubic Hermite interpolant of (q, q̇) and q̇ that of (q̇, q̈)
@@ -19,6 +23,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.errors import FlipkitError
 from flipkit.planning.plan_file import Plan
+from flipkit.planning.verify import TOL, verify_plan
 
 MAX_ROWS = 10_000_000  # refuse absurd rates rather than fill the disk
 _EPS = 1e-9  # s, slack on the last sample time (floating-point T_total · rate)
@@ -72,15 +77,24 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     return t, q, qd
 
 
-def write_csv(plan: Plan, path, rate: float, *, force: bool = False) -> int:
-    """Write ``t,q1..qn,qd1..qdn`` (s, rad, rad/s) at ``rate`` to ``path``; return the row count.
+def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL) -> int:
+    """Verify ``plan``, then write ``t,q1..qn,qd1..qdn`` (s, rad, rad/s) at ``rate`` to
+    ``path``; return the row count.
 
     Values are written with 17 significant digits (round-trip exact).
 
+    Args:
+        plan: The plan. path: Output CSV. rate: Controller rate (Hz).
+        force: Export even a plan whose status is not ``solved`` (it must still verify).
+        tol: Verification tolerance (scaled units, :data:`flipkit.planning.verify.TOL`).
+
     Raises:
+        VerificationError: The plan fails the independent check (the message names the worst
+            check group, its segment and amount); nothing is written.
         FlipkitError: As :func:`resample`, or the file cannot be written.
     """
     t, q, qd = resample(plan, rate, force=force)
+    verify_plan(plan, tol=tol).raise_if_failed()
     nq = q.shape[1]
     header = ",".join(["t"] + [f"q{j + 1}" for j in range(nq)] + [f"qd{j + 1}" for j in range(nq)])
     try:
