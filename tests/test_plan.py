@@ -86,11 +86,11 @@ def test_round_trip_is_exact_and_keys_follow_the_format(models, tmp_path):
     assert list(doc) == ["format", "behavior", "status", "created_by", "robot", "gravity",
                          "grill_height", "spatula", "burger", "cone", "segments"]
     assert doc["format"] == FORMAT and doc["status"] == "solved"
-    assert list(doc["robot"]) == ["urdf", "base_in_world", "tool_parent_frame",
+    assert list(doc["robot"]) == ["urdf", "urdf_sha256", "base_in_world", "tool_parent_frame",
                                   "spatula_in_parent", "payload", "q_home"]
     seg = doc["segments"][0]
     assert list(seg) == ["name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes",
-                         "solver", "goal"]
+                         "solver", "payload", "goal"]
     assert np.array(seg["q"]).shape == (21, 6) and np.array(seg["alpha"]).shape == (6, 7)
     assert set(doc["created_by"]) == {"flipkit", "git"}
     back = Plan.load(path)
@@ -162,7 +162,7 @@ def _edit(doc, path, value):
 
 
 @pytest.mark.parametrize("path, value, message", [
-    (("format",), "flipkit-plan/2", "format: expected 'flipkit-plan/1'"),
+    (("format",), "flipkit-plan/3", "format: expected one of 'flipkit-plan/1', 'flipkit-plan/2'"),
     (("status",), "done", "status: 'done' is not one of"),
     (("cone",), "round", "cone: 'round' is not one of"),
     (("segments", 0, "qdd"), KeyError, r"segments\[0\].qdd: missing key"),

@@ -1,4 +1,4 @@
-"""The documented plan format (docs/plan-format.schema.json) against real plan files."""
+"""The documented plan format (flipkit/data/plan-format.schema.json) against real plan files."""
 
 import copy
 import json
@@ -7,7 +7,8 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-SCHEMA = json.loads((Path(__file__).parents[1] / "docs" / "plan-format.schema.json").read_text())
+SCHEMA = json.loads((Path(__file__).parents[1] / "flipkit" / "data" / "plan-format.schema.json")
+                    .read_text())
 
 
 def test_a_solved_flip_plan_matches_the_documented_format(flip_plan_file):

@@ -44,7 +44,7 @@ def register(subparsers) -> None:
                             "fails), sqp (cvxpy/OSQP) or ipopt (CasADi)")
         if json_out:
             p.add_argument("--json", required=True, metavar="PLAN.json",
-                           help="output plan file (flipkit-plan/1)")
+                           help="output plan file (flipkit-plan/2)")
 
     t = sub.add_parser("translate", help="carry the burger flat from one point to another",
                        description="Translate the flat spatula (burger on it) between two "

@@ -18,7 +18,7 @@ def register(subparsers) -> None:
                     "defects, time grid, joint limits, behaviour endpoints, continuity "
                     "between segments, friction cone and grill clearance. Exit 0 if the plan "
                     "passes, 1 if it fails, 2 if the file is unreadable or malformed.")
-    parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/1)")
+    parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/2; /1 is read too)")
     parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT")
     parser.add_argument("--tol", type=float, metavar="TOL",
                         help="tolerance in the solver's scaled units (default: "

@@ -6,14 +6,16 @@ Constructors validate their arguments and raise :class:`~flipkit.errors.ConfigEr
 
 * :mod:`~flipkit.config.cell`: robot, spatula, burger, grill, table, task limits, Table I;
 * :mod:`~flipkit.config.physics`: the simulated cell's physical parameters and their ranges;
+* :mod:`~flipkit.config.urdf`: URDFs named portably (plan files), with their sha256;
 * :mod:`~flipkit.config.checks`: the argument checks they share.
 """
 
-from flipkit.config.cell import (GRAVITY, TABLE1_LOCATIONS, UR10_URDF_RELATIVE, BurgerConfig,
-                                 CellConfig, GrillConfig, RobotConfig, SpatulaConfig,
-                                 TableConfig, TaskLimits, default_urdf)
+from flipkit.config.cell import (GRAVITY, TABLE1_LOCATIONS, BurgerConfig, CellConfig,
+                                 GrillConfig, RobotConfig, SpatulaConfig, TableConfig, TaskLimits)
 from flipkit.config.physics import PHYSICAL_RANGES, PhysicsConfig, with_parameter
+from flipkit.config.urdf import default_urdf, portable_urdf, resolve_urdf, urdf_sha256
 
-__all__ = ["GRAVITY", "PHYSICAL_RANGES", "TABLE1_LOCATIONS", "UR10_URDF_RELATIVE", "BurgerConfig",
+__all__ = ["GRAVITY", "PHYSICAL_RANGES", "TABLE1_LOCATIONS", "BurgerConfig",
            "CellConfig", "GrillConfig", "PhysicsConfig", "RobotConfig", "SpatulaConfig",
-           "TableConfig", "TaskLimits", "default_urdf", "with_parameter"]
+           "TableConfig", "TaskLimits", "default_urdf", "portable_urdf", "resolve_urdf",
+           "urdf_sha256", "with_parameter"]

@@ -9,29 +9,15 @@ ours where the paper is silent. Constructors validate their arguments and raise
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from flipkit.config.checks import box, finite, positive
 from flipkit.config.physics import PhysicsConfig
+from flipkit.config.urdf import default_urdf, resolve_urdf
 from flipkit.errors import ConfigError
 
 GRAVITY = (0.0, 0.0, -9.81)  # m/s², world z up (DESIGN.md conventions)
-UR10_URDF_RELATIVE = ("cmeel.prefix", "share", "example-robot-data", "robots", "ur_description",
-                      "urdf", "ur10_joint_limited_robot.urdf")
-
-
-def default_urdf() -> str:
-    """Absolute path of the UR10 joint-limited URDF shipped by example-robot-data (pip)."""
-    import sysconfig
-
-    for key in ("purelib", "platlib"):
-        path = Path(sysconfig.get_paths()[key]).joinpath(*UR10_URDF_RELATIVE)
-        if path.is_file():
-            return str(path)
-    raise ConfigError("example-robot-data is not installed: UR10 URDF not found "
-                      "(install the environment.lock)")
 
 
 def _identity() -> tuple:
@@ -43,7 +29,8 @@ class RobotConfig:
     """The arm: URDF, tool frame, base placement and home configuration.
 
     Attributes:
-        urdf: URDF path; ``None`` means the UR10 joint-limited robot of example-robot-data
+        urdf: URDF path or portable name (``example-robot-data:<path>``, see
+            :mod:`flipkit.config.urdf`); ``None`` means the UR10 joint-limited robot of example-robot-data
             (the paper's arm is an unnamed 6-DOF industrial arm; the UR10 matches its reach).
         tool_frame: Frame the spatula is mounted on (``tool0``, the ROS-Industrial flange).
         base_in_world: 4x4 homogeneous transform of the robot base in the world (identity:
@@ -62,8 +49,8 @@ class RobotConfig:
     accel_limit: float = 20.0
 
     def __post_init__(self):
-        if self.urdf is not None and not Path(self.urdf).is_file():
-            raise ConfigError(f"URDF file not found: {self.urdf}")
+        if self.urdf is not None:
+            resolve_urdf(self.urdf)  # a path, or a portable name (flipkit.config.urdf)
         base = finite("base_in_world", self.base_in_world, (4, 4))
         if not np.allclose(base[3], [0, 0, 0, 1]) or not np.allclose(
                 base[:3, :3] @ base[:3, :3].T, np.eye(3), atol=1e-6):
@@ -73,8 +60,8 @@ class RobotConfig:
 
     @property
     def urdf_path(self) -> str:
-        """Absolute URDF path (the default resolved)."""
-        return str(Path(self.urdf).resolve()) if self.urdf else default_urdf()
+        """Absolute URDF path (a portable name or the default resolved)."""
+        return resolve_urdf(self.urdf) if self.urdf else default_urdf()
 
 
 @dataclass(frozen=True)

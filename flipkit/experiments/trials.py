@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import CARRIES_BURGER
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, with_parameter
@@ -77,7 +76,7 @@ class Perturbations:
 
 
 def plan_from_text(text: str) -> Plan:
-    """A plan from the text of a ``flipkit-plan/1`` file (already checked by Plan.load)."""
+    """A plan from the text of a ``flipkit-plan`` file (already checked by Plan.load)."""
     doc = json.loads(text)
     return Plan(**{k: doc[k] for k in _PLAN_KEYS})
 
@@ -102,8 +101,8 @@ def track_plan(plan: Plan, plant_cell: CellConfig | None = None, rate_hz=TRACK_R
     plants = {w: Robot(plant_cell, with_burger=w) for w in (False, True)}
     ts, ps, rs, bounds, errors, start, q0 = [], [], [], {}, {}, 0.0, None
     for seg in plan.segments:
-        res = track(plan.robot_for(seg.name, cell), seg.t, seg.q, seg.qd, u_ff=seg.u,
-                    rate_hz=rate_hz, mismatch=plants[CARRIES_BURGER[seg.name]], q0=q0)
+        res = track(plan.robot_for(seg, cell), seg.t, seg.q, seg.qd, u_ff=seg.u,
+                    rate_hz=rate_hz, mismatch=plants["burger" in seg.payload], q0=q0)
         q0, e = res.q[-1], res.position_error
         errors[seg.name] = {"max_m": float(e.max()), "sum_sq_m2": float(np.sum(e**2)),
                             "n": int(e.size)}

@@ -108,11 +108,9 @@ def contact_series(plan, segments=None, mu: float | None = None) -> ContactSerie
             with cone nodes).
         mu: Friction coefficient (default: the plan's burger μ).
     """
-    from flipkit.behaviors.segments import CARRIES_BURGER
-
     mu = float(plan.burger["mu"] if mu is None else mu)
     if segments is None:
-        segments = [s.name for s in plan.segments if CARRIES_BURGER[s.name]]
+        segments = [s.name for s in plan.segments if "burger" in s.payload]
     missing = set(segments) - {s.name for s in plan.segments}
     if missing:
         raise ConfigError(f"plan has no segment {sorted(missing)}")
@@ -122,7 +120,7 @@ def contact_series(plan, segments=None, mu: float | None = None) -> ContactSerie
     margins = {form: [] for form in CONE_FORMS}
     for k, seg in enumerate(plan.segments):
         if seg.name in segments:
-            robot = plan.robot_for(seg.name, cell)
+            robot = plan.robot_for(seg, cell)
             for i in range(seg.t.size):
                 st = robot.state(seg.q[i], seg.qd[i], seg.qdd[i])
                 rows["t"].append(t0 + seg.t[i])

@@ -17,8 +17,10 @@ predicted ``landing`` (target, r_land, point, offset, tilt_deg, time_of_flight),
 
 from __future__ import annotations
 
+import functools
 import json
 import os
+from importlib import resources
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,14 +34,40 @@ from flipkit.errors import ConfigError, PlanFileError
 from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text, dumps)
-from flipkit.planning.segment import SEGMENT_KEYS, Segment
+from flipkit.planning.segment import SEGMENT_KEYS, Segment, default_payload
 from flipkit.provenance import git_commit
+from flipkit.config.urdf import portable_urdf, resolve_urdf, urdf_sha256
 
-FORMAT = "flipkit-plan/1"
+FORMAT = "flipkit-plan/2"
+FORMATS = ("flipkit-plan/1", FORMAT)  # readable; /1: before per-segment payloads and portable URDFs
 PLAN_BEHAVIORS = ("translate", "flip")
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
 
+
+
+SCHEMA_FILE = "plan-format.schema.json"  # in flipkit/data (package data)
+
+
+@functools.cache
+def _schema_validator():
+    import jsonschema
+
+    schema = json.loads(resources.files("flipkit").joinpath("data", SCHEMA_FILE).read_text())
+    return jsonschema.Draft202012Validator(schema)
+
+
+def check_schema(doc) -> None:
+    """Validate a plan document against the documented JSON Schema.
+
+    Raises:
+        ConfigError: The first violation, one line: the key path and what is wrong.
+    """
+    error = next(iter(sorted(_schema_validator().iter_errors(doc), key=lambda e: e.path)), None)
+    if error is not None:
+        where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.path)
+        message = " ".join(error.message.split())
+        raise ConfigError(f"{where.lstrip('.') or 'top level'}: {message[:200]} (JSON Schema)")
 
 
 def _created_by() -> dict:
@@ -57,14 +85,17 @@ class Plan:
 
     Attributes:
         behavior: ``translate`` or ``flip``. status: ``solved`` or ``failed``.
-        robot: ``urdf`` (path), ``base_in_world`` and ``spatula_in_parent`` (4x4, m),
+        robot: ``urdf`` (portable name ``example-robot-data:<path>`` or absolute path, see
+            :mod:`flipkit.config.urdf`), ``urdf_sha256`` (of its bytes; None in a
+            ``flipkit-plan/1`` file), ``base_in_world`` and ``spatula_in_parent`` (4x4, m),
             ``tool_parent_frame``, ``payload`` (bodies: mass kg, com m, inertia kg·m² in the
-            spatula frame) and ``q_home`` (rad). The payload is that of the model carrying
-            the burger; segments that do not carry it (CARRIES_BURGER) omit the burger body.
+            spatula frame) and ``q_home`` (rad). The payload lists every body any segment
+            carries; each segment names the ones its dynamics carry (``Segment.payload``).
         gravity: (3,) m/s². grill_height: h_g (m). spatula: ``length``, ``width`` (m).
         burger: ``location`` p^b (3,) m or None, ``diameter``, ``thickness`` (m), ``mass``
             (kg), ``mu``. cone: Friction-cone form. segments: The :class:`Segment` list.
-        created_by: ``{"flipkit": version, "git": commit or None}``. format: FORMAT.
+        created_by: ``{"flipkit": version, "git": commit or None}``. format: the file's
+            format (one of :data:`FORMATS`; written as :data:`FORMAT`).
     """
 
     behavior: str
@@ -80,7 +111,7 @@ class Plan:
     format: str = FORMAT
 
     def __post_init__(self):
-        check_choice("format", self.format, (FORMAT,))
+        check_choice("format", self.format, FORMATS)
         check_choice("behavior", self.behavior, PLAN_BEHAVIORS)
         check_choice("status", self.status, PLAN_STATUSES)
         check_choice("cone", self.cone, CONE_FORMS)
@@ -97,6 +128,13 @@ class Plan:
         if not isinstance(r["payload"], list):
             raise ConfigError("robot.payload: expected a list of bodies")
         r["payload"] = [self._body(k, body) for k, body in enumerate(r["payload"])]
+        sha = self.robot.get("urdf_sha256")
+        if sha is None and self.format != FORMATS[0]:
+            raise ConfigError("robot.urdf_sha256: missing key")
+        if sha is not None and not (isinstance(sha, str) and len(sha) == 64
+                                    and all(c in "0123456789abcdef" for c in sha)):
+            raise ConfigError(f"robot.urdf_sha256: expected 64 lowercase hex digits, got {sha!r}")
+        r["urdf_sha256"] = sha
         self.robot = {**self.robot, **r}
         self.gravity = check_array("gravity", self.gravity, (3,))
         self.grill_height = check_number("grill_height", self.grill_height)
@@ -113,8 +151,9 @@ class Plan:
         """A payload body as plain JSON values (name optional)."""
         where = f"robot.payload[{k}]"
         b = check_keys(body, where, ("parent_frame", "mass", "com", "inertia"))
-        out = {"name": check_text(f"{where}.name", body["name"])} if "name" in body else {}
-        return {**out, "parent_frame": check_text(f"{where}.parent_frame", b["parent_frame"]),
+        # flipkit-plan/1 left names optional: the spatula first, the burger second
+        name = body["name"] if "name" in body else ("spatula", "burger")[min(k, 1)]
+        return {"name": check_text(f"{where}.name", name), "parent_frame": check_text(f"{where}.parent_frame", b["parent_frame"]),
                 "mass": check_number(f"{where}.mass", b["mass"], positive=True),
                 "com": check_array(f"{where}.com", b["com"], (3,)).tolist(),
                 "inertia": check_array(f"{where}.inertia", b["inertia"], (3, 3)).tolist()}
@@ -125,11 +164,18 @@ class Plan:
         nq, names = self.robot["q_home"].size, []
         for k, seg in enumerate(self.segments):
             if isinstance(seg, dict):
-                keys = SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing")
+                if "payload" not in seg and self.format != FORMATS[0]:  # /1: by behaviour
+                    raise ConfigError(f"segments[{k}].payload: missing key")
+                keys = SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing", "payload")
                                              if k in seg)
                 seg = self.segments[k] = check_nested(f"segments[{k}]", Segment, seg, keys)
             if not isinstance(seg, Segment):
                 raise ConfigError(f"segments[{k}]: expected a segment")
+            bodies = [b["name"] for b in self.robot["payload"]]
+            unknown = [b for b in seg.payload if b not in bodies]
+            if unknown:
+                raise ConfigError(f"segments[{k}].payload: {unknown} not in robot.payload "
+                                  f"({', '.join(bodies)})")
             if seg.q.shape[1] != nq:
                 raise ConfigError(f"segments[{k}].q: {seg.q.shape[1]} joints, "
                                   f"robot.q_home has {nq}")
@@ -155,7 +201,8 @@ class Plan:
         if status is None:
             status = "solved" if all(s.solver.status == "solved" for s in segments) else "failed"
         return cls(behavior, status, {
-            "urdf": robot.urdf, "base_in_world": np.asarray(cell.robot.base_in_world, float),
+            "urdf": portable_urdf(robot.urdf), "urdf_sha256": urdf_sha256(robot.urdf),
+            "base_in_world": np.asarray(cell.robot.base_in_world, float),
             "tool_parent_frame": cell.robot.tool_frame,
             "spatula_in_parent": robot.spatula_in_parent, "payload": robot.payload_json(),
             "q_home": robot.q_home},
@@ -169,9 +216,18 @@ class Plan:
         table areas and the acceleration limit are not recorded: defaults are used).
 
         Raises:
-            PlanFileError: The URDF is missing here, or the spatula cannot be rebuilt.
+            PlanFileError: The URDF is missing here, differs from the one the plan recorded
+                (sha256), or the spatula cannot be rebuilt.
         """
         r, w = self.robot, self.spatula["width"]
+        try:
+            path = resolve_urdf(r["urdf"])
+        except ConfigError as exc:
+            raise PlanFileError(f"robot.urdf: {exc}") from None
+        if r.get("urdf_sha256") is not None and urdf_sha256(path) != r["urdf_sha256"]:
+            raise PlanFileError(f"robot.urdf: {path} is not the URDF the plan was made with "
+                                f"(sha256 {urdf_sha256(path)[:12]}..., recorded "
+                                f"{r['urdf_sha256'][:12]}...)")
         spatula = next((b for b in r["payload"] if b.get("name", "spatula") == "spatula"), None)
         if spatula is None:
             raise PlanFileError("robot.payload: no spatula body")
@@ -189,24 +245,41 @@ class Plan:
         except ConfigError as exc:
             raise PlanFileError(f"cannot rebuild the cell from the plan: {exc}") from None
 
-    def robot_for(self, name: str, cell: CellConfig | None = None):
-        """The dynamics model of segment ``name`` (burger on the blade per CARRIES_BURGER),
-        checked against the recorded mount and payload.
+    def robot_for(self, segment, cell: CellConfig | None = None):
+        """The dynamics model of ``segment`` (a :class:`Segment` of this plan, or a name: its
+        first segment of that name, or a behaviour the plan lacks, which carries what that
+        behaviour carries), with the bodies its ``payload`` names, checked against the
+        recorded mount and bodies.
 
         Raises:
-            PlanFileError: The rebuilt model's spatula mount or payload differs from the file's.
+            PlanFileError: No such segment, or the rebuilt model's spatula mount or a body
+                differs from the file's.
         """
         from flipkit.model.robot import Robot
 
-        robot = Robot(cell or self.cell(), with_burger=CARRIES_BURGER[name])
+        if isinstance(segment, str):
+            seg = next((s for s in self.segments if s.name == segment), None)
+            if seg is None and segment not in CARRIES_BURGER:
+                raise PlanFileError(f"segments: no segment {segment!r} in this plan "
+                                    f"({', '.join(s.name for s in self.segments)})")
+            payload = seg.payload if seg is not None else default_payload(segment)
+            name = segment
+        else:
+            payload, name = segment.payload, segment.name
+        robot = Robot(cell or self.cell(), with_burger="burger" in payload)
         if not np.allclose(robot.spatula_in_parent, self.robot["spatula_in_parent"], atol=1e-9):
             raise PlanFileError("robot.spatula_in_parent: not the flipkit spatula mount")
-        recorded, mine = self.robot["payload"], robot.payload_json()
-        if len(recorded) < len(mine) or (CARRIES_BURGER[name] and len(recorded) != len(mine)):
-            raise PlanFileError(f"robot.payload: {len(recorded)} bodies, the model of segment "
-                                f"{name!r} has {len(mine)}")
-        for k, body in enumerate(mine):
-            if not all(np.allclose(body[key], recorded[k][key], rtol=PAYLOAD_RTOL, atol=1e-12)
+        recorded = {b["name"]: (k, b) for k, b in enumerate(self.robot["payload"])}
+        mine = robot.payload_json()
+        if sorted(b["name"] for b in mine) != sorted(payload):
+            raise PlanFileError(f"segment {name!r}: payload {payload}, but flipkit's model "
+                                f"carries {[b['name'] for b in mine]}")
+        for body in mine:
+            if body["name"] not in recorded:
+                raise PlanFileError(f"robot.payload: no {body['name']!r} body for segment "
+                                    f"{name!r}")
+            k, rec = recorded[body["name"]]
+            if not all(np.allclose(body[key], rec[key], rtol=PAYLOAD_RTOL, atol=1e-12)
                        for key in ("mass", "com", "inertia")):
                 raise PlanFileError(f"robot.payload[{k}]: does not match the {body['name']} "
                                     "rebuilt from the spatula and burger of the plan")
@@ -214,16 +287,24 @@ class Plan:
 
     # ------------------------------------------------------------------ file
     def to_json(self, path) -> Path:
-        """Write the plan to ``path`` (atomically) and return the path."""
-        """Write the plan to ``path`` (atomically: a temporary file, then renamed).
+        """Write the plan to ``path`` as :data:`FORMAT` (atomically: a temporary file, then
+        renamed) and return the path.
 
         Raises:
             PlanFileError: The file cannot be written.
         """
         robot = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                  for k, v in ((k, self.robot[k]) for k in _ROBOT_KEYS)}
+        sha = self.robot.get("urdf_sha256")
+        if sha is None:  # read from a flipkit-plan/1 file: record the URDF found here
+            try:
+                sha = urdf_sha256(resolve_urdf(self.robot["urdf"]))
+            except ConfigError as exc:
+                raise PlanFileError(f"robot.urdf: {exc}") from None
+        robot = {"urdf": robot["urdf"], "urdf_sha256": sha,
+                 **{k: v for k, v in robot.items() if k != "urdf"}}
         loc = self.burger["location"]
-        doc = {"format": self.format, "behavior": self.behavior, "status": self.status,
+        doc = {"format": FORMAT, "behavior": self.behavior, "status": self.status,
                "created_by": dict(self.created_by), "robot": robot,
                "gravity": self.gravity.tolist(), "grill_height": self.grill_height,
                "spatula": dict(self.spatula),
@@ -241,7 +322,10 @@ class Plan:
 
     @classmethod
     def load(cls, path) -> "Plan":
-        """Read and validate a plan file.
+        """Read and validate a plan file: key by key, then against the documented JSON Schema
+        (``flipkit/data/plan-format.schema.json``, :func:`check_schema`). A
+        ``flipkit-plan/1`` file (before per-segment payloads and portable URDF names) is read
+        too: each segment then carries the bodies its behaviour carries (CARRIES_BURGER).
 
         Raises:
             PlanFileError: Missing or unreadable file, not JSON, or not ``flipkit-plan/1``
@@ -256,10 +340,19 @@ class Plan:
             msg = str(exc).splitlines()[0]
             raise PlanFileError(f"{path}: not a JSON file ({msg})") from None
         try:
-            if isinstance(doc, dict) and doc.get("format") != FORMAT:
-                raise ConfigError(f"format: expected {FORMAT!r}, got {doc.get('format')!r}")
+            if isinstance(doc, dict) and doc.get("format") not in FORMATS:
+                raise ConfigError(f"format: expected one of {', '.join(map(repr, FORMATS))}, "
+                                  f"got {doc.get('format')!r}")
             keys = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
                     "cone", "segments", "created_by")
-            return cls(**check_keys(doc, "", keys))
+            try:  # before the plan is built (it replaces the segment dicts), reported after
+                check_schema(doc)  # the key checks, whose messages are the more precise
+                schema_error = None
+            except ConfigError as exc:
+                schema_error = exc
+            plan = cls(**check_keys(doc, "", keys), format=doc["format"])
+            if schema_error is not None:
+                raise schema_error
+            return plan
         except ConfigError as exc:
             raise PlanFileError(f"{path}: {exc}") from None

@@ -6,11 +6,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flipkit.behaviors.segments import BEHAVIORS
+from flipkit.behaviors.segments import BEHAVIORS, CARRIES_BURGER
 from flipkit.behaviors.targets import Pose
 from flipkit.errors import ConfigError
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text)
+
+def default_payload(name: str) -> list[str]:
+    """The bodies a segment of behaviour ``name`` carries when nothing says otherwise: the
+    spatula, and the burger where the behaviour carries it (CARRIES_BURGER). Used for
+    segments built in memory and for ``flipkit-plan/1`` files, which did not list them."""
+    return ["spatula", "burger"] if CARRIES_BURGER[name] else ["spatula"]
+
 
 SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
 _LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
@@ -56,6 +63,8 @@ class Segment:
             target (m), ``tilt_deg`` (angle of the top face's normal from +z, deg) and
             ``time_of_flight`` (s) (:func:`flipkit.model.flight.predict_landing`), and
             ``burger_on_blade`` (x, y) (m, blade frame), where the flight starts from.
+        payload: Names of the ``robot.payload`` bodies the segment's dynamics carry
+            (``["spatula"]``, ``["spatula", "burger"]``); default :func:`default_payload`.
     """
 
     name: str
@@ -71,6 +80,7 @@ class Segment:
     goal: Pose | None = None
     release: dict | None = None
     landing: dict | None = None
+    payload: list | None = None
 
     def __post_init__(self):
         check_choice("name", self.name, BEHAVIORS)
@@ -121,6 +131,15 @@ class Segment:
                                           self.landing.get("burger_on_blade", (0.0, 0.0)),
                                           (2,)).tolist()}
 
+        if self.payload is None:
+            self.payload = default_payload(self.name)
+        else:
+            names = self.payload
+            if (not isinstance(names, (list, tuple)) or not names
+                    or not all(isinstance(b, str) for b in names) or len(set(names)) != len(names)):
+                raise ConfigError(f"payload: expected a non-empty list of distinct body names, "
+                                  f"got {names!r}")
+            self.payload = list(names)
     @property
     def N(self) -> int:
         """Number of intervals (N + 1 nodes)."""
@@ -145,13 +164,15 @@ class Segment:
         if block is not None:
             release, landing = block.record(nlp.robot, x)
         return cls(nlp.name, T, L.s * T, nodes[:, 0], nodes[:, 1], nodes[:, 2], nodes[:, 3],
-                   L.alpha(x), list(nlp.cone_nodes), info, goal, release, landing)
+                   L.alpha(x), list(nlp.cone_nodes), info, goal, release, landing,
+                   [body["name"] for body in nlp.robot.payload])
 
     def to_json(self) -> dict:
-        """The segment as JSON values, keys in file order (``goal`` last, if any)."""
+        """The segment as JSON values, keys in file order."""
         arrays = {k: getattr(self, k).tolist() for k in ("t", "q", "qd", "qdd", "u", "alpha")}
         out = {"name": self.name, "T": self.T, **arrays, "cone_nodes": list(self.cone_nodes),
                "solver": dict(vars(self.solver))}
+        out["payload"] = list(self.payload)
         if self.goal is not None:
             out["goal"] = {k: [float(v) for v in getattr(self.goal, k)] for k in ("p", "o")}
         for key in ("release", "landing"):

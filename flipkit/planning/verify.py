@@ -1,9 +1,11 @@
 """Independent residual check of a plan: recomputed from the plan's arrays alone.
 
-Nothing here uses :mod:`flipkit.transcription.nlp` or :mod:`flipkit.transcription.constraints`; kinematics and dynamics
-come from pinocchio through :class:`~flipkit.model.robot.Robot` rebuilt from the plan file, targets
-from :mod:`flipkit.behaviors.targets`, and from :mod:`flipkit.behaviors.segments` only the tables T_BOUNDS,
-CARRIES_BURGER, SCOOP_PRESS, SCOOP_TIP_BAND and grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+Nothing here uses :mod:`flipkit.transcription.nlp` or
+:mod:`flipkit.transcription.constraints`; kinematics and dynamics come from pinocchio through
+:class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
+bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
+:mod:`flipkit.behaviors.segments` only the tables T_BOUNDS, SCOOP_PRESS, SCOOP_TIP_BAND and
+grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -198,11 +200,12 @@ def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
     missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
                if expected is not None else int(not names))
     report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
-    robots = {}
+    robots = {}  # one model per payload list
     for k, seg in enumerate(plan.segments):
-        if seg.name not in robots:
-            robots[seg.name] = plan.robot_for(seg.name, cell)
-        _check_segment(report, k, seg, robots[seg.name], plan, cell, tol)
+        bodies = tuple(seg.payload)
+        if bodies not in robots:
+            robots[bodies] = plan.robot_for(seg, cell)
+        _check_segment(report, k, seg, robots[bodies], plan, cell, tol)
         if k:
             prev = plan.segments[k - 1]
             jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))
