@@ -1,3 +1,7 @@
+"""Configuration: defaults with their sources, validation, and the sourced physics."""
+
+from importlib import resources
+
 import numpy as np
 import pytest
 
@@ -20,12 +24,19 @@ def test_grill_contains_table1_and_csv_matches():
     g = GrillConfig()
     assert all(g.contains(p) for p in TABLE1_LOCATIONS)
     assert all(abs(p[2] - g.height) <= 0.0011 for p in TABLE1_LOCATIONS)
+    text = resources.files("flipkit").joinpath("data", "paper_table1.csv").read_text()
+    rows = [line for line in text.splitlines() if line and not line.startswith("#")][1:]
+    csv = np.array([[float(v) for v in row.split(",")[:3]] for row in rows])
+    np.testing.assert_array_equal(csv, np.array(TABLE1_LOCATIONS))
 
 
 def test_table1_locations_are_reachable_scoop_ready():
     r = Robot()
     for p in TABLE1_LOCATIONS:
-        solve_pose(r, p, (0.0, 0.314, 0.0))
+        q = solve_pose(r, p, (0.0, 0.314, 0.0))
+        np.testing.assert_allclose(r.position(q), p, atol=1e-4)
+        np.testing.assert_allclose(rpy(r.rotation(q)), (0.0, 0.314, 0.0), atol=1e-4)
+        assert np.all(q >= r.q_min) and np.all(q <= r.q_max)
 
 
 @pytest.mark.parametrize("make, match", [
