@@ -1,3 +1,5 @@
+"""``python -m flipkit``: the command line (:mod:`flipkit.cli`)."""
+
 import sys
 
 from flipkit.cli import main

@@ -1,4 +1,4 @@
-"""The plan file ``flipkit-plan/1`` (JSON): a planned trajectory with everything needed to
+"""The plan file ``flipkit-plan/2`` (JSON): a planned trajectory with everything needed to
 check or execute it without the objects that made it (DESIGN.md, "Plan file").
 
 :class:`Plan` and :class:`Segment` mirror the file key for key. Constructors validate their

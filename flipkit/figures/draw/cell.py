@@ -1,4 +1,5 @@
-"""Drawing helpers for the figure notebooks (which hold no algorithm code of their own).
+"""The cell in 3D (arm, spatula, grill, table, burger locations) and the shading of
+subbehaviour segments on time axes.
 
 All lengths are in metres, times in seconds. The helpers draw into axes they are given and
 leave the figure size, style (:func:`flipkit.figures.style`) and saving to the caller.
