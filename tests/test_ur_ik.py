@@ -74,3 +74,25 @@ def test_another_arm_is_refused(robot, monkeypatch):
     monkeypatch.setattr(ur, "D", (0.2,) + ur.D[1:])  # not the UR10's shoulder height
     with pytest.raises(ConfigError, match="not the UR10"):
         URAnalyticIK(robot)
+
+
+def test_the_analytic_tracker_follows_a_joint_path_on_one_branch(robot):
+    """Poses of a smooth joint path q(t) away from the wrist singularity (θ5 stays > 0): the
+    tracker returns q(t) itself, on one branch; a
+    pose out of reach keeps the last configuration, marked branch −1."""
+    from types import SimpleNamespace
+
+    from flipkit.baseline.analytic_track import AnalyticTracker
+
+    t = np.linspace(0.0, 1.0, 101)
+    q_path = robot.q_home + np.outer(np.sin(np.pi * t), [0.3, -0.2, 0.4, 0.5, -0.3, 1.2])
+    M = [robot.placement(q).homogeneous for q in q_path]
+    traj = SimpleNamespace(t=t, p=np.array([m[:3, 3] for m in M]),
+                           R=np.array([m[:3, :3] for m in M]))
+    track = AnalyticTracker(robot).track(traj, robot.q_home)
+    np.testing.assert_allclose(track.q, q_path, atol=1e-7)
+    assert len(set(track.branch)) == 1 and track.branch[0] >= 0
+    traj.p[50] = (2.5, 0.0, 0.5)
+    track = AnalyticTracker(robot).track(traj, robot.q_home)
+    assert track.branch[50] == -1 and np.array_equal(track.q[50], track.q[49])
+    np.testing.assert_allclose(track.q[51:], q_path[51:], atol=1e-7)

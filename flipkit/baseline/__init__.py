@@ -22,19 +22,23 @@ import numpy as np
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import Models
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, NoSolutionFound, UnreachableError
+from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy
 from flipkit.baseline.classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
 from flipkit.baseline.ee_opt import EEState, EETrajectory, plan_segment
 
 BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
-from flipkit.baseline.ik_track import IKTrack, PlacoTracker
+from flipkit.baseline.ik_track import IKTrack, PlacoTracker  # noqa: E402
+from flipkit.baseline.analytic_track import AnalyticTracker  # noqa: E402
+
+
+IK_METHODS = ("placo", "analytic")
 
 
 def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: float = 200.0,
                  *, iterations: int = 3, velocity_limits: bool = True,
-                 thresholds: Thresholds = Thresholds()) -> BaselineResult:
+                 thresholds: Thresholds = Thresholds(), ik: str = "placo") -> BaselineResult:
     """Plan pickup-and-flip at ``location`` with the end-effector-space + IK baseline.
 
     Args:
@@ -45,6 +49,9 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
         iterations: placo solver iterations per sample.
         velocity_limits: Enforce joint velocity limits in the IK.
         thresholds: Failure thresholds of the classifier.
+        ik: ``placo`` (differential IK with joint and velocity limits, warm-started) or
+            ``analytic`` (the UR10's closed form, the branch continuous with the start;
+            :mod:`.analytic_track`).
 
     Returns:
         The per-subbehaviour verdicts (with EE and IK wall times), trajectories and tracks.
@@ -52,7 +59,10 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     Raises:
         UnreachableError: ``location`` is not on the grill.
         ConfigError: Bad ``q_start`` or ``rate``.
+        InvalidChoiceError: ``ik`` is not one of :data:`IK_METHODS`.
     """
+    if ik not in IK_METHODS:
+        raise InvalidChoiceError("IK method", ik, IK_METHODS)
     cell = cell or CellConfig()
     if not (np.isfinite(rate) and rate > 0):
         raise ConfigError(f"IK rate must be a positive number of Hz, got {rate!r}")
@@ -66,7 +76,8 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     home = tg.Pose(tuple(home_M.translation), tuple(rpy(home_M.rotation)))
     M0 = robot.placement(q)
     start = EEState(tuple(M0.translation), (0.0, 0.0, 0.0), tuple(rpy(M0.rotation)))
-    tracker = PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits)
+    tracker = (AnalyticTracker(robot) if ik == "analytic" else
+               PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits))
     result = BaselineResult(tuple(float(x) for x in pb), [])
     for name in tg.SUBBEHAVIORS:
         try:
@@ -106,4 +117,4 @@ def _restart(robot, traj: EETrajectory, q_track: np.ndarray) -> np.ndarray:
 
 __all__ = ["run_baseline", "BaselineResult", "SegmentVerdict", "Thresholds", "REASONS",
            "classify_segment", "EEState", "EETrajectory", "plan_segment", "IKTrack",
-           "PlacoTracker"]
+           "PlacoTracker", "AnalyticTracker", "IK_METHODS"]

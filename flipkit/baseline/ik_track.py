@@ -31,11 +31,13 @@ class IKTrack:
 
     Attributes:
         t: Sample times (s). q: Joint angles (rad), (n, nq). time_s: Wall time of the IK (s).
+        branch: Closed-form IK only: each sample's branch (0–7; −1 where none exists).
     """
 
     t: np.ndarray
     q: np.ndarray
     time_s: float
+    branch: np.ndarray | None = None
 
 
 def spatula_urdf(robot: Robot) -> str:
