@@ -25,7 +25,8 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy
-from flipkit.baseline.classify import REASONS, BaselineResult, SegmentVerdict, Thresholds, classify_segment
+from flipkit.baseline.classify import (CLASSES, REASONS, BaselineResult, SegmentVerdict,
+                                      Thresholds, classify_plan, classify_segment)
 from flipkit.baseline.ee_opt import EEState, EETrajectory, plan_segment
 
 BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
@@ -89,7 +90,7 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
         track = tracker.track(traj, q)
         verdict = classify_segment(name, models.for_segment(name), track.t, track.q, traj.p,
                                    traj.R, thresholds=thresholds, ee_time_s=traj.solve_time_s,
-                                   ik_time_s=track.time_s)
+                                   ik_time_s=track.time_s, branch=track.branch)
         result.segments.append(verdict)
         result.trajectories.append(traj)
         result.tracks.append(track)
@@ -117,4 +118,4 @@ def _restart(robot, traj: EETrajectory, q_track: np.ndarray) -> np.ndarray:
 
 __all__ = ["run_baseline", "BaselineResult", "SegmentVerdict", "Thresholds", "REASONS",
            "classify_segment", "EEState", "EETrajectory", "plan_segment", "IKTrack",
-           "PlacoTracker", "AnalyticTracker", "IK_METHODS"]
+           "PlacoTracker", "AnalyticTracker", "IK_METHODS", "CLASSES", "classify_plan"]

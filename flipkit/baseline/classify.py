@@ -1,10 +1,14 @@
-"""Failure classification of an IK-tracked end-effector trajectory, per subbehaviour.
+"""Failure classification of a joint path, per subbehaviour: one judge for the EE + IK baseline
+and for collocation plans (:func:`classify_plan`, resampled at the same rate).
 
 Every measurement uses flipkit's pinocchio model (:class:`flipkit.model.robot.Robot`), not placo.
 The checks run in this order and the first one that fails is the verdict:
 
+0. ``unreachable`` — closed-form IK only: a sample whose pose has no branch within the
+   joint limits (the configuration is held there).
 1. ``tracking_error`` — spatula pose error, max over samples: position > 1 mm or rotation
-   angle |log(R_refᵀ R)| > 0.01 rad.
+   angle |log(R_refᵀ R)| > 0.01 rad. Then ``singularity`` — the spatula Jacobian's smallest
+   singular value below :attr:`Thresholds.sigma_min`.
 2. ``joint_limit`` — a joint within 1e-3 rad of q_min or q_max.
 3. ``configuration_jump`` — |Δq| between consecutive samples > 0.2 rad (a branch switch).
    It runs before the rate checks: a jump of 0.2 rad in one 5 ms sample is a 40 rad/s
@@ -12,9 +16,17 @@ The checks run in this order and the first one that fails is the verdict:
 4. ``joint_velocity`` / ``joint_acceleration`` — finite differences of q (second order,
    ``np.gradient``) above qd_max / qdd_max.
 5. ``torque`` — RNEA along (q, q̇, q̈) with the segment's payload above u_max.
-6. ``below_grill`` — a blade edge (tip, heel, sides) lower than h_g − 1 mm.
+6. ``below_grill`` — a blade edge (tip, heel, sides) lower than h_g − 1 mm (in the scoop,
+   h_g − 1 mm − the commanded press and its band).
 
 ``ee_infeasible`` marks a subbehaviour whose end-effector QP had no solution.
+
+Each reason has a class (:data:`CLASSES`): ``kinematic`` (no joint path realises the poses:
+unreachable, singular, a branch switch or jump, a joint limit, a tracking error, the blade
+below the grill), ``dynamic`` (a path exists but breaks a velocity, acceleration or torque
+limit) and ``ee`` (the end-effector QP itself). A dynamic failure that passes when the same
+path is slowed down uniformly by a factor s ≤ :data:`MAX_TIME_SCALING` (q̇/s, q̈/s², RNEA
+at those) is classed ``time_scalable`` instead, with s recorded in ``time_scaling``.
 """
 
 from __future__ import annotations
@@ -24,12 +36,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from flipkit.behaviors.segments import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
 
-REASONS = ("ee_infeasible", "tracking_error", "joint_limit", "configuration_jump",
-           "joint_velocity", "joint_acceleration", "torque", "below_grill")
-UNITS = {"ee_infeasible": "", "tracking_error": "m or rad", "joint_limit": "rad",
+REASONS = ("ee_infeasible", "unreachable", "singularity", "tracking_error", "joint_limit",
+           "configuration_jump", "joint_velocity", "joint_acceleration", "torque", "below_grill")
+CLASSES = {"ee_infeasible": "ee", "unreachable": "kinematic", "singularity": "kinematic",
+           "tracking_error": "kinematic", "joint_limit": "kinematic",
+           "configuration_jump": "kinematic", "below_grill": "kinematic",
+           "joint_velocity": "dynamic", "joint_acceleration": "dynamic", "torque": "dynamic"}
+FAILURE_CLASSES = ("ee", "kinematic", "dynamic", "time_scalable")
+MAX_TIME_SCALING = 2.0  # issue 14: "slowing the EE trajectory by at most 2x makes it pass"
+UNITS = {"ee_infeasible": "", "unreachable": "s", "singularity": "1",
+         "tracking_error": "m or rad", "joint_limit": "rad",
          "configuration_jump": "rad", "joint_velocity": "rad/s",
          "joint_acceleration": "rad/s^2", "torque": "N m", "below_grill": "m"}
 EDGES = ("tip", "heel", "left", "right")
@@ -47,6 +67,10 @@ class Thresholds:
         rate_tolerance: Relative tolerance on the velocity, acceleration and torque limits
             (the IK holds a saturated joint at qd_max; its finite difference is qd_max to
             rounding).
+        sigma_min: Smallest singular value of the 6×6 spatula Jacobian (linear part in m/rad,
+            angular in rad/rad) below which a sample counts as singular. Our choice: 0.01, a
+            hundredth of the arm's typical values (0.1–1), where the IK's joint rates are
+            ~100× the spatula's.
     """
 
     position: float = 1e-3
@@ -55,10 +79,11 @@ class Thresholds:
     jump: float = 0.2
     grill_margin: float = 1e-3
     rate_tolerance: float = 1e-6
+    sigma_min: float = 0.01
 
     def __post_init__(self):
         for name in ("position", "rotation", "limit_margin", "jump", "grill_margin",
-                     "rate_tolerance"):
+                     "rate_tolerance", "sigma_min"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ConfigError(f"threshold {name} must be positive, got {value!r}")
@@ -88,6 +113,16 @@ class SegmentVerdict:
     ee_time_s: float = 0.0
     ik_time_s: float = 0.0
     measures: dict = field(default_factory=dict)
+    time_scaling: float = float("nan")
+
+    @property
+    def failure_class(self) -> str | None:
+        """One of :data:`FAILURE_CLASSES` (None when solved)."""
+        if self.reason is None:
+            return None
+        if CLASSES[self.reason] == "dynamic" and self.time_scaling <= MAX_TIME_SCALING:
+            return "time_scalable"
+        return CLASSES[self.reason]
 
 
 def _worst_ratio(values: np.ndarray, bound: np.ndarray):
@@ -99,7 +134,7 @@ def _worst_ratio(values: np.ndarray, bound: np.ndarray):
 
 def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
                      thresholds: Thresholds = Thresholds(), ee_time_s: float = 0.0,
-                     ik_time_s: float = 0.0) -> SegmentVerdict:
+                     ik_time_s: float = 0.0, branch=None) -> SegmentVerdict:
     """Classify the joint trajectory q(t) that should realise the spatula poses (p_ref, R_ref).
 
     Args:
@@ -108,6 +143,7 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
         t: Sample times (s), ≥ 3, increasing. q: Joint angles (rad), (n, nq).
         p_ref: Reference positions (m), (n, 3). R_ref: Reference rotations, (n, 3, 3).
         thresholds: Failure thresholds. ee_time_s, ik_time_s: Recorded wall times (s).
+        branch: Closed-form IK branch per sample (−1: none exists), or None.
     """
     t, q = np.asarray(t, float), np.asarray(q, float)
     p_ref, R_ref = np.asarray(p_ref, float), np.asarray(R_ref, float)
@@ -121,8 +157,10 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
     sp = cell.spatula
     edges = np.array([[sp.length / 2, 0, 0], [-sp.length / 2, 0, 0],
                       [0, sp.width / 2, 0], [0, -sp.width / 2, 0]]).T
-    e_pos, e_rot, heights = np.empty(n), np.empty(n), np.empty((n, 4))
+    e_pos, e_rot, heights, sigma = np.empty(n), np.empty(n), np.empty((n, 4)), np.empty(n)
     for k in range(n):
+        _, _, Jp, Jw = robot.pose_jacobians(q[k])
+        sigma[k] = np.linalg.svd(np.vstack([Jp, Jw]), compute_uv=False)[-1]
         M = robot.placement(q[k])
         e_pos[k] = np.linalg.norm(M.translation - p_ref[k])
         e_rot[k] = np.linalg.norm(pin.log3(R_ref[k].T @ M.rotation))
@@ -135,16 +173,29 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
     v_ratio, vk, vj = _worst_ratio(qd, robot.qd_max)
     a_ratio, ak, aj = _worst_ratio(qdd, robot.qdd_max)
     u_ratio, uk, uj = _worst_ratio(u, robot.u_max)
-    floor = cell.grill.height - th.grill_margin
+    # the scoop commands the tip SCOOP_PRESS into the grill (±SCOOP_TIP_BAND), for both methods'
+    # plans alike: the blade may go that deep there (collocation's scoop; the baseline's tip
+    # stays on the surface)
+    depth = th.grill_margin + (SCOOP_PRESS + SCOOP_TIP_BAND if name == "scoop" else 0.0)
+    floor = cell.grill.height - depth
     measures = {"tracking_position_m": float(e_pos.max()),
                 "tracking_rotation_rad": float(e_rot.max()),
                 "limit_margin_rad": float(margin.min()), "max_jump_rad": float(dq.max()),
                 "velocity_ratio": v_ratio, "acceleration_ratio": a_ratio,
-                "torque_ratio": u_ratio, "min_edge_height_m": float(heights.min())}
+                "torque_ratio": u_ratio, "min_edge_height_m": float(heights.min()),
+                "sigma_min": float(sigma.min())}
 
     def fail(reason, amount, limit, detail):
+        scale = (time_scaling(robot, t, q, th.rate_tolerance) if CLASSES[reason] == "dynamic"
+                 else float("nan"))
         return SegmentVerdict(name, "failed", reason, float(amount), float(limit), detail,
-                              ee_time_s, ik_time_s, measures)
+                              ee_time_s, ik_time_s, measures, scale)
+
+    if branch is not None and np.any(np.asarray(branch) < 0):
+        missing = np.flatnonzero(np.asarray(branch) < 0)
+        return fail("unreachable", len(missing) * (t[1] - t[0]), 0.0,
+                    f"{len(missing)} samples without an IK branch in the joint limits, first at "
+                    f"t={t[missing[0]]:.3f} s")
 
     rp, rr = e_pos.max() / th.position, e_rot.max() / th.rotation
     if max(rp, rr) > 1:
@@ -153,6 +204,11 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
         return fail("tracking_error", amount, limit,
                     f"t={t[k]:.3f} s: position {e_pos[k] * 1e3:.2f} mm, rotation "
                     f"{e_rot[k]:.4f} rad (limits {th.position * 1e3:g} mm, {th.rotation:g} rad)")
+    if sigma.min() < th.sigma_min:
+        k = int(np.argmin(sigma))
+        return fail("singularity", sigma[k], th.sigma_min,
+                    f"t={t[k]:.3f} s: smallest singular value {sigma[k]:.3g} of the spatula "
+                    f"Jacobian (q5 = {q[k, 4]:.3f} rad)")
     if margin.min() < th.limit_margin:
         k, j = np.unravel_index(int(np.argmin(margin)), margin.shape)
         return fail("joint_limit", margin[k, j], th.limit_margin,
@@ -177,6 +233,28 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
                     f"(grill {cell.grill.height:g} m)")
     return SegmentVerdict(name, "solved", ee_time_s=ee_time_s, ik_time_s=ik_time_s,
                           measures=measures)
+
+
+def _rate_ratio(robot: Robot, t, q, s: float) -> float:
+    """Largest velocity, acceleration or torque ratio of the path q(t) run s times slower."""
+    qd = np.gradient(q, t, axis=0, edge_order=2) / s
+    qdd = np.gradient(np.gradient(q, t, axis=0, edge_order=2), t, axis=0, edge_order=2) / s**2
+    u = np.array([robot.inverse_dynamics(q[k], qd[k], qdd[k]) for k in range(len(t))])
+    return max(_worst_ratio(qd, robot.qd_max)[0], _worst_ratio(qdd, robot.qdd_max)[0],
+               _worst_ratio(u, robot.u_max)[0])
+
+
+def time_scaling(robot: Robot, t, q, tolerance: float = 1e-6, steps: int = 20) -> float:
+    """The smallest uniform slow-down factor s ∈ [1, :data:`MAX_TIME_SCALING`] with which the
+    path passes the velocity, acceleration and torque limits (bisection, ``steps`` halvings);
+    ``inf`` if even s = MAX_TIME_SCALING does not."""
+    if _rate_ratio(robot, t, q, MAX_TIME_SCALING) > 1 + tolerance:
+        return float("inf")
+    lo, hi = 1.0, MAX_TIME_SCALING
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if _rate_ratio(robot, t, q, mid) <= 1 + tolerance else (mid, hi)
+    return hi
 
 
 @dataclass
@@ -220,3 +298,30 @@ class BaselineResult:
     def time_s(self) -> dict:
         """{subbehaviour: {"ee": s, "ik": s}} wall times."""
         return {s.subbehavior: {"ee": s.ee_time_s, "ik": s.ik_time_s} for s in self.segments}
+
+
+def classify_plan(plan, rate: float = 500.0, thresholds: Thresholds = Thresholds()) -> list:
+    """The same judge on a collocation plan: each segment resampled at ``rate`` (cubic Hermite
+    of (q, q̇) between nodes, as the collocation), its own spatula poses as the reference (a
+    joint-space plan has no tracking error), with the segment's payload.
+
+    Args:
+        plan: A :class:`~flipkit.planning.plan_file.Plan`. rate: Sample rate (Hz).
+
+    Returns:
+        One :class:`SegmentVerdict` per segment.
+    """
+    from scipy.interpolate import CubicHermiteSpline
+
+    from flipkit.baseline.ee_opt import sample_times
+
+    cell, out = plan.cell(), []
+    for seg in plan.segments:
+        robot = plan.robot_for(seg, cell)
+        t = sample_times(seg.T, rate)
+        q = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(t)
+        M = [robot.placement(qk) for qk in q]
+        out.append(classify_segment(seg.name, robot, t, q, np.array([m.translation for m in M]),
+                                    np.array([m.rotation for m in M]), thresholds=thresholds))
+    return out
+
