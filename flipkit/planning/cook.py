@@ -26,6 +26,7 @@ FIRST_SIDE_S = 90.0  # s on the first side (paper Sec. I)
 SECOND_SIDE_S = 60.0  # s on the second side (paper Sec. I)
 CSV_HEADER = ("burger", "t_drop", "x", "y")
 SPOT_GAP = 0.01  # m: clearance between served burgers and from the table's edge (ours)
+EXAMPLE_ORDER = Path(__file__).resolve().parents[1] / "data" / "cook_five.csv"  # 5 in 20 s
 
 
 class CookOrderError(ConfigError):
@@ -188,5 +189,5 @@ def table_spots(cell: CellConfig | None = None, gap: float = SPOT_GAP) -> list[t
     return sorted(spots, key=lambda s: (round(float(np.hypot(*(np.array(s) - centre))), 9), s))
 
 
-__all__ = ["CSV_HEADER", "FIRST_SIDE_S", "SECOND_SIDE_S", "SPOT_GAP", "CookBurger",
+__all__ = ["CSV_HEADER", "EXAMPLE_ORDER", "FIRST_SIDE_S", "SECOND_SIDE_S", "SPOT_GAP", "CookBurger",
            "CookOrderError", "check_cook", "read_cook_csv", "table_spots"]
