@@ -128,7 +128,8 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto") -> Motion
 
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto") -> MotionPlanner:
     """The real serve: ``flipkit.planning.planner.plan_serve(burger, table_spot,
-    q_start=..., cell=..., solver=...)``.
+    q_start=..., cell=..., solver=...)`` (``cell`` and ``solver`` passed where its signature
+    takes them).
 
     Raises:
         MissingPlannerError: ``plan_serve`` does not exist in :mod:`flipkit.planning.planner`.
@@ -141,9 +142,19 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto") -> Motio
                                   "not have yet (issue 13, item 1); --flip-only plans the "
                                   "flips alone")
 
+    import inspect
+
+    params = inspect.signature(plan_serve).parameters
+    takes_all = any(p.kind is p.VAR_KEYWORD for p in params.values())
+    extra = {k: v for k, v in (("cell", cell), ("solver", solver))
+             if takes_all or k in params}
+    if cell is not None and cell != CellConfig() and "cell" not in extra:
+        raise MissingPlannerError(f"{SERVE_PLANNER} takes no cell; it cannot plan in a "
+                                  "non-default cell")
+
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell, solver=solver)
+        p = plan_serve(job.location, job.table_spot, q_start=q_start, **extra)
         return from_plan(p, "serve", time.perf_counter() - t0)
 
     return plan
