@@ -308,3 +308,22 @@ def test_flip_only_schedule_with_the_real_planner(tmp_path, capsys):
         90 - landing - m["planning_time_s"], abs=1e-3)
     assert fig.stat().st_size > 5000
     assert math.isclose(doc["planning_time_s"], m["planning_time_s"], abs_tol=1e-5)
+
+
+def test_gantt_draws_every_motion_and_burger(tmp_path):
+    import matplotlib.pyplot as plt
+
+    from flipkit import figures
+    from flipkit.figures.draw import plot_schedule
+
+    doc = run([0, 5, 10], fail=[("flip", "b2")])[0].to_dict()
+    with figures.style():
+        fig, ax = plt.subplots()
+        drawn = plot_schedule(ax, doc)
+        labels = [t.get_text() for t in ax.get_yticklabels()]
+        fig.savefig(tmp_path / "g.png")
+        plt.close(fig)
+    assert drawn == {"n_burgers": 3, "n_motions": 5,
+                     "t_end_s": pytest.approx(max(m["end"] for m in doc["motions"]) + 5)}
+    assert labels == ["planning", "arm", "burger b1", "burger b2", "burger b3"]
+    assert (tmp_path / "g.png").stat().st_size > 5000

@@ -66,8 +66,11 @@ def plot_schedule(ax, timeline: dict, title: str = "") -> dict:
                  if any(m["kind"] == k for m in motions)],
                Patch(color=SIDE_COLORS[0], label="first side"),
                Patch(color=SIDE_COLORS[1], label="second side"),
+               *([Patch(color=SIDE_COLORS[1], alpha=0.45, label="second side, not served")]
+                 if any(b["flip_time"] is not None and b["serve_time"] is None
+                        for b in burgers) else []),
                Line2D([], [], color="black", lw=0.8, label="90 s / 150 s marks")]
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=6)
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=4)
     if title:
         ax.set_title(title)
     return {"n_burgers": len(burgers), "n_motions": len(motions), "t_end_s": float(t_end)}
