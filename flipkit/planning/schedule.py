@@ -10,12 +10,15 @@ Policy — earliest deadline first, one arm, no early starts:
 
 1. The pending motions are the flips of all burgers not yet flipped and the serves of the
    burgers already flipped. The next motion is the pending one whose burger event is due
-   first (a flip's landing mark, a serve's lift-off mark; ties by drop order, flips first).
+   first (a flip's landing mark, a serve's lift-off mark; ties: the burger dropped first).
 2. It is planned from the configuration the previous motion ended at (at rest; the first
    from ``q_start``), which gives its duration and the time from its start to the event.
-3. It starts when the arm is free, but never before its event's mark (so no side is
-   cooked shorter than 90 s / 60 s), and never before its plan exists (below).
-   Lateness = event time − mark (≥ 0: overcooking).
+3. It starts when the arm is free, but never so early that its event comes before the mark
+   (so no side is cooked shorter than 90 s / 60 s), and never before its plan exists
+   (below).
+
+Lateness, reported per burger: landing − (``t_drop`` + 90 s) and lift-off − (``t_drop`` +
+150 s); both ≥ 0 (overcooking), the second ≥ the first.
 
 Planning runs ahead of execution: the motions are planned one after another, in the order
 above, on a planning clock that starts at ``plan_start`` (default: the first drop). A
