@@ -37,7 +37,7 @@ class Fixed:
                                  q_end=np.full(6, float(n)), planning_time_s=self.plan_s,
                                  landing=(job.location[0] + 0.01, job.location[1])
                                  if kind == "flip" else None,
-                                 failure=None if ok else "flip: cone violated by 1 (test)")
+                                 failure=None if ok else "pickup: cone violated by 1 (test)")
         return plan
 
     def planners(self):
@@ -327,3 +327,22 @@ def test_gantt_draws_every_motion_and_burger(tmp_path):
                      "t_end_s": pytest.approx(max(m["end"] for m in doc["motions"]) + 5)}
     assert labels == ["planning", "arm", "burger b1", "burger b2", "burger b3"]
     assert (tmp_path / "g.png").stat().st_size > 5000
+
+
+def test_cli_writes_the_timeline_and_exits_1_on_a_failed_plan(tmp_path, capsys, monkeypatch):
+    fixed = Fixed(fail=[("flip", "b2")])
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver: {
+        k: v for k, v in fixed.planners().items() if k in kinds})
+    path = tmp_path / "order.csv"
+    path.write_text("burger,t_drop,x,y\nb1,0,0.64,-0.33\nb2,5,0.69,-0.16\nb3,10,0.75,0.0\n")
+    out, fig = tmp_path / "t.json", tmp_path / "g.pdf"
+    code = cli.main(["schedule", str(path), "--json", str(out), "--figure", str(fig),
+                     "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and err == ["flipkit: error: burger b2: flip: pickup: cone violated by 1 "
+                                 "(test)"]
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "failed" and [m["kind"] for m in doc["motions"]] == [
+        "flip", "flip", "flip", "serve", "serve"]
+    assert doc["burgers"][0]["lateness_s"] == {"flip": 0.0, "serve": 0.0}
+    assert fig.read_bytes().startswith(b"%PDF")
