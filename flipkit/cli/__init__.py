@@ -12,7 +12,8 @@ import sys
 
 from flipkit.errors import FlipkitError
 
-COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate")
+COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate",
+            "schedule")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -12,6 +12,6 @@ FIGURES = {  # figure id -> notebook that makes it (DESIGN.md, "The figures"), i
     "table1": "table1.ipynb", "ik_failure": "ik_failure.ipynb",
     "solve_times": "solve_times.ipynb", "cone_forms": "cone_forms.ipynb",
     "landing": "landing.ipynb", "filmstrip": "landing.ipynb",
-    "sensitivity": "sensitivity.ipynb",
+    "sensitivity": "sensitivity.ipynb", "schedule": "schedule.ipynb",
 }
 FIGURE_IDS = tuple(FIGURES)

@@ -12,11 +12,12 @@ from flipkit.figures.draw.maps import draw_burger, draw_snapshot, plot_grill_map
 from flipkit.figures.draw.panels import (plot_cone_regions, plot_defect_zoom, plot_forces,
                                          plot_hermite_simpson, plot_tangential_sections,
                                          plot_tracking, plot_tracking_error, shade_nodes)
+from flipkit.figures.draw.schedule import plot_schedule
 from flipkit.figures.draw.stats import (plot_sensitivity, plot_solve_times, plot_success,
                                         plot_success_series, wilson_interval)
 
 __all__ = ["draw_burger", "draw_cell", "draw_snapshot", "plot_cone_regions", "plot_defect_zoom",
            "plot_forces", "plot_grill_map", "plot_hermite_simpson", "plot_landings",
-           "plot_sensitivity", "plot_solve_times", "plot_success", "plot_success_series",
+           "plot_schedule", "plot_sensitivity", "plot_solve_times", "plot_success", "plot_success_series",
            "plot_tangential_sections", "plot_tracking", "plot_tracking_error", "shade_nodes",
            "shade_segments", "wilson_interval"]

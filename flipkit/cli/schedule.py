@@ -1,0 +1,128 @@
+"""``flipkit schedule``: order, time and plan one arm's flips and serves for a cook order.
+
+Exit status: 0 every motion planned, solved and verified; 1 a motion's plan failed — one
+line per failure on stderr; the timeline and the plan files (the failed one with
+``"status": "failed"``) are still written; 2 bad input (unreadable or malformed CSV, wrong
+header, a non-finite or negative number, a burger off the grill, duplicate ids, two burgers
+closer than one diameter on the grill at once) or a motion kind without a planner
+(``flipkit.planning.planner.plan_serve`` missing) — one line on stderr, nothing planned,
+nothing written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import warnings
+from pathlib import Path
+
+from flipkit.cli.common import SOLVER_CHOICES, write_json
+from flipkit.errors import FlipkitError
+
+DESCRIPTION = (
+    "Flip every burger of a cook order at its 90 s mark and serve it to a table spot after "
+    "60 s on its second side, with one arm: the motions are ordered earliest deadline "
+    "first and each is planned from where the previous one ends, ahead of its start. "
+    "Writes the timeline (JSON), one plan file per motion, and optionally a Gantt chart. "
+    "Exit 0: all solved. Exit 1: a plan failed (everything still written). Exit 2: bad "
+    "input or a missing planner; nothing written.")
+
+
+def register(subparsers) -> None:
+    """Add the ``schedule`` sub-command to the parser."""
+    p = subparsers.add_parser("schedule", help="schedule and plan the flips and serves of a "
+                                                "cook (one arm)", description=DESCRIPTION)
+    p.add_argument("burgers", metavar="BURGERS.csv",
+                   help="cook order: header burger,t_drop,x,y (id, drop time s, grill "
+                        "position m); lines starting with # skipped")
+    p.add_argument("--json", required=True, metavar="TIMELINE.json", help="timeline output")
+    p.add_argument("--figure", metavar="PATH", help="Gantt chart (PDF or PNG by suffix)")
+    p.add_argument("--plans", metavar="DIR",
+                   help="directory for the motions' plan files (default: TIMELINE_plans/ "
+                        "beside the timeline); the timeline names them relative to its own "
+                        "directory")
+    p.add_argument("--flip-only", action="store_true",
+                   help="plan the flips alone (no serves; serve_time stays null)")
+    p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+                   help="NLP solver (default auto: the SQP, then IPOPT where it fails)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(run=run)
+
+
+def _safe(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:40] or "burger"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Read, check, plan, write, report."""
+    from flipkit.config import CellConfig
+    from flipkit.planning.cook import read_cook_csv
+    from flipkit.planning.motions import default_planners
+    from flipkit.planning.schedule import format_timeline, schedule_cook
+
+    warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+    cell = CellConfig()
+    burgers = read_cook_csv(args.burgers, cell)
+    kinds = ("flip",) if args.flip_only else ("flip", "serve")
+    planners = default_planners(kinds, cell, args.solver)  # MissingPlannerError before planning
+    timeline_path = Path(args.json)
+    plans = Path(args.plans) if args.plans else timeline_path.with_name(
+        timeline_path.stem + "_plans")
+    q_home = cell.robot.q_home
+    timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
+                             progress=not args.no_progress)
+    try:
+        plans.mkdir(parents=True, exist_ok=True)
+        for k, m in enumerate(timeline.motions, 1):
+            if m.plan is None:
+                continue
+            path = plans / f"{k:02d}_{m.kind}_{_safe(m.burger)}.json"
+            m.plan.to_json(path)
+            try:
+                m.plan_file = str(path.resolve().relative_to(timeline_path.resolve().parent))
+            except ValueError:
+                m.plan_file = str(path.resolve())
+    except OSError as exc:
+        raise FlipkitError(f"{plans}: cannot write plans ({exc.strerror or exc})") from None
+    doc = timeline.to_dict()
+    write_json(timeline_path, doc)
+    if args.figure:
+        _figure(doc, args.figure)
+    print(format_timeline(timeline))
+    late = doc["max_lateness_s"]
+    print(f"flipkit schedule: {len(timeline.burgers)} burgers, {len(timeline.motions)} "
+          f"motions ({'+'.join(kinds)}), {doc['status']}; planning {doc['planning_time_s']:.1f}"
+          f" s, min slack {doc['slack_s']['min']:.1f} s, max lateness flip "
+          f"{_s(late['flip'])}, serve {_s(late['serve'])}; wrote {timeline_path}")
+    for b in timeline.burgers:
+        if b.failure:
+            print(f"flipkit: error: burger {b.burger.burger}: {b.failure}", file=sys.stderr)
+    return 0 if timeline.ok else 1
+
+
+def _s(v) -> str:
+    return "-" if v is None else f"{v:.2f} s"
+
+
+def _figure(doc: dict, path) -> None:
+    """Draw the Gantt chart of ``doc`` to ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flipkit import figures
+    from flipkit.figures.draw import plot_schedule
+
+    with figures.style():
+        fig, ax = plt.subplots(figsize=(figures.PAGE_WIDTH, 0.35 * len(doc["burgers"]) + 1.6),
+                               layout="constrained")
+        plot_schedule(ax, doc)
+        try:
+            fig.savefig(path, metadata={"CreationDate": None} if str(path).endswith(".pdf")
+                        else None)
+        except (OSError, ValueError) as exc:
+            raise FlipkitError(f"cannot write figure {path}: {exc}") from None
+        finally:
+            plt.close(fig)

@@ -1,0 +1,192 @@
+"""The arm's motions in a cook, as the scheduler sees them, and the real planners behind them.
+
+The scheduler (:mod:`flipkit.planning.schedule`) does not call a planner directly: it is
+given a mapping from motion kind (``"flip"``, ``"serve"``) to a :class:`MotionPlanner`, a
+function ``(job, q_start) -> PlannedMotion``. :func:`default_planners` wires in the real
+ones: :func:`~flipkit.planning.planner.plan_flip` for ``"flip"``, and
+``flipkit.planning.planner.plan_serve`` for ``"serve"`` when that function exists — when
+it does not, asking for serves raises :class:`MissingPlannerError`; no serve motion is
+ever made up. Tests inject planners with fixed durations.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable, Mapping, Protocol
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import FlipkitError
+
+KINDS = ("flip", "serve")
+SERVE_PLANNER = "flipkit.planning.planner.plan_serve"
+
+
+class MissingPlannerError(FlipkitError):
+    """A motion kind the schedule needs has no planner (e.g. ``plan_serve`` not built)."""
+
+
+@dataclass(frozen=True)
+class MotionJob:
+    """What one motion must do.
+
+    Attributes:
+        kind: ``"flip"`` or ``"serve"``.
+        burger: The burger's id.
+        location: Where the burger lies (x, y, z) (m): its drop position for a flip, its
+            predicted landing point (on the grill surface) for a serve.
+        table_spot: Serve only: the spot (x, y) (m) on the table; ``None`` for a flip.
+    """
+
+    kind: str
+    burger: str
+    location: tuple
+    table_spot: tuple | None = None
+
+
+@dataclass
+class PlannedMotion:
+    """A planned motion, reduced to what the scheduler needs.
+
+    Attributes:
+        ok: The plan is solved (and verified); only then is it executed.
+        duration_s: Execution time of the whole motion (s), start at rest to end at rest.
+        event_s: From the motion's start to the burger's event (s): a flip's landing on
+            the second side, a serve's lift-off from the grill.
+        q_end: Configuration (rad) the arm ends at, at rest; the next motion starts there.
+        planning_time_s: Wall time the planning took (s).
+        landing: Flip only: the burger's predicted landing point (x, y) (m).
+        plan: The plan (anything with ``to_json(path)``), or ``None``.
+        failure: One line saying why it is not ``ok``.
+    """
+
+    ok: bool
+    duration_s: float
+    event_s: float
+    q_end: np.ndarray
+    planning_time_s: float
+    landing: tuple | None = None
+    plan: object | None = None
+    failure: str | None = None
+
+
+class MotionPlanner(Protocol):
+    """Plans one motion of ``job`` starting at rest at ``q_start`` (rad)."""
+
+    def __call__(self, job: MotionJob, q_start: np.ndarray) -> PlannedMotion: ...
+
+
+def _segment_start(plan, name: str) -> float:
+    """Start time (s) of the first segment called ``name``, from the start of the plan."""
+    t = 0.0
+    for seg in plan.segments:
+        if seg.name == name:
+            return t
+        t += float(seg.T)
+    raise FlipkitError(f"{plan.behavior} plan has no {name!r} segment "
+                       f"(segments: {', '.join(s.name for s in plan.segments)})")
+
+
+def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
+    """A :class:`~flipkit.planning.plan_file.Plan` as a :class:`PlannedMotion`.
+
+    The event of a flip is its predicted landing: flip segment start + release time + time
+    of flight. The event of a serve is the start of its ``pickup`` segment: the scoop has
+    slid the blade under the burger and the lift begins.
+    """
+    ok = plan.status == "solved"
+    duration = float(sum(s.T for s in plan.segments))
+    last = plan.segments[-1]
+    landing, event = None, duration
+    if ok and kind == "flip":
+        flip = next(s for s in plan.segments if s.name == "flip")
+        event = (_segment_start(plan, "flip") + flip.release["time"]
+                 + flip.landing["time_of_flight"])
+        landing = tuple(float(v) for v in flip.landing["point"][:2])
+    elif ok:
+        event = _segment_start(plan, "pickup")
+    return PlannedMotion(ok=ok, duration_s=duration, event_s=float(event),
+                         q_end=np.asarray(last.q[-1], float), planning_time_s=planning_time_s,
+                         landing=landing, plan=plan,
+                         failure=None if ok else getattr(plan, "failure", "plan failed"))
+
+
+def flip_planner(cell: CellConfig | None = None, solver: str = "auto") -> MotionPlanner:
+    """The real flip: :func:`~flipkit.planning.planner.plan_flip` from ``q_start``, landing
+    where the burger was picked up (its default)."""
+    from flipkit.planning.planner import plan_flip
+
+    def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
+        t0 = time.perf_counter()
+        p = plan_flip(job.location, q_start, cell=cell, solver=solver)
+        return from_plan(p, "flip", time.perf_counter() - t0)
+
+    return plan
+
+
+def serve_planner(cell: CellConfig | None = None, solver: str = "auto") -> MotionPlanner:
+    """The real serve: ``flipkit.planning.planner.plan_serve(burger, table_spot,
+    q_start=..., cell=..., solver=...)`` (``cell`` and ``solver`` passed where its signature
+    takes them).
+
+    Raises:
+        MissingPlannerError: ``plan_serve`` does not exist in :mod:`flipkit.planning.planner`.
+    """
+    from flipkit.planning import planner
+
+    plan_serve = getattr(planner, "plan_serve", None)
+    if plan_serve is None:
+        raise MissingPlannerError(f"serving needs {SERVE_PLANNER}, which this flipkit does "
+                                  "not have yet (issue 13, item 1); --flip-only plans the "
+                                  "flips alone")
+
+    import inspect
+
+    params = inspect.signature(plan_serve).parameters
+    takes_all = any(p.kind is p.VAR_KEYWORD for p in params.values())
+    extra = {k: v for k, v in (("cell", cell), ("solver", solver))
+             if takes_all or k in params}
+    if cell is not None and cell != CellConfig() and "cell" not in extra:
+        raise MissingPlannerError(f"{SERVE_PLANNER} takes no cell; it cannot plan in a "
+                                  "non-default cell")
+
+    def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
+        t0 = time.perf_counter()
+        p = plan_serve(job.location, job.table_spot, q_start=q_start, **extra)
+        return from_plan(p, "serve", time.perf_counter() - t0)
+
+    return plan
+
+
+def available_kinds() -> tuple[str, ...]:
+    """The motion kinds whose real planner exists in this flipkit."""
+    from flipkit.planning import planner
+
+    return KINDS if hasattr(planner, "plan_serve") else ("flip",)
+
+
+def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = "auto"
+                     ) -> Mapping[str, MotionPlanner]:
+    """The real planners of ``kinds``.
+
+    Raises:
+        MissingPlannerError: A kind without a planner (``serve`` before ``plan_serve``).
+        InvalidChoiceError: An unknown kind.
+    """
+    from flipkit.errors import InvalidChoiceError
+
+    makers: dict[str, Callable[..., MotionPlanner]] = {"flip": flip_planner,
+                                                       "serve": serve_planner}
+    out = {}
+    for kind in kinds:
+        if kind not in makers:
+            raise InvalidChoiceError("motion kind", kind, KINDS)
+        out[kind] = makers[kind](cell, solver)
+    return out
+
+
+__all__ = ["KINDS", "SERVE_PLANNER", "MissingPlannerError", "MotionJob", "MotionPlanner",
+           "PlannedMotion", "available_kinds", "default_planners", "flip_planner",
+           "from_plan", "serve_planner"]
