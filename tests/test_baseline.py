@@ -218,3 +218,31 @@ def test_arguments_are_validated(cell, bare):
     t, qs = _static(bare, bare.q_home)
     with pytest.raises(ConfigError):
         classify_segment("x", bare, t, qs[:-1], *_refs(bare, qs))
+
+
+@pytest.mark.parametrize("speed, T, want", [(0.9, 1.0, None), (1.5, 1.0, "time_scalable"),
+                                           (3.0, 0.4, "dynamic")])
+def test_time_scaling_class(bare, speed, T, want):
+    """A wrist-3 sweep run at `speed` × its velocity limit: under the limit it passes; 1.5×
+    passes once slowed down by s ≈ 1.5 (≤ 2: time_scalable); 3× needs more than 2× (dynamic)."""
+    from flipkit.baseline.classify import MAX_TIME_SCALING, classify_segment
+
+    n = 501
+    t = np.linspace(0.0, T, n)
+    amp = speed * bare.qd_max[5] * T / np.pi  # q6 = amp sin(πt/T): peak rate amp π / T
+    q = np.tile(bare.q_home, (n, 1))
+    q[:, 5] -= amp * np.sin(np.pi * t / T)  # starts and ends at q_home's q6, within limits
+    M = [bare.placement(qk) for qk in q]
+    v = classify_segment("go_to_burger", bare, t, q, np.array([m.translation for m in M]),
+                         np.array([m.rotation for m in M]))
+    assert v.failure_class == want
+    if want is None:
+        assert v.status == "solved"
+        return
+    assert v.reason == "joint_velocity" and v.amount == pytest.approx(speed * bare.qd_max[5],
+                                                                      rel=1e-3)
+    if want == "time_scalable":
+        assert v.time_scaling == pytest.approx(speed, rel=2e-3)
+        assert v.time_scaling <= MAX_TIME_SCALING
+    else:
+        assert v.time_scaling == float("inf")

@@ -7,6 +7,7 @@ import json
 import pytest
 
 from flipkit.baseline import REASONS
+from flipkit.baseline.classify import FAILURE_CLASSES
 from flipkit.cli import main
 from flipkit.experiments.compare_ik import compare_ik, plan_filename
 from flipkit.config import TABLE1_LOCATIONS
@@ -16,8 +17,9 @@ from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.verify import verify_plan
 
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
-COLLOCATION_KEYS = {"status", "reason", "time_s"}
-EE_IK_KEYS = {"status", "reason", "subbehavior", "amount", "time_s"}
+COLLOCATION_KEYS = {"status", "reason", "time_s", "judge"}
+EE_IK_KEYS = {"status", "reason", "class", "subbehavior", "amount", "time_scaling", "time_s",
+              "time_breakdown_s"}
 
 
 @pytest.fixture(scope="module")
@@ -42,10 +44,15 @@ def test_output_schema(run):
     for method in ("collocation", "ee_ik"):
         assert entry[method]["status"] in ("solved", "failed")
     assert entry["collocation"]["time_s"] > 0
-    assert set(entry["ee_ik"]["time_s"]) <= set(SUBBEHAVIORS)
+    assert entry["ee_ik"]["time_s"] > 0 and set(entry["ee_ik"]["time_breakdown_s"]) <= set(
+        SUBBEHAVIORS)
+    assert entry["ee_ik"]["class"] in FAILURE_CLASSES + (None,)
     s = doc["summary"]
     assert s["locations"] == 1 and set(s["success_fraction"]) == {"collocation", "ee_ik"}
     assert set(s["ik_failure_reasons"]) == set(REASONS)
+    assert set(s["ik_failure_classes"]) == set(FAILURE_CLASSES)
+    judge = entry["collocation"]["judge"]
+    assert judge["status"] in ("solved", "failed") and sum(s["collocation_judge"].values()) == 1
     assert set(s["median_time_s"]["collocation"]) == set(SUBBEHAVIORS) | {"total"}
     assert set(s["median_time_s"]["ee_ik"]) == set(SUBBEHAVIORS)
 

@@ -4,8 +4,13 @@ The paper's motivating claim (Sec. I) is that planning in end-effector space and
 inverse kinematics fails where joint-space collocation succeeds. :func:`compare_ik` runs both
 on each burger location — :func:`flipkit.planning.planner.plan_flip` (its plan re-checked by
 :func:`flipkit.planning.verify.verify_plan`) and :func:`flipkit.baseline.run_baseline` — on the sweep
-executor, and summarises success fractions, the baseline's failure reasons and the median
-wall time per subbehaviour of each method.
+executor, and summarises success fractions, the baseline's failure reasons and classes, and
+the median wall time per subbehaviour of each method.
+
+One judge for both (:mod:`flipkit.baseline.classify`): the baseline's joint path (closed-form
+IK, the branch continuous with the start, :data:`RATE` Hz) and the collocation plan resampled at
+the same rate (cubic Hermite between nodes) face the same checks and thresholds; the
+collocation plan's verdict is recorded under ``judge`` beside its solver status.
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from collections import Counter
 from pathlib import Path
 
 from flipkit.behaviors import targets as tg
-from flipkit.baseline.classify import REASONS
+from flipkit.baseline.classify import FAILURE_CLASSES, REASONS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.sweep import run_sweep
@@ -25,6 +30,8 @@ from flipkit.experiments.sweep import run_sweep
 LOCATION_SETS = {"table1": TABLE1_LOCATIONS}
 METHODS = ("collocation", "ee_ik")
 _PRIVATE = "_segment_time_s"  # per-segment solve times, used by the summary only
+RATE = 500.0  # Hz: the judge's sample rate for both methods (issue 14)
+IK = "analytic"  # the baseline's IK: the UR10's closed form (flipkit.model.ur_ik)
 
 
 def _number(x) -> float | None:
@@ -53,15 +60,34 @@ def _collocation(location, solver: str, plans_dir) -> dict:
     if plans_dir is not None:
         plan.to_json(Path(plans_dir) / plan_filename(location, solver))
     return {"status": status, "reason": reason, "time_s": float(plan.wall_time_s),
+            "judge": _judge(plan) if status == "solved" else None,
             _PRIVATE: {s.name: float(s.solver.wall_time_s) for s in plan.segments}}
+
+
+def _judge(plan) -> dict:
+    """The baseline's judge on the collocation plan at :data:`RATE` (first failing segment)."""
+    from flipkit.baseline.classify import classify_plan
+
+    verdicts = classify_plan(plan, RATE)
+    bad = next((v for v in verdicts if v.status != "solved"), None)
+    if bad is None:
+        return {"status": "solved", "reason": None, "class": None, "subbehavior": None,
+                "amount": None}
+    return {"status": "failed", "reason": bad.reason, "class": bad.failure_class,
+            "subbehavior": bad.subbehavior, "amount": _number(bad.amount)}
 
 
 def _ee_ik(location) -> dict:
     from flipkit.baseline import run_baseline
 
-    res = run_baseline(location)
-    return {"status": res.status, "reason": res.reason, "subbehavior": res.subbehavior,
-            "amount": _number(res.amount), "time_s": res.time_s}
+    res = run_baseline(location, rate=RATE, ik=IK)
+    failure = res.failure
+    return {"status": res.status, "reason": res.reason,
+            "class": failure.failure_class if failure else None,
+            "subbehavior": res.subbehavior, "amount": _number(res.amount),
+            "time_scaling": _number(failure.time_scaling) if failure else None,
+            "time_s": float(sum(v["ee"] + v["ik"] for v in res.time_s.values())),
+            "time_breakdown_s": res.time_s}
 
 
 def compare_location(job: dict) -> dict:
@@ -74,8 +100,9 @@ def compare_location(job: dict) -> dict:
 
     Returns:
         ``{"location", "collocation": {status, reason, time_s (s, the whole planning call),
-        ...}, "ee_ik": {status, reason, subbehavior, amount, time_s: {subbehaviour: {"ee":
-        s, "ik": s}}}}``.
+        judge: {status, reason, class, subbehavior, amount} or None, ...}, "ee_ik": {status,
+        reason, class, subbehavior, amount, time_scaling, time_s (s, EE + IK of every
+        subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}}}``.
     """
     loc = [float(v) for v in job["location"]]
     return {"location": loc, "collocation": _collocation(loc, job["solver"], job["plans_dir"]),
@@ -97,6 +124,9 @@ def summarize(records: list) -> dict:
     frac = {m: sum(r[m]["status"] == "solved" for r in records) / n if n else None
             for m in METHODS}
     reasons = Counter(r["ee_ik"]["reason"] for r in records if r["ee_ik"]["status"] != "solved")
+    classes = Counter(r["ee_ik"]["class"] for r in records if r["ee_ik"]["status"] != "solved")
+    judged = Counter((r["collocation"].get("judge") or {}).get("class") or "solved"
+                     for r in records if r["collocation"]["status"] == "solved")
     stops = Counter()
     for r in records:
         c = r["collocation"]
@@ -106,10 +136,13 @@ def summarize(records: list) -> dict:
     coll = {s: _median(r["collocation"][_PRIVATE].get(s) for r in records)
             for s in tg.SUBBEHAVIORS}
     coll["total"] = _median(r["collocation"]["time_s"] for r in records)
-    ee = {s: {part: _median(r["ee_ik"]["time_s"].get(s, {}).get(part) for r in records)
+    ee = {s: {part: _median(r["ee_ik"]["time_breakdown_s"].get(s, {}).get(part)
+                            for r in records)
               for part in ("ee", "ik")} for s in tg.SUBBEHAVIORS}
     return {"locations": n, "success_fraction": frac,
             "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
+            "ik_failure_classes": {k: classes.get(k, 0) for k in FAILURE_CLASSES},
+            "collocation_judge": dict(sorted(judged.items())),
             "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
                                         for s in tg.SUBBEHAVIORS},
             "collocation_failures": dict(sorted(stops.items())),
@@ -130,8 +163,9 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
         cell: Only used to check the locations (the methods plan in the default cell).
 
     Returns:
-        ``{"locations": [{"location", "collocation": {status, reason, time_s}, "ee_ik":
-        {status, reason, subbehavior, amount, time_s}}, ...], "summary": summarize(...)}``.
+        ``{"locations": [{"location", "collocation": {status, reason, time_s, judge},
+        "ee_ik": {status, reason, class, subbehavior, amount, time_scaling, time_s,
+        time_breakdown_s}}, ...], "summary": summarize(...)}``.
 
     Raises:
         UnreachableError: A location off the grill (named by its index, from 1).
@@ -150,11 +184,13 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
     if plans_dir is not None:
         Path(plans_dir).mkdir(parents=True, exist_ok=True)
         plans_dir = str(Path(plans_dir).resolve())
-    jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir} for loc in locs]
+    jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir, "judge_rate": RATE,
+             "ik": IK} for loc in locs]  # judge and IK in the job: caches of other setups miss
     records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
                         desc="compare-ik")
     entries = [{"location": r["location"],
-                "collocation": {k: r["collocation"][k] for k in ("status", "reason", "time_s")},
+                "collocation": {k: r["collocation"][k]
+                                for k in ("status", "reason", "time_s", "judge")},
                 "ee_ik": r["ee_ik"]} for r in records]
     return {"locations": entries, "summary": summarize(records)}
 
@@ -166,6 +202,10 @@ def format_summary(summary: dict) -> str:
              f"EE+IK {f['ee_ik']:.0%} solved"]
     bad = {k: v for k, v in summary["ik_failure_reasons"].items() if v}
     lines.append("EE+IK failures: " + (", ".join(f"{k} {v}" for k, v in bad.items()) or "none"))
+    cls = {k: v for k, v in summary["ik_failure_classes"].items() if v}
+    lines.append("  by class: " + (", ".join(f"{k} {v}" for k, v in cls.items()) or "none"))
+    lines.append("collocation plans under the same judge: " + ", ".join(
+        f"{k} {v}" for k, v in summary["collocation_judge"].items()))
     fmt = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
     for s in tg.SUBBEHAVIORS:
         lines.append(f"  {s:<13} collocation {fmt(t['collocation'][s]):>7} s   EE "
