@@ -142,7 +142,7 @@ def summarize(records: list) -> dict:
     return {"locations": n, "success_fraction": frac,
             "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
             "ik_failure_classes": {k: classes.get(k, 0) for k in FAILURE_CLASSES},
-            "collocation_judge": dict(sorted(judged.items())),
+            "collocation_judge": {k: judged.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
                                         for s in tg.SUBBEHAVIORS},
             "collocation_failures": dict(sorted(stops.items())),
@@ -205,7 +205,7 @@ def format_summary(summary: dict) -> str:
     cls = {k: v for k, v in summary["ik_failure_classes"].items() if v}
     lines.append("  by class: " + (", ".join(f"{k} {v}" for k, v in cls.items()) or "none"))
     lines.append("collocation plans under the same judge: " + ", ".join(
-        f"{k} {v}" for k, v in summary["collocation_judge"].items()))
+        f"{k} {v}" for k, v in summary["collocation_judge"].items() if v))
     fmt = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
     for s in tg.SUBBEHAVIORS:
         lines.append(f"  {s:<13} collocation {fmt(t['collocation'][s]):>7} s   EE "
