@@ -1,0 +1,117 @@
+"""Planning the serve behaviour: pick a burger up from the grill and tilt it off onto the side
+table (:mod:`flipkit.behaviors.serve`), then return home.
+
+:func:`plan_serve` chains go to burger, scoop, pickup, carry, place and return home by (29) —
+each segment starts at the previous one's final (q, q̇) — and checks the plan independently
+(:func:`~flipkit.planning.verify.verify_plan`) like every planner entry point
+(:mod:`flipkit.planning.planner`): status ``solved`` only if every segment converged and the
+check passes. It is re-exported as :func:`flipkit.planning.planner.plan_serve`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from flipkit.behaviors import serve as sv
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.config import CellConfig
+from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.model.ik import solve_pose
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.planner import (SOLVERS, _finish, _joint_vector, _solver_failure,
+                                      models_for, solve_segment)
+from flipkit.planning.segment import Segment
+
+
+def placing_record(cell: CellConfig, spot) -> dict:
+    """The ``placing`` record of the carry and place segments: the table ``spot`` (x, y) (m),
+    the blade's ``heading`` and ``pitch`` at the place's end (rad) and the ``runout`` (m)
+    allowed beyond the tip (:func:`flipkit.behaviors.serve.place_end`)."""
+    end = sv.place_end(cell, spot)
+    return {"spot": [float(v) for v in spot], "heading": float(end.o[2]),
+            "pitch": float(end.o[1]), "runout": sv.PLACE_RUNOUT}
+
+
+def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
+               solver: str = "auto", options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
+    22–25), carry with the friction cone throughout, place by a tilt-off, return home.
+
+    Args:
+        burger: Burger location p^b (m) on the grill (:func:`~flipkit.behaviors.targets.check_location`).
+        table_spot: Where the burger's centre should come to rest on the table (x, y) (m);
+            the whole burger must lie on the table (:func:`~flipkit.behaviors.serve.check_table_spot`).
+        q_start: Start configuration (rad), default q_home — e.g. where the previous motion
+            of a schedule ended. qd_start: Start joint velocities (rad/s), default rest.
+        cell: The cell (default :class:`~flipkit.config.CellConfig`).
+        solver: ``"auto"`` (default: the SQP, then IPOPT where it fails), ``"sqp"`` or
+            ``"ipopt"``.
+        options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
+
+    Returns:
+        The :class:`~flipkit.planning.plan_file.Plan`, behaviour ``serve``: status
+        ``solved`` (verified) or ``failed`` with ``plan.failure`` one line; on a segment
+        failure the chain stops there. ``plan.report`` and ``plan.wall_time_s`` (s) as
+        :func:`~flipkit.planning.planner.plan_flip`. It ends at q_home, at rest.
+
+    Raises:
+        UnreachableError: Burger off the grill, spot off the table, or the place pose out of
+            reach. ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
+    """
+    t0, cell = time.perf_counter(), cell or CellConfig()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    pb = tg.check_location(cell, burger)
+    spot = sv.check_table_spot(cell, table_spot)
+    models = models_for(cell)
+    robot = models.bare
+    q = robot.q_home.copy() if q_start is None else _joint_vector(
+        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
+    qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
+        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    for what, pose in (("carry end", sv.carry_end(cell, spot)),
+                       ("place", sv.place_end(cell, spot))):
+        try:  # reachability first, one clear line
+            solve_pose(models.loaded, pose.p, pose.o, robot.q_home)
+        except UnreachableError as exc:
+            raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
+                                   f"{exc}") from None
+    segments, failure = [], None
+    for name in sv.SERVE_SUBBEHAVIORS:
+        try:
+            nlp = build_segment(name, models, q, qd, location=pb, spot=spot, options=options)
+        except FlipkitError as exc:
+            if not segments:
+                raise
+            failure = f"{name}: cannot build the initial guess ({exc})"
+            break
+        result = solve_segment(nlp, solver)
+        seg = Segment.from_solution(nlp, result)
+        if name in ("carry", "place"):
+            seg.placing = placing_record(cell, spot)
+        segments.append(seg)
+        if not result.success:
+            failure = _solver_failure(name, nlp, result)
+            break
+        q, qd = seg.q[-1], seg.qd[-1]
+    plan = Plan.from_segments("serve", cell, segments, location=pb, cone=options.cone,
+                              status="failed")
+    return _finish(plan, failure, t0)
+
+
+def table_spot(plan: Plan) -> np.ndarray:
+    """The table spot (x, y) (m) of a serve plan (its carry or place segment's ``placing``).
+
+    Raises:
+        FlipkitError: No segment records one.
+    """
+    rec = next((s.placing for s in plan.segments if getattr(s, "placing", None)), None)
+    if rec is None:
+        raise FlipkitError("serve plan: no segment records the table spot (placing.spot)")
+    return np.asarray(rec["spot"], float)
+
+
+__all__ = ["plan_serve", "placing_record", "table_spot"]
