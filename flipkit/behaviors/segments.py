@@ -124,7 +124,7 @@ def grill_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
     turn back stays clear of a flipped burger lying anywhere on the grill.
     """
     if name in sv.SERVE_ONLY:
-        return sv.table_floor(cell, N)
+        return sv.table_floor(name, cell, N)
     hg = cell.grill.height
     pressed = hg - SCOOP_PRESS - SCOOP_TIP_BAND
     floor = np.full(N + 1, {"scoop": pressed, "pickup": pressed,
@@ -191,7 +191,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         land: Flip: landing spot (x, y) (m); default where the burger was picked up
             (:func:`~flipkit.behaviors.targets.landing_spot`).
         on_blade: Flip: where the burger's centre sits on the blade (x, y) in the blade frame
-            (m), for its release state; default the blade centre.
+            (m), for its release state; serve: for where it comes to rest on the table;
+            default the blade centre.
         spot: Serve (carry, place): the table spot (x, y) (m) (:mod:`flipkit.behaviors.serve`).
         options: Transcription options.
     """
@@ -222,7 +223,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", moving,
                                  grill_floor(name, cell, L.N)[1:, None], np.inf, ctx=ctx))
     # the burger's contact acceleration is that of the blade point under its centre
-    on_point = (*np.asarray(on_blade, float)[:2], 0.0) if name == "flip" else None
+    on_point = ((*np.asarray(on_blade, float)[:2], 0.0) if name in ("flip", "carry", "place")
+                else None)
     cone = Cone(make_cone(options.cone, cell.burger.mu * options.mu_safety, cell.gravity),
                 on_point)
     cone_nodes: list[int] = []
@@ -234,7 +236,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     if name in sv.SERVE_ONLY:
         if spot is None and name != "return_home":
             raise ConfigError(f"{name} needs the table spot")
-        more, pose = sv.serve_blocks(name, L, robot, q_start, spot, ctx)
+        more, pose = sv.serve_blocks(name, L, robot, q_start, spot, on_blade)
         blocks += more
         cone_nodes = sv.cone_nodes(name, L.N)
     elif name == "translate":

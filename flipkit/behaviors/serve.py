@@ -7,26 +7,33 @@ are) and three subbehaviours of its own, each a collocation segment:
 * ``carry`` (like translate, eq. 9): from the pickup's end, friction cone on every node, to
   the blade flat and level :data:`CARRY_CLEARANCE` above the place pose, heading
   ψ = atan2(y, x) of the spot (radially outward from the base), at rest.
-* ``place`` — a **tilt-off**: the blade comes down and pitches its tip down to
+* ``place`` — a **tilt-and-withdraw**: the blade comes down and pitches its tip down to
   :data:`PLACE_PITCH` with the tip :data:`PLACE_TIP_GAP` above the table, at rest. The cone
   holds on nodes i ≤ :data:`PLACE_CONE_FRACTION` N (the burger rides the descent); after
-  them the pitch passes the friction angle and the burger slides off the tip onto the table.
-* ``return_home``: first a withdrawal — for nodes 1..:data:`WITHDRAW_NODES` the blade keeps
+  them the pitch passes the friction angle, the burger slides down the blade until its front
+  edge meets the table, and rests there, front edge on the table, back on the blade.
+* ``return_home``: first the withdrawal — for nodes 1..:data:`WITHDRAW_NODES` the blade keeps
   its attitude (±:data:`WITHDRAW_ANGLE_BAND`) and slides back in its own plane
-  (±:data:`WITHDRAW_BAND` off it) by at least :data:`WITHDRAW_DISTANCE` — so a burger still on
-  the tip is pulled out from under, not flung; then to q_home at rest.
+  (±:data:`WITHDRAW_BAND` off it) by at least :data:`WITHDRAW_DISTANCE` (a blade length less
+  its overlap with a burger at its tip): gravity along the 40° blade beats friction
+  (tan θ > μ), so the burger stays where it is while the blade is pulled out from under it,
+  and lies down flat about its front edge. Then the blade rises above the burger's top and
+  goes to q_home at rest.
 
-Why a tilt-off. A set-down-and-withdraw drags the burger with the blade (static friction
-holds it to the blade, nothing holds it to the table); a slide-off by a fast backward jerk
-(tablecloth trick) needs blade accelerations ≫ μ g and its drag distance grows with μ.
-Tilted past the friction angle, the burger leaves by gravity alone: the pitch only has to
-exceed atan μ for every μ the cell may have (0.70 rad = 40°: tan = 0.84 > 0.8, the top of
-the burger.mu range), and with the tip just above the table the burger slides a few
-centimetres at most before its front edge meets the table, so it runs out little.
+Why this move. A set-down-and-withdraw on a flat blade drags the burger with the blade
+(static friction holds it to the blade, nothing holds it to the table); a slide-off by a fast
+backward jerk (tablecloth trick) needs blade accelerations ≫ μ g and its drag distance grows
+with μ; a tilt-off from a height lets the burger tumble. Tilted past the friction angle for
+every μ the cell may have (0.70 rad = 40°: tan = 0.84 > 0.8, the top of the burger.mu range)
+with the tip just above the table, the burger ends with its front edge on the table, and the
+withdrawal lets it down where it is: its final place is geometry, not a sliding distance.
 
-Where it lands: the burger's centre ends about a burger radius plus :data:`PLACE_RUNOUT`
-beyond the tip along the heading, so the tip is put at spot − (d/2 + runout)·(cos ψ, sin ψ).
-The runout is a planning allowance, not a simulation parameter (see its comment).
+Where it lands (:func:`predicted_rest`): with the burger's centre at x_b along the blade
+(x_eff = max(x_b, l/2 − d/2): a burger further back slides until its front edge is at the
+tip) and y_b across it, it lies down about its front edge, so its centre comes to rest
+x_eff cos θ − (d/2)(1 − cos θ) ahead of the blade centre along the heading and y_b across.
+The planner puts the blade so that this point is the spot; ``on_blade`` is where the burger
+sits on the blade (default the centre; sensed after the scoop, :func:`flipkit.planning.serve.replan_serve`).
 """
 
 from __future__ import annotations
@@ -46,13 +53,10 @@ SERVE_ONLY = SERVE_SUBBEHAVIORS[3:]
 PLACE_PITCH = 0.70  # rad, tip down at the end of the place (tan 0.70 = 0.84 > μ's range 0.2–0.8)
 PLACE_TIP_GAP = 0.005  # m, blade tip above the table at the end of the place
 PLACE_CONE_FRACTION = 0.7  # the cone holds on place nodes i ≤ 0.7 N
-# m, the burger's centre ends this far beyond (tip + d/2) along the heading. Estimate: sliding
-# s ≤ l/2 − d/2 = 3 cm down the 40° blade and running out on a table of friction μ_t ≈ μ it
-# covers s (sin θ − μ cos θ)/μ_t ≈ 0.5 s ≤ 1.5 cm; 1 cm is the middle of that.
-PLACE_RUNOUT = 0.01
 CARRY_CLEARANCE = 0.06  # m, the carry ends with the blade centre this far above the place pose
-WITHDRAW_NODES = 5  # return_home nodes 1..5 withdraw the blade in its own plane
-WITHDRAW_DISTANCE = 0.06  # m, at least this far back along −x of the blade by node 5
+WITHDRAW_NODES = 8  # return_home nodes 1..8 withdraw the blade in its own plane
+WITHDRAW_DISTANCE = 0.14  # m, back along −x of the blade by node 8: l − 2 cm of overlap
+BURGER_CLEARANCE = 0.01  # m, blade edges above the placed burger's top after the withdrawal
 WITHDRAW_BAND = 0.005  # m, off the blade's start plane / start line while withdrawing
 WITHDRAW_ANGLE_BAND = 0.05  # rad, rpy about the place end's while withdrawing
 # Duration bounds (s): Σu² drives T to the upper bound. The carry covers up to ~1 m under the
@@ -84,28 +88,49 @@ def heading(spot) -> float:
     return float(math.atan2(spot[1], spot[0]))
 
 
-def place_end(cell: CellConfig, spot) -> Pose:
+def rest_offset(cell: CellConfig, on_blade=(0.0, 0.0)) -> tuple[float, float]:
+    """Where the placed burger comes to rest relative to the blade centre at the place's end
+    (m): (along the heading, across it) — module docstring."""
+    th, l, r = PLACE_PITCH, cell.spatula.length, cell.burger.diameter / 2
+    x_eff = max(float(on_blade[0]), l / 2 - r)
+    return x_eff * math.cos(th) - r * (1 - math.cos(th)), float(on_blade[1])
+
+
+def place_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
     """End of the place: tip :data:`PLACE_TIP_GAP` above the table, pitched :data:`PLACE_PITCH`
-    tip down, heading :func:`heading`, the tip d/2 + :data:`PLACE_RUNOUT` short of the spot."""
+    tip down, heading :func:`heading`, placed so that the burger at ``on_blade`` (x, y on the
+    blade, m) comes to rest at ``spot`` (:func:`rest_offset`)."""
     psi, th, l = heading(spot), PLACE_PITCH, cell.spatula.length
-    u = np.array([math.cos(psi), math.sin(psi)])
-    tip = np.asarray(spot, float) - (cell.burger.diameter / 2 + PLACE_RUNOUT) * u
-    centre = tip - l / 2 * math.cos(th) * u
+    u, v = np.array([math.cos(psi), math.sin(psi)]), np.array([-math.sin(psi), math.cos(psi)])
+    along, across = rest_offset(cell, on_blade)
+    centre = np.asarray(spot, float) - along * u - across * v
     z = cell.table.height + PLACE_TIP_GAP + l / 2 * math.sin(th)
     return Pose((float(centre[0]), float(centre[1]), float(z)), (0.0, th, psi))
 
 
-def carry_end(cell: CellConfig, spot) -> Pose:
+def predicted_rest(cell: CellConfig, p, psi: float, on_blade=(0.0, 0.0)) -> np.ndarray:
+    """Predicted rest point (x, y) (m) of the burger placed by a blade ending at centre ``p``
+    with heading ``psi`` (rad), the burger at ``on_blade`` (:func:`rest_offset`)."""
+    along, across = rest_offset(cell, on_blade)
+    u, v = np.array([math.cos(psi), math.sin(psi)]), np.array([-math.sin(psi), math.cos(psi)])
+    return np.asarray(p, float)[:2] + along * u + across * v
+
+
+def carry_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
     """End of the carry: the blade flat and level :data:`CARRY_CLEARANCE` above the place
     pose's centre, heading :func:`heading`."""
-    p = place_end(cell, spot).p
+    p = place_end(cell, spot, on_blade).p
     return Pose((p[0], p[1], p[2] + CARRY_CLEARANCE), (0.0, 0.0, heading(spot)))
 
 
-def table_floor(cell: CellConfig, N: int) -> np.ndarray:
+def table_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
     """Lowest blade edge height (m) at nodes 0..N of a serve-only segment: the table's top
-    (the blade never goes below it; the grill is lower)."""
-    return np.full(N + 1, max(cell.table.height, cell.grill.height))
+    (the blade never goes below it; the grill is lower), and after the withdrawal the placed
+    burger's top plus :data:`BURGER_CLEARANCE`."""
+    floor = np.full(N + 1, max(cell.table.height, cell.grill.height))
+    if name == "return_home":
+        floor[WITHDRAW_NODES + 1:] = cell.table.height + cell.burger.thickness + BURGER_CLEARANCE
+    return floor
 
 
 class InStartFrame(Quantity):
@@ -128,12 +153,13 @@ def withdraw_bounds(N: int) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def serve_blocks(name: str, L, robot, q_start, spot, ctx) -> tuple[list, Pose | None]:
+def serve_blocks(name: str, L, robot, q_start, spot, on_blade=(0.0, 0.0)
+                 ) -> tuple[list, Pose | None]:
     """Path blocks of a serve-only segment and its end pose (None for return_home)."""
     if name == "carry":
-        return [], carry_end(robot.cell, spot)
+        return [], carry_end(robot.cell, spot, on_blade)
     if name == "place":
-        return [], place_end(robot.cell, spot)
+        return [], place_end(robot.cell, spot, on_blade)
     st = robot.placement(q_start)
     nodes = range(1, WITHDRAW_NODES + 1)
     lo, hi = withdraw_bounds(L.N)
@@ -151,7 +177,8 @@ def cone_nodes(name: str, N: int) -> list[int]:
     return []
 
 
-__all__ = ["SERVE_SUBBEHAVIORS", "SERVE_ONLY", "PLACE_PITCH", "PLACE_TIP_GAP", "PLACE_RUNOUT",
+__all__ = ["SERVE_SUBBEHAVIORS", "SERVE_ONLY", "PLACE_PITCH", "PLACE_TIP_GAP", "rest_offset",
+           "predicted_rest", "WITHDRAW_NODES", "WITHDRAW_DISTANCE",
            "PLACE_CONE_FRACTION", "T_BOUNDS", "CARRIES_BURGER", "check_table_spot", "heading",
            "place_end", "carry_end", "table_floor", "InStartFrame", "withdraw_bounds",
            "serve_blocks", "cone_nodes"]

@@ -20,7 +20,7 @@ def default_payload(name: str) -> list[str]:
 
 
 SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
-_PLACING_KEYS = ("spot", "heading", "pitch", "runout")
+_PLACING_KEYS = ("spot", "on_blade", "heading", "pitch")
 _LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
 
 
@@ -66,8 +66,9 @@ class Segment:
             ``burger_on_blade`` (x, y) (m, blade frame), where the flight starts from.
         payload: Names of the ``robot.payload`` bodies the segment's dynamics carry
             (``["spatula"]``, ``["spatula", "burger"]``); default :func:`default_payload`.
-        placing: Serve carry and place only: ``spot`` (x, y) on the table (m), the blade's
-            ``heading`` and ``pitch`` at the place's end (rad) and the ``runout`` (m)
+        placing: Serve carry and place only: ``spot`` (x, y) on the table (m), ``on_blade``
+            (x, y) (m, blade frame) where the burger was planned to sit, the blade's
+            ``heading`` and ``pitch`` at the place's end (rad)
             (:func:`flipkit.planning.serve.placing_record`).
     """
 
@@ -139,8 +140,9 @@ class Segment:
             if self.name not in ("carry", "place"):
                 raise ConfigError("placing: only carry and place segments have it")
             f = check_keys(self.placing, "placing", _PLACING_KEYS)
-            self.placing = {"spot": check_array("placing.spot", f["spot"], (2,)).tolist(),
-                            **{k: check_number(f"placing.{k}", f[k]) for k in _PLACING_KEYS[1:]}}
+            self.placing = {**{k: check_array(f"placing.{k}", f[k], (2,)).tolist()
+                               for k in _PLACING_KEYS[:2]},
+                            **{k: check_number(f"placing.{k}", f[k]) for k in _PLACING_KEYS[2:]}}
         if self.payload is None:
             self.payload = default_payload(self.name)
         else:

@@ -99,9 +99,9 @@ def _desired(plan, t: np.ndarray):
 def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> dict:
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
-    if plan.behavior != "flip" or plan.status != "solved":
-        raise ConfigError(f"execute_plan needs a solved flip plan, got a {plan.status} "
-                          f"{plan.behavior} plan")
+    if plan.behavior not in ("flip", "serve") or plan.status != "solved":
+        raise ConfigError(f"execute_plan needs a solved flip or serve plan, got a "
+                          f"{plan.status} {plan.behavior} plan")
     if not (np.isfinite(hold) and hold >= 0 and np.isfinite(rate_hz) and rate_hz > 0):
         raise ConfigError(f"need hold >= 0 s and rate_hz > 0, got {hold!r}, {rate_hz!r}")
     draw = {**NO_DRAW, **(draw or {})}
@@ -114,10 +114,12 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None) -> Execution:
-    """Execute a flip plan closed-loop in the MuJoCo cell with the burger on the grill.
+    """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
-        plan: A solved flip :class:`~flipkit.planning.plan_file.Plan` (segments go_to_burger … turn_back).
+        plan: A solved flip or serve :class:`~flipkit.planning.plan_file.Plan` (segments
+            go_to_burger … turn_back, or go_to_burger … return_home; a serve plan tilts the
+            burger off onto the scene's table).
         mode: ``"feedforward"`` or ``"position"`` (module docstring).
         draw: A perturbation (:meth:`flipkit.experiments.trials.Perturbations.draw`): ``dx_m``, ``dy_m``
             burger placement error (m), ``grill_offset_m`` (m), ``mu_factor`` (burger-blade
@@ -130,7 +132,8 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
             rest, blade flat on the grill) with the burger's centre measured in the blade
-            frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip`; the rest of the run
+            frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip` (a serve plan:
+            :func:`flipkit.planning.serve.replan_serve`); the rest of the run
             follows the returned plan, which must keep go to burger and scoop and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
