@@ -21,7 +21,7 @@ from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.model.contact import make_cone
-from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.transcription.nlp import NLP
 from flipkit.model.orientation import rpy
@@ -166,7 +166,14 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
             p = (1 - w) * p0 + w * np.asarray(pose.p)
             if name == "scoop":  # keep the tip pressed: p_z = h_g − press + (l/2) sin o_y
                 p[2] = cell.grill.height - SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
-            q = solve_pose(robot, p, o, q)
+            try:
+                q = solve_pose(robot, p, o, q)
+            except UnreachableError:
+                if name not in sv.SERVE_ONLY:
+                    raise
+                # the straight carry to the table passes near the base: a joint-space path
+                return bezier_guess(L, robot, q_start, sv.reach(robot, pose, (q_start, q)),
+                                    T, qd_start)
             waypoints.append(q)
         return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end)
     seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)

@@ -9,9 +9,13 @@ are) and three subbehaviours of its own, each a collocation segment:
   ψ = atan2(y, x) of the spot (radially outward from the base), at rest.
 * ``place`` — a **tilt-and-withdraw**: the blade comes down and pitches its tip down to
   :data:`PLACE_PITCH` with the tip :data:`PLACE_TIP_GAP` above the table, at rest. The cone
-  holds on nodes i ≤ :data:`PLACE_CONE_FRACTION` N (the burger rides the descent); after
-  them the pitch passes the friction angle, the burger slides down the blade until its front
-  edge meets the table, and rests there, front edge on the table, back on the blade.
+  holds on nodes i ≤ :data:`PLACE_CONE_FRACTION` N (the burger rides the descent); from
+  node ⌈0.7 N⌉ on the tip holds its final point (±:data:`PIVOT_BAND`) and the blade tilts
+  about it, so the pitch passes the friction angle with the tip in place: the burger slides
+  down the blade until its front edge meets the table, and rests there, front edge on the
+  table, back on the blade. (Without the pivot the solver's place swung the blade low and
+  back, tilted it early and came forward again: a burger that slid off early was pushed
+  7 cm past its spot in MuJoCo.)
 * ``return_home``: first the withdrawal — for nodes 1..:data:`WITHDRAW_NODES` the blade keeps
   its attitude (±:data:`WITHDRAW_ANGLE_BAND`) and slides back in its own plane
   (±:data:`WITHDRAW_BAND` off it) by at least :data:`WITHDRAW_DISTANCE` (a blade length less
@@ -29,9 +33,11 @@ with the tip just above the table, the burger ends with its front edge on the ta
 withdrawal lets it down where it is: its final place is geometry, not a sliding distance.
 
 Where it lands (:func:`predicted_rest`): with the burger's centre at x_b along the blade
-(x_eff = max(x_b, l/2 − d/2): a burger further back slides until its front edge is at the
-tip) and y_b across it, it lies down about its front edge, so its centre comes to rest
-x_eff cos θ − (d/2)(1 − cos θ) ahead of the blade centre along the heading and y_b across.
+and y_b across it, its front edge overhangs the tip by x_eff + d/2 − l/2, with
+x_eff = max(x_b, l/2 − d/2) (a burger further back slides down until its front edge is at
+the tip). That edge meets the table there, about (x_eff + d/2 − l/2) beyond the tip, and the
+burger lies down about it when the blade is pulled out: its centre comes to rest d/2 behind
+it, x_eff − (l/2)(1 − cos θ) ahead of the blade centre along the heading and y_b across.
 The planner puts the blade so that this point is the spot; ``on_blade`` is where the burger
 sits on the blade (default the centre; sensed after the scoop, :func:`flipkit.planning.serve.replan_serve`).
 """
@@ -46,6 +52,7 @@ from flipkit.behaviors.targets import Pose
 from flipkit.config import CellConfig
 from flipkit.errors import UnreachableError
 from flipkit.model.orientation import rpy
+from flipkit.model.robot import skew
 from flipkit.transcription.constraints.kinematic import KinematicBlock, Quantity
 
 SERVE_SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "carry", "place", "return_home")
@@ -53,6 +60,7 @@ SERVE_ONLY = SERVE_SUBBEHAVIORS[3:]
 PLACE_PITCH = 0.70  # rad, tip down at the end of the place (tan 0.70 = 0.84 > μ's range 0.2–0.8)
 PLACE_TIP_GAP = 0.005  # m, blade tip above the table at the end of the place
 PLACE_CONE_FRACTION = 0.7  # the cone holds on place nodes i ≤ 0.7 N
+PIVOT_BAND = 0.003  # m, the tip within this of its final point while the blade tilts about it
 CARRY_CLEARANCE = 0.06  # m, the carry ends with the blade centre this far above the place pose
 WITHDRAW_NODES = 8  # return_home nodes 1..8 withdraw the blade in its own plane
 WITHDRAW_DISTANCE = 0.14  # m, back along −x of the blade by node 8: l − 2 cm of overlap
@@ -93,7 +101,7 @@ def rest_offset(cell: CellConfig, on_blade=(0.0, 0.0)) -> tuple[float, float]:
     (m): (along the heading, across it) — module docstring."""
     th, l, r = PLACE_PITCH, cell.spatula.length, cell.burger.diameter / 2
     x_eff = max(float(on_blade[0]), l / 2 - r)
-    return x_eff * math.cos(th) - r * (1 - math.cos(th)), float(on_blade[1])
+    return x_eff - l / 2 * (1 - math.cos(th)), float(on_blade[1])
 
 
 def place_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
@@ -133,6 +141,28 @@ def table_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
     return floor
 
 
+class TipPoint(Quantity):
+    """World position (m) of the blade tip p + R (l/2, 0, 0) and its ∂/∂q = ∂p/∂q − [R r]× J_ω."""
+
+    def __call__(self, st, ctx):
+        r = st.R @ np.array([ctx["length"] / 2, 0.0, 0.0])
+        return st.p + r, st.dp_dq - skew(r) @ st.Jw
+
+
+def tip_point(cell: CellConfig, pose: Pose) -> np.ndarray:
+    """World position (m) of the blade tip at ``pose``."""
+    from flipkit.model.orientation import rpy_matrix
+
+    return np.asarray(pose.p, float) + rpy_matrix(pose.o) @ np.array(
+        [cell.spatula.length / 2, 0.0, 0.0])
+
+
+def pivot_nodes(N: int) -> list[int]:
+    """Place nodes where the tip holds its final point (the tilt pivots about it): after the
+    cone nodes."""
+    return [i for i in range(N + 1) if i >= PLACE_CONE_FRACTION * N - 1e-9]
+
+
 class InStartFrame(Quantity):
     """Blade-centre position in a fixed frame (R0, p0): R0ᵀ (p − p0) (m), ∂/∂q = R0ᵀ ∂p/∂q."""
 
@@ -159,13 +189,33 @@ def serve_blocks(name: str, L, robot, q_start, spot, on_blade=(0.0, 0.0)
     if name == "carry":
         return [], carry_end(robot.cell, spot, on_blade)
     if name == "place":
-        return [], place_end(robot.cell, spot, on_blade)
+        end = place_end(robot.cell, spot, on_blade)
+        tip, b = tip_point(robot.cell, end), PIVOT_BAND
+        ctx = {"length": robot.cell.spatula.length}
+        return [KinematicBlock("place_pivot", L, TipPoint(), pivot_nodes(L.N), tip - b,
+                               tip + b, ctx=ctx)], end
     st = robot.placement(q_start)
     nodes = range(1, WITHDRAW_NODES + 1)
     lo, hi = withdraw_bounds(L.N)
     o0, band = rpy(st.rotation), WITHDRAW_ANGLE_BAND
     return [KinematicBlock("withdraw", L, InStartFrame(st.rotation, st.translation), nodes, lo, hi),
             KinematicBlock("withdraw_attitude", L, "rpy", nodes, o0 - band, o0 + band)], None
+
+
+def reach(robot, pose: Pose, seeds=()) -> np.ndarray:
+    """An IK solution of ``pose`` from the first of ``seeds``, then q_home, that reaches it.
+
+    Raises:
+        UnreachableError: None does.
+    """
+    from flipkit.model.ik import solve_pose
+
+    for seed in (*seeds, robot.q_home):
+        try:
+            return solve_pose(robot, pose.p, pose.o, seed)
+        except UnreachableError as exc:
+            error = exc
+    raise error
 
 
 def cone_nodes(name: str, N: int) -> list[int]:
@@ -181,4 +231,4 @@ __all__ = ["SERVE_SUBBEHAVIORS", "SERVE_ONLY", "PLACE_PITCH", "PLACE_TIP_GAP", "
            "predicted_rest", "WITHDRAW_NODES", "WITHDRAW_DISTANCE",
            "PLACE_CONE_FRACTION", "T_BOUNDS", "CARRIES_BURGER", "check_table_spot", "heading",
            "place_end", "carry_end", "table_floor", "InStartFrame", "withdraw_bounds",
-           "serve_blocks", "cone_nodes"]
+           "serve_blocks", "cone_nodes", "TipPoint", "tip_point", "pivot_nodes", "reach"]

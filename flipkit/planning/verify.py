@@ -21,7 +21,8 @@ endpoints          end pose / rest / q_home per behaviour; translate: rest at  t
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded;
                    serve: carry and place end poses from the recorded spot
 behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip   tol
-                   normal, x axis, height band; return_home withdrawal
+                   normal, x axis, height band; place: tip at its final
+                   point ± PIVOT_BAND from node 0.7 N; return_home withdrawal
                    (in the blade's start frame, attitude band)
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
@@ -329,7 +330,12 @@ def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
         return
     target = (sv.carry_end if seg.name == "carry" else sv.place_end)(cell, spot, on_blade)
     pose(target)
-    if seg.name == "place":
+    if seg.name == "place":  # the tilt pivots about the tip's final point
+        tip = sv.tip_point(cell, target)
+        half = np.array([cell.spatula.length / 2, 0.0, 0.0])
+        for i in sv.pivot_nodes(N):
+            miss = np.abs(states[i].p + states[i].R @ half - tip) - sv.PIVOT_BAND
+            add("behavior_path", k, np.maximum(miss, 0.0), tol, i)
         end = states[-1]
         rest = sv.predicted_rest(cell, end.p, rpy(end.R)[2], on_blade)
         add("placing", k, [np.linalg.norm(rest - spot)], 1e-3, N)

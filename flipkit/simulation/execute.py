@@ -194,19 +194,18 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
             mujoco.mj_kinematics(m, d)
             p_b, R_b = scene.blade_pose()
             sensed = ((d.xpos[burger_body] - p_b) @ R_b)[:2]
-            try:
+            try:  # a failed replan keeps the verified plan under way (and this step runs)
                 new = replan(plan, np.clip(sensed, -half, half))
-            except FlipkitError as exc:  # keep the verified plan under way
-                replan_failure = str(exc)
-                continue
-            if new.status != "solved":
-                replan_failure = new.failure or "replanned plan not solved"
-                continue
-            plan = new
-            t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
-            if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
-                raise ConfigError("the replanned run does not extend the executed one")
-            t = t2
+            except FlipkitError as exc:
+                new, replan_failure = None, str(exc)
+            if new is not None and new.status != "solved":
+                new, replan_failure = None, new.failure or "replanned plan not solved"
+            if new is not None:
+                plan = new
+                t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
+                if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
+                    raise ConfigError("the replanned run does not extend the executed one")
+                t = t2
         q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
         ff = u_ff[k] if mode == "feedforward" else pin.computeGeneralizedGravity(
             robot.model, robot.data, q)
