@@ -76,6 +76,21 @@ def test_in_start_frame_jacobian_matches_finite_differences(robot):
     np.testing.assert_allclose(value, R0.T @ (robot.position(q) - p0), atol=1e-12)
 
 
+def test_tip_point_jacobian_matches_finite_differences(robot, cell):
+    ctx = {"length": cell.spatula.length}
+    q = robot.q_home + np.array([0.1, 0.2, -0.1, 0.3, 0.2, -0.4])
+    zero = np.zeros(robot.nq)
+    value, jac = sv.TipPoint()(robot.state(q, zero, zero), ctx)
+    fd = central_fd(lambda x: sv.TipPoint()(robot.state(x, zero, zero), ctx)[0], q)
+    np.testing.assert_allclose(jac, fd, atol=1e-7)
+    pose = sv.place_end(cell, SPOT)
+    from flipkit.model.ik import solve_pose
+
+    qe = solve_pose(robot, pose.p, pose.o)
+    np.testing.assert_allclose(sv.TipPoint()(robot.state(qe, zero, zero), ctx)[0],
+                               sv.tip_point(cell, pose), atol=1e-6)
+
+
 # ---------------------------------------------------------------- planner and verify
 def test_serve_plan_is_solved_verified_and_chained(plan):
     names = [s.name for s in plan.segments]

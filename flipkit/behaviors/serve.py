@@ -78,7 +78,10 @@ def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
 
     The whole burger must lie on the table: the spot is at least a burger radius inside the
     table's edges (:class:`~flipkit.config.TableConfig`)."""
-    xy = np.asarray(spot, dtype=float).ravel() if np.ndim(spot) else np.array([spot], float)
+    try:
+        xy = np.asarray(spot, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}") from None
     if xy.shape != (2,) or not np.all(np.isfinite(xy)):
         raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}")
     tb, r = cell.table, cell.burger.diameter / 2
