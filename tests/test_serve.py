@@ -61,7 +61,7 @@ def test_place_end_puts_the_predicted_rest_point_on_the_spot(cell, on_blade):
 def test_a_burger_further_out_on_the_blade_moves_the_blade_back(cell):
     near, far = (sv.place_end(cell, SPOT, (x, 0.0)).p for x in (0.0, 0.06))
     u = np.array([np.cos(sv.heading(SPOT)), np.sin(sv.heading(SPOT))])
-    assert (np.asarray(far[:2]) - near[:2]) @ u < -0.02
+    assert (np.asarray(far[:2]) - near[:2]) @ u < -0.01
 
 
 def test_in_start_frame_jacobian_matches_finite_differences(robot):
@@ -88,7 +88,7 @@ def test_tip_point_jacobian_matches_finite_differences(robot, cell):
 
     qe = solve_pose(robot, pose.p, pose.o)
     np.testing.assert_allclose(sv.TipPoint()(robot.state(qe, zero, zero), ctx)[0],
-                               sv.tip_point(cell, pose), atol=1e-6)
+                               sv.tip_point(cell, pose), atol=1e-4)  # IK tolerance
 
 
 # ---------------------------------------------------------------- planner and verify
