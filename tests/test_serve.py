@@ -232,3 +232,16 @@ def test_serve_lands_on_the_table_in_simulation(plan):
     # the burger rode the blade through the carry
     k = run.index(bounds["carry"][1])
     assert run.on_blade()[k] and rpy(run.burger_rot[k])[0] == pytest.approx(0.0, abs=0.3)
+
+
+def test_cli_validate_judges_a_serve_plan_on_the_table(plan_file, tmp_path, capsys):
+    out = tmp_path / "v.json"
+    rc = main(["validate", "--plan", str(plan_file), "--trials", "1", "--workers", "1",
+               "--replan", "--no-progress", "--json", str(out)])
+    assert rc == 0 and "serve" in capsys.readouterr().out
+    doc = json.loads(out.read_text())
+    entry = doc["locations"][0]
+    assert set(entry["success"]) == {"scoop", "pickup", "serve"}
+    assert entry["spot"] == list(SPOT) and len(entry["rests"]) == 1
+    rest = entry["rests"][0]
+    assert entry["success"]["serve"] == int(rest["distance"] <= SERVE_TOL and rest["up_z"] > 0.9)

@@ -5,7 +5,8 @@ Nothing here uses :mod:`flipkit.transcription.nlp` or
 :class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
 bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
 :mod:`flipkit.behaviors.segments` only the tables T_BOUNDS, SCOOP_PRESS, SCOOP_TIP_BAND and
-grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+grill_floor, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
+poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -43,7 +44,8 @@ flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
 and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
 duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
-Task-space bounds (cell.limits) are not recorded in the plan file and not checked.
+Task-space bounds (cell.limits) are not recorded in the plan file and not checked; nor is the
+side table (its default :class:`~flipkit.config.TableConfig` is used for a serve plan).
 """
 
 from __future__ import annotations
