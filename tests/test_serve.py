@@ -34,8 +34,13 @@ def plan():
 
 
 @pytest.fixture(scope="module")
-def plan_file(plan, tmp_path_factory):
-    return plan.to_json(tmp_path_factory.mktemp("serve") / "serve.json")
+def plan_file(tmp_path_factory):
+    """A serve plan written by ``flipkit plan serve`` (exit 0: solved and verified)."""
+    path = tmp_path_factory.mktemp("serve") / "serve.json"
+    rc = main(["plan", "serve", "--burger", *map(str, BURGER), "--table-spot", *map(str, SPOT),
+               "--json", str(path)])
+    assert rc == 0 and path.exists()
+    return path
 
 
 # ---------------------------------------------------------------- geometry
