@@ -116,10 +116,14 @@ def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
                  options: SegmentOptions = SegmentOptions()) -> Plan:
-    """Re-plan carry, place and return home of a solved serve plan for a burger measured at
-    ``on_blade`` on the blade after the scoop (sense, plan, act; as
-    :func:`~flipkit.planning.planner.replan_flip`): go to burger, scoop and pickup are kept,
-    the place is moved so that the burger where it really lies comes to rest on the spot.
+    """Re-plan place and return home of a solved serve plan for a burger measured at
+    ``on_blade`` on the blade at the end of the carry (sense, plan, act; as
+    :func:`~flipkit.planning.planner.replan_flip`): the carry ends at rest with the blade flat
+    above the table, so the cell can measure where the burger lies on it and wait there while
+    this runs. Go to burger, scoop, pickup and carry are kept; the place is moved so that the
+    burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a
+    burger that shifted on the blade during the pickup and carry was placed 5.5 cm off in
+    MuJoCo.)
 
     Args:
         plan: A solved serve plan. on_blade: (x, y) of the burger's centre in the blade frame
@@ -136,7 +140,7 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
     cell = plan.cell()
     on_blade = _on_blade(on_blade, cell)
     options = replace(options, cone=plan.cone)
-    done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
+    done = [s for s in plan.segments if s.name in sv.SERVE_SUBBEHAVIORS[:4]]
     return _chain(np.asarray(plan.burger["location"], float), table_spot(plan), on_blade,
                   done[-1].q[-1], done[-1].qd[-1], done, models_for(cell), cell, solver,
                   options, t0)

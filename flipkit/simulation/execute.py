@@ -36,6 +36,11 @@ from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burge
 
 MODES = ("feedforward", "position")
 HOLD_S = 1.0  # s after the plan: the flipped burger lands
+# The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
+# scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
+# burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
+# μ × 0.81, sensed after the scoop; the place depends on where it lies then).
+SENSE_AFTER = {"flip": "scoop", "serve": "carry"}
 NO_DRAW = {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0}
 
 
@@ -131,10 +136,11 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
-            rest, blade flat on the grill) with the burger's centre measured in the blade
-            frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip` (a serve plan:
-            :func:`flipkit.planning.serve.replan_serve`); the rest of the run
-            follows the returned plan, which must keep go to burger and scoop and be solved
+            rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
+            flat above the table, :data:`SENSE_AFTER`) with the burger's centre measured in
+            the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip`
+            (serve: :func:`flipkit.planning.serve.replan_serve`); the rest of the run
+            follows the returned plan, which must keep the segments up to then and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
             runs on (``replan_failure`` says why). The arm waits at rest while a real cell
@@ -170,7 +176,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
 
     t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
-    t_sense = bounds["scoop"][1] if replan is not None else np.inf
+    t_sense = bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
     kp, kd, umax = np.asarray(ph.kp), np.asarray(ph.kd), robot.u_max
 
     pb = np.asarray(plan.burger["location"], float)
@@ -190,7 +196,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     k = -1
     while k + 1 < len(t):
         k += 1
-        if t[k] >= t_sense - 1e-9 and sensed is None:  # the scoop has ended: sense and replan
+        if t[k] >= t_sense - 1e-9 and sensed is None:  # at rest: sense and replan
             mujoco.mj_kinematics(m, d)
             p_b, R_b = scene.blade_pose()
             sensed = ((d.xpos[burger_body] - p_b) @ R_b)[:2]
@@ -254,4 +260,4 @@ def _errors(robot, t, q, q_des, bounds) -> dict:
     return out
 
 
-__all__ = ["MODES", "HOLD_S", "NO_DRAW", "Execution", "execute_plan"]
+__all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "NO_DRAW", "Execution", "execute_plan"]
