@@ -230,6 +230,9 @@ def test_serve_lands_on_the_table_in_simulation(plan):
     ex = execute_plan(plan, replan=replan_serve)
     assert ex.replan_failure is None and ex.plan.status == "solved"
     assert 0.0 < ex.sensed_on_blade[0] < plan.spatula["length"] / 2  # dragged toward the tip
+    for a, b in zip(plan.segments[:4], ex.plan.segments[:4]):  # kept up to the sensing
+        np.testing.assert_array_equal(a.q, b.q)
+    assert ex.plan.segments[4].placing["on_blade"] == pytest.approx(ex.sensed_on_blade)
     run, bounds = ex.run, ex.bounds
     assert judge_scoop(run, bounds["scoop"]).ok and judge_pickup(run, bounds["pickup"]).ok
     verdict = judge_serve(run, SPOT, plan.cell().table)

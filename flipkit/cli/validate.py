@@ -44,7 +44,7 @@ def register(subparsers) -> None:
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
-                             "(serve: carry, place and return home)")
+                             "(serve: at the end of the carry, re-plan place and return home)")
     add_sweep_arguments(parser)
     parser.add_argument("--json", required=True, metavar="OUT.json", help="output file")
     parser.set_defaults(run=run)

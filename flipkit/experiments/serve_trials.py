@@ -6,8 +6,8 @@ physics perturbed (:class:`~flipkit.experiments.trials.Perturbations`, drawn fro
 ``np.random.default_rng(seed + trial)``), then judges the scoop and pickup (paper Sec. V) and
 the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
 within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
-``replan`` the cell measures where the burger lies on the blade after the scoop and re-plans
-carry, place and return home for it (:func:`flipkit.planning.serve.replan_serve`).
+``replan`` the cell measures where the burger lies on the blade at the end of the carry and
+re-plans place and return home for it (:func:`flipkit.planning.serve.replan_serve`).
 """
 
 from __future__ import annotations
