@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
 from flipkit.transcription.guess import bezier_guess, fit_guess
 from flipkit.transcription.layout import Layout
@@ -20,13 +21,13 @@ from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.model.contact import make_cone
-from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.transcription.nlp import NLP
 from flipkit.model.orientation import rpy
 from flipkit.model.robot import Robot
 
-BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
+BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS + sv.SERVE_ONLY
 # Duration bounds (s). The cost Σu² drives T to its upper bound (DESIGN.md), so the chain
 # executes in the sum of the upper bounds: 3.4 s (it was 4.0 s; the paper's Fig. 7: < 3 s).
 # Measured minima (a time term in the cost, SQP, Table I locs 0, 1, 5, 8, 9): go to burger
@@ -37,7 +38,7 @@ BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS
 # solved the ten Table I locations with the SQP, but IPOPT's flip at (0.76, 0.09) ends where
 # a 1.1 s turn back is infeasible and a 1.2 s one is not.
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.75), "scoop": (0.2, 0.6),
-            "pickup": (0.2, 0.25), "flip": (0.2, 0.6), "turn_back": (0.4, 1.2)}
+            "pickup": (0.2, 0.25), "flip": (0.2, 0.6), "turn_back": (0.4, 1.2), **sv.T_BOUNDS}
 BRAKING_FRACTION = 0.5  # share of q̈_max assumed for braking at a moving segment end
 # Scoop (eq. 24): the blade tip stays on the grill, pressed into it by a commanded SCOOP_PRESS
 # that the grill's contact absorbs (the arm's PD then presses the blade onto the grill, and a
@@ -54,7 +55,7 @@ MU_SAFETY = 0.8
 SCOOP_LATERAL_BAND = 0.01  # m: |p_y − p^b_y| during the scoop
 SCOOP_ANGLE_BAND = 0.05  # rad: |o_x|, |o_z| during the scoop
 CARRIES_BURGER = {"translate": True, "go_to_burger": False, "scoop": False, "pickup": True,
-                  "flip": True, "turn_back": False}
+                  "flip": True, "turn_back": False, **sv.CARRIES_BURGER}
 
 
 @dataclass(frozen=True)
@@ -122,6 +123,8 @@ def grill_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
     onto the grill only at the last node (the scoop's start pose presses the tip in), and the
     turn back stays clear of a flipped burger lying anywhere on the grill.
     """
+    if name in sv.SERVE_ONLY:
+        return sv.table_floor(name, cell, N)
     hg = cell.grill.height
     pressed = hg - SCOOP_PRESS - SCOOP_TIP_BAND
     floor = np.full(N + 1, {"scoop": pressed, "pickup": pressed,
@@ -146,14 +149,14 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
     joint-space Bezier path to an IK solution of the end pose (flip: a pose in its end set;
     turn back: q_home).
     """
-    if name == "turn_back":
+    if name in ("turn_back", "return_home"):
         # Critically damped return to q_home from the (moving) start state: it brakes first
         # instead of extrapolating the start velocity past the joint limits.
         w, t = 4.0 / T, L.s * T  # peak |q̈| ≈ w²|q_0 − q_home| stays near the limit
         e0 = q_start - robot.q_home
         waypoints = robot.q_home + (e0 + np.outer(t, qd_start + w * e0)) * np.exp(-w * t)[:, None]
         return fit_guess(L, robot, np.clip(waypoints, robot.q_min, robot.q_max), T, qd_start, True)
-    if name in ("go_to_burger", "scoop", "pickup"):
+    if name in ("go_to_burger", "scoop", "pickup", "carry", "place"):
         p0, R0 = robot.position(q_start), robot.rotation(q_start)
         o0, o1 = rpy(R0), np.asarray(pose.o)
         waypoints, q = [], q_start
@@ -163,7 +166,14 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
             p = (1 - w) * p0 + w * np.asarray(pose.p)
             if name == "scoop":  # keep the tip pressed: p_z = h_g − press + (l/2) sin o_y
                 p[2] = cell.grill.height - SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
-            q = solve_pose(robot, p, o, q)
+            try:
+                q = solve_pose(robot, p, o, q)
+            except UnreachableError:
+                if name not in sv.SERVE_ONLY:
+                    raise
+                # the straight carry to the table passes near the base: a joint-space path
+                return bezier_guess(L, robot, q_start, sv.reach(robot, pose, (q_start, q)),
+                                    T, qd_start)
             waypoints.append(q)
         return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end)
     seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)
@@ -175,7 +185,7 @@ def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at
 
 
 def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
-                  goal: tg.Pose | None = None, land=None, on_blade=(0.0, 0.0),
+                  goal: tg.Pose | None = None, land=None, on_blade=(0.0, 0.0), spot=None,
                   options: SegmentOptions = SegmentOptions()) -> NLP:
     """The NLP of one behaviour segment.
 
@@ -188,7 +198,9 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         land: Flip: landing spot (x, y) (m); default where the burger was picked up
             (:func:`~flipkit.behaviors.targets.landing_spot`).
         on_blade: Flip: where the burger's centre sits on the blade (x, y) in the blade frame
-            (m), for its release state; default the blade centre.
+            (m), for its release state; serve: for where it comes to rest on the table;
+            default the blade centre.
+        spot: Serve (carry, place): the table spot (x, y) (m) (:mod:`flipkit.behaviors.serve`).
         options: Transcription options.
     """
     if name not in BEHAVIORS:
@@ -218,15 +230,23 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     blocks.append(KinematicBlock("grill_clearance", L, "blade_heights", moving,
                                  grill_floor(name, cell, L.N)[1:, None], np.inf, ctx=ctx))
     # the burger's contact acceleration is that of the blade point under its centre
-    on_point = (*np.asarray(on_blade, float)[:2], 0.0) if name == "flip" else None
+    on_point = ((*np.asarray(on_blade, float)[:2], 0.0) if name in ("flip", "carry", "place")
+                else None)
     cone = Cone(make_cone(options.cone, cell.burger.mu * options.mu_safety, cell.gravity),
                 on_point)
     cone_nodes: list[int] = []
     # The scoop ends at rest too (our addition): the blade lies flat on the grill at its end,
     # so any downward or pitching velocity there would push it through the grill on pickup.
-    rest_at_end = name in ("translate", "go_to_burger", "scoop", "turn_back")
-    pose = None
-    if name == "translate":
+    rest_at_end = name in ("translate", "go_to_burger", "scoop", "turn_back", "carry", "place",
+                           "return_home")
+    pose, pb = None, None
+    if name in sv.SERVE_ONLY:
+        if spot is None and name != "return_home":
+            raise ConfigError(f"{name} needs the table spot")
+        more, pose = sv.serve_blocks(name, L, robot, q_start, spot, on_blade)
+        blocks += more
+        cone_nodes = sv.cone_nodes(name, L.N)
+    elif name == "translate":
         if goal is None:
             raise ConfigError("translate needs a goal pose")
         pose, cone_nodes = goal, list(all_nodes)
@@ -283,12 +303,12 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     if pose is not None:
         blocks.append(KinematicBlock("end_pose", L, "position", [last], pose.p, pose.p))
         blocks.append(KinematicBlock("end_orientation", L, "rpy", [last], pose.o, pose.o))
-    if name == "turn_back":
+    if name in ("turn_back", "return_home"):
         blocks.append(FixedValues("end_state", L, np.concatenate([L.iq(last), L.iqd(last)]),
                                   np.concatenate([robot.q_home, np.zeros(robot.nq)])))
     elif rest_at_end:
         blocks.append(FixedValues("end_rest", L, L.iqd(last), np.zeros(robot.nq)))
-    if not rest_at_end and name != "turn_back":
+    if not rest_at_end:
         # Stopping distance at half the acceleration limit: the next segment's polynomial
         # motion cannot realise a bang-bang stop (measured: at the full 20 rad/s² flips ended
         # on the margin and 5 of 10 turn-backs from them were infeasible).
@@ -298,8 +318,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
 
     T_lo, T_hi = T_BOUNDS[name]
-    x0 = _initial_guess(name, L, robot, q_start, qd_start, T_hi, pose,
-                        None if name == "translate" else pb, cell, rest_at_end)
+    x0 = _initial_guess(name, L, robot, q_start, qd_start, T_hi, pose, pb, cell, rest_at_end)
 
     lb, ub, scale = (np.empty(L.n) for _ in range(3))
     per_node = [(robot.q_min, robot.q_max, 1.0), (-robot.qd_max, robot.qd_max, 1.0),

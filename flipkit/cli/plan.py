@@ -1,11 +1,13 @@
-"""``flipkit plan``: plan a translate, a pickup-and-flip, or a batch of burgers.
+"""``flipkit plan``: plan a translate, a pickup-and-flip, a serve to the table, or a batch of
+burgers.
 
 Exit status: 0 every plan is solved and passes :func:`~flipkit.planning.verify.verify_plan`; 1 a plan
 failed — one line ``flipkit: error: <segment>: <group> violated by <amount> (...)`` on
 stderr per failed plan, and the plan file is still written, with ``"status": "failed"``, so
 it can be inspected (``flipkit verify`` exits 1 on it, ``flipkit export`` refuses it without
 ``--force``); 2 bad input (non-finite numbers, a burger off the grill, a point out of reach,
-a start configuration of the wrong size or outside the joint limits, a malformed CSV) —
+a start configuration of the wrong size or outside the joint limits, a table spot off the
+table, a malformed CSV) —
 one line on stderr, nothing written. A plan file is never written as ``"solved"`` unless it
 passed the check.
 """
@@ -28,13 +30,15 @@ DESCRIPTION = (
     "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
     "plan file is written with status 'failed' for inspection. Exit 2: bad input (non-finite "
     "numbers, burger off the grill, point out of reach, start configuration of the wrong "
-    "size or outside the joint limits, malformed CSV); nothing is written.")
+    "size or outside the joint limits, a table spot off the table, malformed CSV); nothing "
+    "is written.")
 
 
 def register(subparsers) -> None:
-    """Add the ``plan`` sub-command (``translate``, ``flip``, ``batch``) to the parser."""
+    """Add the ``plan`` sub-command (``translate``, ``flip``, ``serve``, ``batch``) to the parser."""
     parser = subparsers.add_parser(
-        "plan", help="plan a translate, a pickup-and-flip, or a batch of up to five burgers",
+        "plan", help="plan a translate, a pickup-and-flip, a serve to the table, or a batch "
+                            "of up to five flips",
         description=DESCRIPTION)
     sub = parser.add_subparsers(dest="plan_command", required=True, metavar="BEHAVIOR")
 
@@ -70,6 +74,19 @@ def register(subparsers) -> None:
                    help="radius (m) of the landing disc about the spot (default 0.02)")
     common(f)
     f.set_defaults(run=run_flip)
+
+    s = sub.add_parser("serve", help="pick up one burger and put it on the side table",
+                       description="Go to burger, scoop, pickup (eqs. 22-25), carry with the "
+                                   "friction cone, place on the table by tilting the blade "
+                                   "and withdrawing it, return home.")
+    s.add_argument("--burger", nargs="+", required=True, metavar="X",
+                   help="burger location X Y Z (m), on the grill (z = grill height)")
+    s.add_argument("--table-spot", nargs="+", required=True, metavar="X",
+                   help="where the burger should rest on the table, X Y (m)")
+    s.add_argument("--start-q", nargs="+", metavar="Q",
+                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+    common(s)
+    s.set_defaults(run=run_serve)
 
     b = sub.add_parser("batch", help="pick up and flip up to five burgers in a row",
                        description="Plan up to five burgers, each starting where the "
@@ -187,6 +204,19 @@ def run_flip(args: argparse.Namespace) -> int:
     land = None if args.land is None else _numbers("--land", args.land, 2)
     options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
     plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options)
+    plan.to_json(args.json)
+    return _report(plan, args.json)
+
+
+def run_serve(args: argparse.Namespace) -> int:
+    """Plan, write (solved or failed), summarise."""
+    from flipkit.planning.planner import plan_serve
+
+    _quiet()
+    location = _numbers("--burger", args.burger, 3)
+    spot = _numbers("--table-spot", args.table_spot, 2)
+    q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
+    plan = plan_serve(location, spot, q_start, solver=args.solver)
     plan.to_json(args.json)
     return _report(plan, args.json)
 

@@ -23,7 +23,8 @@ def register(subparsers) -> None:
                     "U(0.9, 1.1)) under the chosen joint controller, and judge scoop, pickup "
                     "and flip with the paper's criteria.")
     what = parser.add_mutually_exclusive_group(required=True)
-    what.add_argument("--plan", metavar="PLAN.json", help="a solved flip plan file")
+    what.add_argument("--plan", metavar="PLAN.json",
+                      help="a solved flip or serve plan file (serve: judged on the table)")
     what.add_argument("--locations", choices=("table1",),
                       help="plan every location of a named set (table1: the paper's ten), "
                            "then simulate")
@@ -42,7 +43,8 @@ def register(subparsers) -> None:
                              "states with its own gravity compensation (position)")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
-                             "on the blade and re-plan pickup, flip and turn back for it")
+                             "on the blade and re-plan pickup, flip and turn back for it "
+                             "(serve: at the end of the carry, re-plan place and return home)")
     add_sweep_arguments(parser)
     parser.add_argument("--json", required=True, metavar="OUT.json", help="output file")
     parser.set_defaults(run=run)
@@ -50,7 +52,8 @@ def register(subparsers) -> None:
 
 def format_table(out: dict) -> str:
     """Success counts and tracking errors per location as an aligned text table."""
-    lines = [f"{'location (m)':<24}{'scoop':>7}{'pickup':>8}{'flip':>6}   "
+    last = list(out["locations"][0]["success"])[-1] if out["locations"] else "flip"
+    lines = [f"{'location (m)':<24}{'scoop':>7}{'pickup':>8}{last:>6}   "
              f"{'max err mm':>10}{'rms mm':>8}"]
     for e in out["locations"]:
         s, k = e["success"], e["trials"]
@@ -58,7 +61,7 @@ def format_table(out: dict) -> str:
         mx = max((t["max_m"] for t in errs), default=float("nan")) * 1e3
         rms = max((t["rms_m"] for t in errs), default=float("nan")) * 1e3
         where = "(" + ", ".join(f"{v:.3f}" for v in e["location"]) + ")"
-        lines.append(f"{where:<24}{s['scoop']:>4}/{k:<2}{s['pickup']:>5}/{k:<2}{s['flip']:>3}/"
+        lines.append(f"{where:<24}{s['scoop']:>4}/{k:<2}{s['pickup']:>5}/{k:<2}{s[last]:>3}/"
                      f"{k:<2}   {mx:>10.2f}{rms:>8.2f}")
     return "\n".join(lines)
 

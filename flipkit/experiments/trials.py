@@ -335,11 +335,15 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
 
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
-    """:func:`validate` of one plan file; raises FlipkitError (one line) if it is missing,
-    malformed, not a flip plan or not solved. ``kwargs`` as :func:`validate`."""
+    """:func:`validate` of one plan file (a serve plan: :func:`~flipkit.experiments.serve_trials.validate_serve`);
+    raises FlipkitError (one line) if it is missing, malformed, not a flip or serve plan or
+    not solved. ``kwargs`` as :func:`validate`."""
     plan = Plan.load(path)
+    if plan.behavior == "serve":  # the serve judge (flipkit.experiments.serve_trials)
+        from flipkit.experiments.serve_trials import validate_serve
+        return validate_serve(path, trials, seed, **kwargs)
     if plan.behavior != "flip":
-        raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip plan")
+        raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip or serve plan")
     if plan.status != "solved":
         raise FlipkitError(f"{path}: plan status is {plan.status!r}; validate needs a solved plan")
     info = {"status": plan.status, "file": str(path)}

@@ -31,6 +31,7 @@ from flipkit.behaviors.segments import CARRIES_BURGER
 from flipkit.config import BurgerConfig, CellConfig, GrillConfig, RobotConfig, SpatulaConfig
 from flipkit.model.contact import CONE_FORMS
 from flipkit.errors import ConfigError, PlanFileError
+from flipkit.behaviors.serve import SERVE_SUBBEHAVIORS
 from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text, dumps)
@@ -40,7 +41,7 @@ from flipkit.config.urdf import portable_urdf, resolve_urdf, urdf_sha256
 
 FORMAT = "flipkit-plan/2"
 FORMATS = ("flipkit-plan/1", FORMAT)  # readable; /1: before per-segment payloads and portable URDFs
-PLAN_BEHAVIORS = ("translate", "flip")
+PLAN_BEHAVIORS = ("translate", "flip", "serve")
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
 
@@ -84,7 +85,7 @@ class Plan:
     """A plan file in memory; attribute names and nesting are the file's (DESIGN.md).
 
     Attributes:
-        behavior: ``translate`` or ``flip``. status: ``solved`` or ``failed``.
+        behavior: ``translate``, ``flip`` or ``serve``. status: ``solved`` or ``failed``.
         robot: ``urdf`` (portable name ``example-robot-data:<path>`` or absolute path, see
             :mod:`flipkit.config.urdf`), ``urdf_sha256`` (of its bytes; None in a
             ``flipkit-plan/1`` file), ``base_in_world`` and ``spatula_in_parent`` (4x4, m),
@@ -166,7 +167,8 @@ class Plan:
             if isinstance(seg, dict):
                 if "payload" not in seg and self.format != FORMATS[0]:  # /1: by behaviour
                     raise ConfigError(f"segments[{k}].payload: missing key")
-                keys = SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing", "payload")
+                keys = SEGMENT_KEYS + tuple(k for k in ("goal", "release", "landing", "payload",
+                                                        "placing")
                                              if k in seg)
                 seg = self.segments[k] = check_nested(f"segments[{k}]", Segment, seg, keys)
             if not isinstance(seg, Segment):
@@ -180,14 +182,15 @@ class Plan:
                 raise ConfigError(f"segments[{k}].q: {seg.q.shape[1]} joints, "
                                   f"robot.q_home has {nq}")
             names.append(seg.name)
-        allowed = ("translate",) if self.behavior == "translate" else SUBBEHAVIORS
+        allowed = {"translate": ("translate",), "flip": SUBBEHAVIORS,
+                   "serve": SERVE_SUBBEHAVIORS}[self.behavior]
         order = [allowed.index(n) if n in allowed else -1 for n in names]
-        if -1 in order or (self.behavior == "flip" and order != sorted(set(order))):
+        if -1 in order or (self.behavior != "translate" and order != sorted(set(order))):
             raise ConfigError(f"segments: names {names} do not fit behavior {self.behavior!r} "
                               f"(expected {', '.join(allowed)}"
                               f"{' in this order' if len(allowed) > 1 else ''})")
-        if self.behavior == "flip" and self.burger["location"] is None:
-            raise ConfigError("burger.location: a flip plan needs the burger location")
+        if self.behavior != "translate" and self.burger["location"] is None:
+            raise ConfigError(f"burger.location: a {self.behavior} plan needs the burger location")
 
     # ------------------------------------------------------------------ building
     @classmethod

@@ -350,6 +350,14 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
     return plans
 
 
+def plan_serve(burger, table_spot, q_start=None, qd_start=None, **kwargs) -> Plan:
+    """Serve the burger at ``burger`` to ``table_spot`` (x, y) on the side table, from
+    ``q_start`` (default q_home): :func:`flipkit.planning.serve.plan_serve`, same arguments."""
+    from flipkit.planning.serve import plan_serve as _plan_serve
+
+    return _plan_serve(burger, table_spot, q_start, qd_start, **kwargs)
+
+
 SUMMARY_HEADER = ("burger", "location_m", "status", "solve_time_s", "iterations",
                   "max_violation")
 
@@ -379,4 +387,4 @@ def format_summary(rows) -> str:
 
 
 __all__ = ["SOLVERS", "MAX_BATCH", "SUMMARY_HEADER", "models_for", "solve_segment",
-           "plan_translate", "plan_flip", "plan_batch", "summary_table", "format_summary"]
+           "plan_translate", "plan_flip", "plan_serve", "plan_batch", "summary_table", "format_summary"]

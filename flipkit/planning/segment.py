@@ -20,6 +20,7 @@ def default_payload(name: str) -> list[str]:
 
 
 SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
+_PLACING_KEYS = ("spot", "on_blade", "heading", "pitch")
 _LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
 
 
@@ -65,6 +66,10 @@ class Segment:
             ``burger_on_blade`` (x, y) (m, blade frame), where the flight starts from.
         payload: Names of the ``robot.payload`` bodies the segment's dynamics carry
             (``["spatula"]``, ``["spatula", "burger"]``); default :func:`default_payload`.
+        placing: Serve carry and place only: ``spot`` (x, y) on the table (m), ``on_blade``
+            (x, y) (m, blade frame) where the burger was planned to sit, the blade's
+            ``heading`` and ``pitch`` at the place's end (rad)
+            (:func:`flipkit.planning.serve.placing_record`).
     """
 
     name: str
@@ -81,6 +86,7 @@ class Segment:
     release: dict | None = None
     landing: dict | None = None
     payload: list | None = None
+    placing: dict | None = None
 
     def __post_init__(self):
         check_choice("name", self.name, BEHAVIORS)
@@ -130,7 +136,13 @@ class Segment:
                 "burger_on_blade": check_array("landing.burger_on_blade",
                                           self.landing.get("burger_on_blade", (0.0, 0.0)),
                                           (2,)).tolist()}
-
+        if self.placing is not None:
+            if self.name not in ("carry", "place"):
+                raise ConfigError("placing: only carry and place segments have it")
+            f = check_keys(self.placing, "placing", _PLACING_KEYS)
+            self.placing = {**{k: check_array(f"placing.{k}", f[k], (2,)).tolist()
+                               for k in _PLACING_KEYS[:2]},
+                            **{k: check_number(f"placing.{k}", f[k]) for k in _PLACING_KEYS[2:]}}
         if self.payload is None:
             self.payload = default_payload(self.name)
         else:
@@ -175,7 +187,7 @@ class Segment:
         out["payload"] = list(self.payload)
         if self.goal is not None:
             out["goal"] = {k: [float(v) for v in getattr(self.goal, k)] for k in ("p", "o")}
-        for key in ("release", "landing"):
+        for key in ("release", "landing", "placing"):
             if getattr(self, key) is not None:
                 out[key] = dict(getattr(self, key))
         return out

@@ -5,7 +5,8 @@ Nothing here uses :mod:`flipkit.transcription.nlp` or
 :class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
 bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
 :mod:`flipkit.behaviors.segments` only the tables T_BOUNDS, SCOOP_PRESS, SCOOP_TIP_BAND and
-grill_floor. Check groups (a row's violation is ≥ 0, 0 when satisfied):
+grill_floor, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
+poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -18,15 +19,22 @@ q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         t
                                                                                10·tol,
                                                                                tol·u_max/10
 endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
-                   both ends, o_x = o_y = 0 and the ``goal`` if recorded
+                   both ends, o_x = o_y = 0 and the ``goal`` if recorded;
+                   serve: carry and place end poses from the recorded spot
 behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip   tol
-                   normal, x axis, height band
+                   normal, x axis, height band; place: tip at its final
+                   point ± PIVOT_BAND from node 0.7 N; return_home withdrawal
+                   (in the blade's start frame, attitude band)
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
-                   (flip: nodes ≤ max(0.6 N, release node))
+                   (flip: nodes ≤ max(0.6 N, release node); carry: all;
+                   place: nodes ≤ 0.7 N)
 grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m):  tol
                    h_g, pressed SCOOP_PRESS into it on scoop and pickup,
                    a burger's thickness above it on turn back (grill_floor)
+placing            serve: the table spot on the table, and the rest point        1 mm
+                   predicted from the place's end pose (FK) at the spot
+                   (:func:`flipkit.behaviors.serve.predicted_rest`)
 landing            flip: landing recomputed (:mod:`flipkit.planning.verify_flight`):    0.1 mm,
                    within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
 flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
@@ -36,7 +44,8 @@ flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
 and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
 duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
-Task-space bounds (cell.limits) are not recorded in the plan file and not checked.
+Task-space bounds (cell.limits) are not recorded in the plan file and not checked; nor is the
+side table (its default :class:`~flipkit.config.TableConfig` is used for a serve plan).
 """
 
 from __future__ import annotations
@@ -49,10 +58,11 @@ import numpy as np
 
 from flipkit.behaviors.targets import SUBBEHAVIORS
 
+from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, grill_floor
 from flipkit.model.contact import make_cone
-from flipkit.errors import ConfigError, VerificationError
+from flipkit.errors import ConfigError, FlipkitError, VerificationError
 from flipkit.model.orientation import rpy
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.verify_flight import check_flight
@@ -63,7 +73,7 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
-          "flight_clearance": "m", "completeness": "segments"}
+          "flight_clearance": "m", "placing": "m", "completeness": "segments"}
 
 
 @dataclass
@@ -196,7 +206,8 @@ def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
     # A flip plan is the five subbehaviours in order (a plan cut short by a failed segment
     # must not pass); a translate plan has at least one segment.
     names = [s.name for s in plan.segments]
-    expected = list(SUBBEHAVIORS) if plan.behavior == "flip" else None
+    expected = {"flip": list(SUBBEHAVIORS), "serve": list(sv.SERVE_SUBBEHAVIORS)}.get(
+        plan.behavior)
     missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
                if expected is not None else int(not names))
     report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
@@ -244,8 +255,10 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
     release = seg.release["node"] if seg.release else 0
     required = {"translate": range(N + 1), "pickup": range(N + 1),
-                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)]}
-    on_blade = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
+                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)],
+                "carry": sv.cone_nodes("carry", N), "place": sv.cone_nodes("place", N)}
+    on_blade = (seg.landing or seg.placing or {}).get(
+        "burger_on_blade" if seg.landing else "on_blade", (0.0, 0.0))
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
         st = states[i]  # the flip's cone holds where the burger lies on the blade
         if np.any(on_blade):
@@ -287,5 +300,44 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         for i, st in enumerate(states):
             add("behavior_path", k, _outside(st.R[:, 0], *tg.FLIP_XAXIS_BOUNDS), tol, i)
         check_flight(report, k, seg, robot, cell, states)
-    elif seg.name == "turn_back":
+    elif seg.name in ("turn_back", "return_home"):
         add("endpoints", k, np.abs(seg.q[-1] - robot.q_home), tol, N)
+    if seg.name in sv.SERVE_ONLY:
+        _check_serve(report, k, seg, cell, states, tol, pose)
+
+
+def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
+    """Serve's carry, place and return home: end poses from the recorded spot, the spot on
+    the table and the predicted rest point at it, the withdrawal (module docstring)."""
+    N, add = seg.N, report.add
+    add("endpoints", k, np.abs(seg.qd[-1]), tol, N)  # at rest at the end
+    if seg.name == "return_home":
+        R0, p0 = states[0].R, states[0].p
+        lo, hi = sv.withdraw_bounds(N)
+        o0 = rpy(R0)
+        for row, i in enumerate(range(1, sv.WITHDRAW_NODES + 1)):
+            st = states[i]
+            add("behavior_path", k, _outside(R0.T @ (st.p - p0), lo[row], hi[row]), tol, i)
+            add("behavior_path", k, np.maximum(_angle(rpy(st.R), o0) - sv.WITHDRAW_ANGLE_BAND,
+                                               0.0), tol, i)
+        return
+    if seg.placing is None:
+        add("placing", k, [np.inf], 1e-3, N)
+        return
+    spot, on_blade = np.asarray(seg.placing["spot"]), np.asarray(seg.placing["on_blade"])
+    try:
+        sv.check_table_spot(cell, spot)
+    except FlipkitError:
+        add("placing", k, [np.inf], 1e-3, N)
+        return
+    target = (sv.carry_end if seg.name == "carry" else sv.place_end)(cell, spot, on_blade)
+    pose(target)
+    if seg.name == "place":  # the tilt pivots about the tip's final point
+        tip = sv.tip_point(cell, target)
+        half = np.array([cell.spatula.length / 2, 0.0, 0.0])
+        for i in sv.pivot_nodes(N):
+            miss = np.abs(states[i].p + states[i].R @ half - tip) - sv.PIVOT_BAND
+            add("behavior_path", k, np.maximum(miss, 0.0), tol, i)
+        end = states[-1]
+        rest = sv.predicted_rest(cell, end.p, rpy(end.R)[2], on_blade)
+        add("placing", k, [np.linalg.norm(rest - spot)], 1e-3, N)

@@ -36,6 +36,11 @@ from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burge
 
 MODES = ("feedforward", "position")
 HOLD_S = 1.0  # s after the plan: the flipped burger lands
+# The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
+# scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
+# burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
+# μ × 0.81, sensed after the scoop; the place depends on where it lies then).
+SENSE_AFTER = {"flip": "scoop", "serve": "carry"}
 NO_DRAW = {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0}
 
 
@@ -99,9 +104,9 @@ def _desired(plan, t: np.ndarray):
 def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> dict:
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
-    if plan.behavior != "flip" or plan.status != "solved":
-        raise ConfigError(f"execute_plan needs a solved flip plan, got a {plan.status} "
-                          f"{plan.behavior} plan")
+    if plan.behavior not in ("flip", "serve") or plan.status != "solved":
+        raise ConfigError(f"execute_plan needs a solved flip or serve plan, got a "
+                          f"{plan.status} {plan.behavior} plan")
     if not (np.isfinite(hold) and hold >= 0 and np.isfinite(rate_hz) and rate_hz > 0):
         raise ConfigError(f"need hold >= 0 s and rate_hz > 0, got {hold!r}, {rate_hz!r}")
     draw = {**NO_DRAW, **(draw or {})}
@@ -114,10 +119,12 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None) -> Execution:
-    """Execute a flip plan closed-loop in the MuJoCo cell with the burger on the grill.
+    """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
-        plan: A solved flip :class:`~flipkit.planning.plan_file.Plan` (segments go_to_burger … turn_back).
+        plan: A solved flip or serve :class:`~flipkit.planning.plan_file.Plan` (segments
+            go_to_burger … turn_back, or go_to_burger … return_home; a serve plan tilts the
+            burger off onto the scene's table).
         mode: ``"feedforward"`` or ``"position"`` (module docstring).
         draw: A perturbation (:meth:`flipkit.experiments.trials.Perturbations.draw`): ``dx_m``, ``dy_m``
             burger placement error (m), ``grill_offset_m`` (m), ``mu_factor`` (burger-blade
@@ -129,9 +136,11 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
-            rest, blade flat on the grill) with the burger's centre measured in the blade
-            frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip`; the rest of the run
-            follows the returned plan, which must keep go to burger and scoop and be solved
+            rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
+            flat above the table, :data:`SENSE_AFTER`) with the burger's centre measured in
+            the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip`
+            (serve: :func:`flipkit.planning.serve.replan_serve`); the rest of the run
+            follows the returned plan, which must keep the segments up to then and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
             runs on (``replan_failure`` says why). The arm waits at rest while a real cell
@@ -167,7 +176,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
 
     t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
-    t_sense = bounds["scoop"][1] if replan is not None else np.inf
+    t_sense = bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
     kp, kd, umax = np.asarray(ph.kp), np.asarray(ph.kd), robot.u_max
 
     pb = np.asarray(plan.burger["location"], float)
@@ -187,23 +196,22 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     k = -1
     while k + 1 < len(t):
         k += 1
-        if t[k] >= t_sense - 1e-9 and sensed is None:  # the scoop has ended: sense and replan
+        if t[k] >= t_sense - 1e-9 and sensed is None:  # at rest: sense and replan
             mujoco.mj_kinematics(m, d)
             p_b, R_b = scene.blade_pose()
             sensed = ((d.xpos[burger_body] - p_b) @ R_b)[:2]
-            try:
+            try:  # a failed replan keeps the verified plan under way (and this step runs)
                 new = replan(plan, np.clip(sensed, -half, half))
-            except FlipkitError as exc:  # keep the verified plan under way
-                replan_failure = str(exc)
-                continue
-            if new.status != "solved":
-                replan_failure = new.failure or "replanned plan not solved"
-                continue
-            plan = new
-            t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
-            if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
-                raise ConfigError("the replanned run does not extend the executed one")
-            t = t2
+            except FlipkitError as exc:
+                new, replan_failure = None, str(exc)
+            if new is not None and new.status != "solved":
+                new, replan_failure = None, new.failure or "replanned plan not solved"
+            if new is not None:
+                plan = new
+                t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
+                if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
+                    raise ConfigError("the replanned run does not extend the executed one")
+                t = t2
         q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
         ff = u_ff[k] if mode == "feedforward" else pin.computeGeneralizedGravity(
             robot.model, robot.data, q)
@@ -252,4 +260,4 @@ def _errors(robot, t, q, q_des, bounds) -> dict:
     return out
 
 
-__all__ = ["MODES", "HOLD_S", "NO_DRAW", "Execution", "execute_plan"]
+__all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "NO_DRAW", "Execution", "execute_plan"]

@@ -1,4 +1,5 @@
-"""The paper's success judges (Sec. V): scoop, pickup and flip, applied to a :class:`BurgerRun`."""
+"""The paper's success judges (Sec. V): scoop, pickup and flip, applied to a :class:`BurgerRun`;
+and flipkit's serve judge (the burger rests on the side table, top up, near its spot)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flipkit.errors import ConfigError
-from flipkit.simulation.run import BLADE_GAP_TOL, GRILL_SEPARATION, BurgerRun
+from flipkit.simulation.run import BLADE_GAP_TOL, GRILL_SEPARATION, BurgerRun, _half_extent
 
 UPSIDE_DOWN_Z = -0.9  # up-axis z below this: lying on its other side (within ~26°)
 LANDING_TOL = 0.05  # m, in x and in y (paper Sec. V)
@@ -148,3 +149,57 @@ def judge_flip(run: BurgerRun, bounds, spot) -> FlipVerdict:
     return FlipVerdict(ok=bool(frac >= FLIP_CONTACT_FRACTION and down and grill and near),
                        contact_fraction=frac, upside_down=bool(down), on_grill=grill,
                        offset=tuple(float(x) for x in offset), up_z=up_z)
+
+
+SERVE_TOL = 0.03  # m: the burger's centre rests within 3 cm of the table spot (issue 13)
+UPRIGHT_Z = 0.9  # up-axis z above this: top face up (within ~26°, as UPSIDE_DOWN_Z)
+REST_WINDOW = 0.1  # s: "resting" = moved less than REST_MOTION over the run's last 0.1 s
+REST_MOTION = 0.001  # m
+
+
+@dataclass(frozen=True)
+class ServeVerdict:
+    """Serve: the burger rests on the table, top face up, within :data:`SERVE_TOL` of the spot.
+
+    Attributes:
+        ok: Success. offset: Final centre (x, y) minus the spot (m); distance: its norm (m).
+        upright: Up axis z > :data:`UPRIGHT_Z` at the end. up_z: That z.
+        on_table: Lowest point within :data:`BLADE_GAP_TOL` of the table's top and the centre
+            over the table area. at_rest: Moved < :data:`REST_MOTION` over the last
+            :data:`REST_WINDOW`. off_blade: Not resting on the blade at the end.
+    """
+
+    ok: bool
+    offset: tuple
+    distance: float
+    upright: bool
+    up_z: float
+    on_table: bool
+    at_rest: bool
+    off_blade: bool
+
+
+def judge_serve(run: BurgerRun, spot, table) -> ServeVerdict:
+    """Judge a serve at the run's end (the run must last until the burger has settled).
+
+    Args:
+        run: The simulation. spot: The table spot (x, y) (m).
+        table: The :class:`~flipkit.config.TableConfig` (height, area).
+    """
+    p, up_z = run.burger_pos[-1], float(run.up_z[-1])
+    offset = p[:2] - np.asarray(spot, float)[:2]
+    bottom = p[2] - float(_half_extent(up_z, run.burger_diameter, run.burger_thickness))
+    inside = (table.x_range[0] <= p[0] <= table.x_range[1]
+              and table.y_range[0] <= p[1] <= table.y_range[1])
+    on_table = bool(inside and abs(bottom - table.height) <= BLADE_GAP_TOL)
+    win = run.window(run.t[-1], REST_WINDOW)
+    moved = float(np.max(np.linalg.norm(run.burger_pos[win] - p, axis=1)))
+    off_blade = not bool(run.on_blade()[-1])
+    distance = float(np.linalg.norm(offset))
+    upright = up_z > UPRIGHT_Z
+    return ServeVerdict(ok=bool(distance <= SERVE_TOL and upright and on_table
+                                and moved < REST_MOTION and off_blade),
+                        offset=tuple(float(x) for x in offset), distance=distance,
+                        upright=bool(upright), up_z=up_z, on_table=on_table,
+                        at_rest=bool(moved < REST_MOTION), off_blade=bool(off_blade))
+

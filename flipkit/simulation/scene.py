@@ -15,6 +15,8 @@ leading edge (x = +l/2) ground on the underside over ``bevel_length`` down to
 Contacts are explicit pairs only (every geom has contype = conaffinity = 0): blade-grill
 (steel on steel, ``mu_blade_grill``; compliant: the blade's flex, below), burger-blade (``burger.mu``) and burger-grill
 (``mu_grill``) with the patty's softness (:meth:`PhysicsConfig.burger_timeconst`); the
+side table, where serve plans put the burger, is a steel tray like the grill plate: burger-table
+is the burger-grill pair's friction and softness, blade-table the blade-grill pair's; the
 burger is a convex disc with rounded rims (``burger_edge_radius``); condim 3,
 elliptic cones, ``noslip`` iterations against soft-contact creep. Links are capsules for
 rendering only.
@@ -105,7 +107,7 @@ class Scene:
         model, data: MuJoCo model and data. xml: The MJCF it was compiled from.
         robot: The pinocchio arm it mirrors (no burger payload).
         blade_site: Site id of the spatula frame (top-face centre). grill_height: Actual
-            surface height (m). geoms: ``{"blade", "grill", "burger"}`` geom ids.
+            surface height (m). geoms: ``{"blade", "grill", "burger", "table"}`` geom ids.
         burger_qpos, burger_qvel: Slices of the burger's free joint in qpos / qvel.
         blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
             (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
@@ -251,18 +253,21 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
     {pair("burger", "blade", mu, (tau_b, ph.burger_dampratio))}
     {pair("burger", "grill", ph.mu_grill, (tau_b, ph.burger_dampratio))}
+    {pair("burger", "table", ph.mu_grill, (tau_b, ph.burger_dampratio))}
+    {pair("blade", "table", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
   </contact>
 </mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
     contact = _blade_contact(model, cell)
-    pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "blade_grill")
-    model.pair_solref[pid] = contact["solref"]
+    for name in ("blade_grill", "blade_table"):
+        model.pair_solref[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)] = \
+            contact["solref"]
     xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
     data = mujoco.MjData(model)
     gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     scene = Scene(model, data, xml, robot,
                   mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
-                  {n: gid(n) for n in ("blade", "grill", "burger")}, contact)
+                  {n: gid(n) for n in ("blade", "grill", "burger", "table")}, contact)
     mujoco.mj_forward(model, data)
     return scene
 

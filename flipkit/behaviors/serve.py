@@ -1,0 +1,246 @@
+"""Serve: carry the picked-up burger to a spot on the side table, tilt it off, return home.
+
+The paper's cell places finished burgers "on a side table" (Sec. I, Fig. 1); the paper gives
+no constraints for it. flipkit's serve is go to burger, scoop, pickup (eqs. 22–25, as they
+are) and three subbehaviours of its own, each a collocation segment:
+
+* ``carry`` (like translate, eq. 9): from the pickup's end, friction cone on every node, to
+  the blade flat and level :data:`CARRY_CLEARANCE` above the place pose, heading
+  ψ = atan2(y, x) of the spot (radially outward from the base), at rest.
+* ``place`` — a **tilt-and-withdraw**: the blade comes down and pitches its tip down to
+  :data:`PLACE_PITCH` with the tip :data:`PLACE_TIP_GAP` above the table, at rest. The cone
+  holds on nodes i ≤ :data:`PLACE_CONE_FRACTION` N (the burger rides the descent); from
+  node ⌈0.7 N⌉ on the tip holds its final point (±:data:`PIVOT_BAND`) and the blade tilts
+  about it, so the pitch passes the friction angle with the tip in place: the burger slides
+  down the blade until its front edge meets the table, and rests there, front edge on the
+  table, back on the blade. (Without the pivot the solver's place swung the blade low and
+  back, tilted it early and came forward again: a burger that slid off early was pushed
+  7 cm past its spot in MuJoCo.)
+* ``return_home``: first the withdrawal — for nodes 1..:data:`WITHDRAW_NODES` the blade keeps
+  its attitude (±:data:`WITHDRAW_ANGLE_BAND`) and slides back in its own plane
+  (±:data:`WITHDRAW_BAND` off it) by at least :data:`WITHDRAW_DISTANCE` (a blade length less
+  its overlap with a burger at its tip): gravity along the 40° blade beats friction
+  (tan θ > μ), so the burger stays where it is while the blade is pulled out from under it,
+  and lies down flat about its front edge. Then the blade rises above the burger's top and
+  goes to q_home at rest.
+
+Why this move. A set-down-and-withdraw on a flat blade drags the burger with the blade
+(static friction holds it to the blade, nothing holds it to the table); a slide-off by a fast
+backward jerk (tablecloth trick) needs blade accelerations ≫ μ g and its drag distance grows
+with μ; a tilt-off from a height lets the burger tumble. Tilted past the friction angle for
+every μ the cell may have (0.70 rad = 40°: tan = 0.84 > 0.8, the top of the burger.mu range)
+with the tip just above the table, the burger ends with its front edge on the table, and the
+withdrawal lets it down where it is: its final place is geometry, not a sliding distance.
+
+Where it lands (:func:`predicted_rest`): with the burger's centre at x_b along the blade
+and y_b across it, its front edge overhangs the tip by x_eff + d/2 − l/2, with
+x_eff = max(x_b, l/2 − d/2) (a burger further back slides down until its front edge is at
+the tip). That edge meets the table there, about (x_eff + d/2 − l/2) beyond the tip, and the
+burger lies down about it when the blade is pulled out: its centre comes to rest d/2 behind
+it, x_eff − (l/2)(1 − cos θ) ahead of the blade centre along the heading and y_b across.
+A burger that slid s = x_eff − x_b down the blade arrives moving: with the energy
+m g (sin θ − μ cos θ) s it gained spent against the table's friction μ_t m g, it runs out
+s (sin θ − μ cos θ)/μ_t further (μ the burger's nominal friction on the blade, μ_t the
+table's: a steel tray like the grill, ``physics.mu_grill``). (Without this term a burger the
+scoop had left at the blade centre came to rest 3.8 cm beyond its spot in MuJoCo; with
+it, 1.4 cm of that is predicted.)
+The planner puts the blade so that this point is the spot; ``on_blade`` is where the burger
+sits on the blade (default the centre; sensed at the end of the carry, :func:`flipkit.planning.serve.replan_serve`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flipkit.behaviors.targets import Pose
+from flipkit.config import CellConfig
+from flipkit.errors import UnreachableError
+from flipkit.model.orientation import rpy
+from flipkit.model.robot import skew
+from flipkit.transcription.constraints.kinematic import KinematicBlock, Quantity
+
+SERVE_SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "carry", "place", "return_home")
+SERVE_ONLY = SERVE_SUBBEHAVIORS[3:]
+PLACE_PITCH = 0.70  # rad, tip down at the end of the place (tan 0.70 = 0.84 > μ's range 0.2–0.8)
+PLACE_TIP_GAP = 0.005  # m, blade tip above the table at the end of the place
+PLACE_CONE_FRACTION = 0.7  # the cone holds on place nodes i ≤ 0.7 N
+PIVOT_BAND = 0.003  # m, the tip within this of its final point while the blade tilts about it
+CARRY_CLEARANCE = 0.06  # m, the carry ends with the blade centre this far above the place pose
+WITHDRAW_NODES = 8  # return_home nodes 1..8 withdraw the blade in its own plane
+WITHDRAW_DISTANCE = 0.14  # m, back along −x of the blade by node 8: l − 2 cm of overlap
+BURGER_CLEARANCE = 0.01  # m, blade edges above the placed burger's top after the withdrawal
+WITHDRAW_BAND = 0.005  # m, off the blade's start plane / start line while withdrawing
+WITHDRAW_ANGLE_BAND = 0.05  # rad, rpy about the place end's while withdrawing
+# Duration bounds (s): Σu² drives T to the upper bound. The carry covers up to ~1 m under the
+# cone (planned μ 0.4: ≤ 3.9 m/s² sideways); the return unrolls the heading back to q_home's.
+T_BOUNDS = {"carry": (0.6, 1.6), "place": (0.3, 0.8), "return_home": (0.5, 1.5)}
+CARRIES_BURGER = {"carry": True, "place": True, "return_home": False}
+
+
+def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
+    """The table spot (x, y) (m) as an array, or :class:`UnreachableError` (one line).
+
+    The whole burger must lie on the table: the spot is at least a burger radius inside the
+    table's edges (:class:`~flipkit.config.TableConfig`)."""
+    try:
+        xy = np.asarray(spot, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}") from None
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+        raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}")
+    tb, r = cell.table, cell.burger.diameter / 2
+    lo = np.array([tb.x_range[0], tb.y_range[0]]) + r
+    hi = np.array([tb.x_range[1], tb.y_range[1]]) - r
+    if np.any(xy < lo - 1e-9) or np.any(xy > hi + 1e-9):
+        raise UnreachableError(
+            f"table spot ({xy[0]:.3f}, {xy[1]:.3f}) m is off the table: a burger there must lie "
+            f"on it, x in [{lo[0]:.3f}, {hi[0]:.3f}], y in [{lo[1]:.3f}, {hi[1]:.3f}] m")
+    return xy
+
+
+def heading(spot) -> float:
+    """Heading ψ (rad) of the blade at the table: radially outward from the base, toward the spot."""
+    return float(math.atan2(spot[1], spot[0]))
+
+
+def rest_offset(cell: CellConfig, on_blade=(0.0, 0.0)) -> tuple[float, float]:
+    """Where the placed burger comes to rest relative to the blade centre at the place's end
+    (m): (along the heading, across it) — module docstring."""
+    th, l, r = PLACE_PITCH, cell.spatula.length, cell.burger.diameter / 2
+    x_eff = max(float(on_blade[0]), l / 2 - r)
+    slide = x_eff - float(on_blade[0])  # m down the blade before the front edge is at the tip
+    mu, mu_t = cell.burger.mu, cell.physics.mu_grill
+    runout = slide * max(math.sin(th) - mu * math.cos(th), 0.0) / mu_t
+    return x_eff - l / 2 * (1 - math.cos(th)) + runout, float(on_blade[1])
+
+
+def place_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
+    """End of the place: tip :data:`PLACE_TIP_GAP` above the table, pitched :data:`PLACE_PITCH`
+    tip down, heading :func:`heading`, placed so that the burger at ``on_blade`` (x, y on the
+    blade, m) comes to rest at ``spot`` (:func:`rest_offset`)."""
+    psi, th, l = heading(spot), PLACE_PITCH, cell.spatula.length
+    u, v = np.array([math.cos(psi), math.sin(psi)]), np.array([-math.sin(psi), math.cos(psi)])
+    along, across = rest_offset(cell, on_blade)
+    centre = np.asarray(spot, float) - along * u - across * v
+    z = cell.table.height + PLACE_TIP_GAP + l / 2 * math.sin(th)
+    return Pose((float(centre[0]), float(centre[1]), float(z)), (0.0, th, psi))
+
+
+def predicted_rest(cell: CellConfig, p, psi: float, on_blade=(0.0, 0.0)) -> np.ndarray:
+    """Predicted rest point (x, y) (m) of the burger placed by a blade ending at centre ``p``
+    with heading ``psi`` (rad), the burger at ``on_blade`` (:func:`rest_offset`)."""
+    along, across = rest_offset(cell, on_blade)
+    u, v = np.array([math.cos(psi), math.sin(psi)]), np.array([-math.sin(psi), math.cos(psi)])
+    return np.asarray(p, float)[:2] + along * u + across * v
+
+
+def carry_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
+    """End of the carry: the blade flat and level :data:`CARRY_CLEARANCE` above the place
+    pose's centre, heading :func:`heading`."""
+    p = place_end(cell, spot, on_blade).p
+    return Pose((p[0], p[1], p[2] + CARRY_CLEARANCE), (0.0, 0.0, heading(spot)))
+
+
+def table_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
+    """Lowest blade edge height (m) at nodes 0..N of a serve-only segment: the table's top
+    (the blade never goes below it; the grill is lower), and after the withdrawal the placed
+    burger's top plus :data:`BURGER_CLEARANCE`."""
+    floor = np.full(N + 1, max(cell.table.height, cell.grill.height))
+    if name == "return_home":
+        floor[WITHDRAW_NODES + 1:] = cell.table.height + cell.burger.thickness + BURGER_CLEARANCE
+    return floor
+
+
+class TipPoint(Quantity):
+    """World position (m) of the blade tip p + R (l/2, 0, 0) and its ∂/∂q = ∂p/∂q − [R r]× J_ω."""
+
+    def __call__(self, st, ctx):
+        r = st.R @ np.array([ctx["length"] / 2, 0.0, 0.0])
+        return st.p + r, st.dp_dq - skew(r) @ st.Jw
+
+
+def tip_point(cell: CellConfig, pose: Pose) -> np.ndarray:
+    """World position (m) of the blade tip at ``pose``."""
+    from flipkit.model.orientation import rpy_matrix
+
+    return np.asarray(pose.p, float) + rpy_matrix(pose.o) @ np.array(
+        [cell.spatula.length / 2, 0.0, 0.0])
+
+
+def pivot_nodes(N: int) -> list[int]:
+    """Place nodes where the tip holds its final point (the tilt pivots about it): after the
+    cone nodes."""
+    return [i for i in range(N + 1) if i >= PLACE_CONE_FRACTION * N - 1e-9]
+
+
+class InStartFrame(Quantity):
+    """Blade-centre position in a fixed frame (R0, p0): R0ᵀ (p − p0) (m), ∂/∂q = R0ᵀ ∂p/∂q."""
+
+    def __init__(self, R0, p0):
+        self.R0, self.p0 = np.asarray(R0, float), np.asarray(p0, float)
+
+    def __call__(self, st, ctx):
+        return self.R0.T @ (st.p - self.p0), self.R0.T @ st.dp_dq
+
+
+def withdraw_bounds(N: int) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds (lo, hi) on :class:`InStartFrame` at return_home nodes 1..WITHDRAW_NODES: back
+    along the blade's −x (by WITHDRAW_DISTANCE at the last), within WITHDRAW_BAND of its plane
+    and line."""
+    n, b = WITHDRAW_NODES, WITHDRAW_BAND
+    lo, hi = np.tile([-np.inf, -b, -b], (n, 1)), np.tile([0.0, b, b], (n, 1))
+    hi[-1, 0] = -WITHDRAW_DISTANCE
+    return lo, hi
+
+
+def serve_blocks(name: str, L, robot, q_start, spot, on_blade=(0.0, 0.0)
+                 ) -> tuple[list, Pose | None]:
+    """Path blocks of a serve-only segment and its end pose (None for return_home)."""
+    if name == "carry":
+        return [], carry_end(robot.cell, spot, on_blade)
+    if name == "place":
+        end = place_end(robot.cell, spot, on_blade)
+        tip, b = tip_point(robot.cell, end), PIVOT_BAND
+        ctx = {"length": robot.cell.spatula.length}
+        return [KinematicBlock("place_pivot", L, TipPoint(), pivot_nodes(L.N), tip - b,
+                               tip + b, ctx=ctx)], end
+    st = robot.placement(q_start)
+    nodes = range(1, WITHDRAW_NODES + 1)
+    lo, hi = withdraw_bounds(L.N)
+    o0, band = rpy(st.rotation), WITHDRAW_ANGLE_BAND
+    return [KinematicBlock("withdraw", L, InStartFrame(st.rotation, st.translation), nodes, lo, hi),
+            KinematicBlock("withdraw_attitude", L, "rpy", nodes, o0 - band, o0 + band)], None
+
+
+def reach(robot, pose: Pose, seeds=()) -> np.ndarray:
+    """An IK solution of ``pose`` from the first of ``seeds``, then q_home, that reaches it.
+
+    Raises:
+        UnreachableError: None does.
+    """
+    from flipkit.model.ik import solve_pose
+
+    for seed in (*seeds, robot.q_home):
+        try:
+            return solve_pose(robot, pose.p, pose.o, seed)
+        except UnreachableError as exc:
+            error = exc
+    raise error
+
+
+def cone_nodes(name: str, N: int) -> list[int]:
+    """Nodes where a serve-only segment enforces the friction cone."""
+    if name == "carry":
+        return list(range(N + 1))
+    if name == "place":
+        return [i for i in range(N + 1) if i <= PLACE_CONE_FRACTION * N + 1e-9]
+    return []
+
+
+__all__ = ["SERVE_SUBBEHAVIORS", "SERVE_ONLY", "PLACE_PITCH", "PLACE_TIP_GAP", "rest_offset",
+           "predicted_rest", "WITHDRAW_NODES", "WITHDRAW_DISTANCE",
+           "PLACE_CONE_FRACTION", "T_BOUNDS", "CARRIES_BURGER", "check_table_spot", "heading",
+           "place_end", "carry_end", "table_floor", "InStartFrame", "withdraw_bounds",
+           "serve_blocks", "cone_nodes", "TipPoint", "tip_point", "pivot_nodes", "reach"]

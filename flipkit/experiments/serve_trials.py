@@ -1,0 +1,133 @@
+"""Simulated execution of serve plans under perturbations: does the burger end on the table?
+
+As :mod:`flipkit.experiments.trials` for flips: each trial executes the plan closed-loop in the
+MuJoCo cell (:func:`flipkit.simulation.execute.execute_plan`) with the burger misplaced and the
+physics perturbed (:class:`~flipkit.experiments.trials.Perturbations`, drawn from
+``np.random.default_rng(seed + trial)``), then judges the scoop and pickup (paper Sec. V) and
+the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
+within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
+``replan`` the cell measures where the burger lies on the blade at the end of the carry and
+re-plans place and return home for it (:func:`flipkit.planning.serve.replan_serve`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+
+import numpy as np
+
+from flipkit.errors import ConfigError
+from flipkit.experiments.trials import (HOLD_S, TRACK_RATE_HZ, Perturbations, merge_tracking,
+                                        plan_from_text, trial_jobs, trial_key)
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.serve import table_spot
+from flipkit.simulation.judges import judge_pickup, judge_scoop, judge_serve
+
+SERVE_STAGES = ("scoop", "pickup", "serve")
+
+
+def run_serve_trial(job: dict) -> dict:
+    """One simulated execution of a serve plan (the sweep worker; ``job`` as
+    :func:`flipkit.experiments.trials.run_trial`, ``plan_text`` a solved serve plan).
+
+    Returns:
+        ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` (each judge on its
+        own), ``failure`` (first failed stage and why, or ``None``), ``perturbation``,
+        ``tracking``, ``mode``, ``rest`` (final centre ``xy`` (m), ``distance`` from the
+        spot (m), ``up_z``), ``replan`` (sensed position and failure, or ``None``).
+    """
+    from flipkit.config import with_parameter
+    from flipkit.planning.serve import replan_serve
+    from flipkit.simulation.execute import execute_plan
+
+    plan = plan_from_text(job["plan_text"])
+    draw = Perturbations(**job["perturbations"]).draw(
+        np.random.default_rng(job["seed"] + job["trial"]))
+    cell = plan.cell()
+    for name, value in (job.get("physics") or {}).items():
+        cell = with_parameter(cell, name, value)
+    replan = replan_serve if job.get("replan", False) else None
+    mode = job.get("mode", "feedforward")
+    ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
+                      replan=replan)
+    run, bounds = ex.run, ex.bounds
+    spot = table_spot(ex.plan)
+    scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
+    serve = judge_serve(run, spot, cell.table)
+    ok = {"scoop": scoop.ok}
+    ok["pickup"] = ok["scoop"] and pickup.ok
+    ok["serve"] = ok["pickup"] and serve.ok
+    return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, serve),
+            "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "serve": serve.ok},
+            "perturbation": draw, "tracking": ex.errors, "mode": mode,
+            "rest": {"xy": [float(v) for v in run.burger_pos[-1, :2]],
+                     "distance": serve.distance, "up_z": serve.up_z},
+            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
+            if replan is not None else None}
+
+
+def _failure(scoop, pickup, serve) -> dict | None:
+    """The first failed stage: stage, reason and the measured amount."""
+    if not scoop.ok:
+        return {"stage": "scoop", "reason": "overlap", "amount": scoop.overlap}
+    if not pickup.ok:
+        return {"stage": "pickup", "reason": "on_grill" if not pickup.off_grill
+                else "off_spatula", "amount": pickup.clearance}
+    if serve.ok:
+        return None
+    for reason, bad, amount in (("not_upright", not serve.upright, serve.up_z),
+                                ("not_on_table", not serve.on_table, serve.distance),
+                                ("on_blade", not serve.off_blade, serve.distance),
+                                ("moving", not serve.at_rest, serve.distance)):
+        if bad:
+            return {"stage": "serve", "reason": reason, "amount": float(amount)}
+    return {"stage": "serve", "reason": "missed_spot", "amount": serve.distance}
+
+
+def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations(), *,
+                   executor=None, cache_dir=None, progress: bool = True,
+                   rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+                   replan: bool = False) -> dict:
+    """Run ``trials`` simulated executions of the serve plan file ``path``.
+
+    Returns:
+        ``{"seed", "trials", "perturbations", "rate_hz", "mode", "replan", "locations":
+        [{"location", "spot", "plan", "trials", "success", "independent", "failures",
+        "tracking", "rests"}], "tracking", "summary"}`` — the layout of
+        :func:`flipkit.experiments.trials.validate`, stages :data:`SERVE_STAGES`.
+
+    Raises:
+        FlipkitError: The file is missing, malformed, not a serve plan or not solved.
+    """
+    from pathlib import Path
+
+    from flipkit.experiments.sweep import run_sweep
+
+    plan = Plan.load(path)
+    if plan.behavior != "serve" or plan.status != "solved":
+        raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
+    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
+        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
+                      replan)
+    results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,
+                        desc="trials")
+    entry = {"location": plan.burger["location"].tolist(),
+             "spot": table_spot(plan).tolist(), "plan": {"status": plan.status,
+                                                        "file": str(path)},
+             "trials": int(trials),
+             "success": {s: sum(r["ok"][s] for r in results) for s in SERVE_STAGES},
+             "independent": {s: sum(r["independent"][s] for r in results) for s in SERVE_STAGES},
+             "failures": [{"trial": r["trial"], **r["failure"], "perturbation": r["perturbation"]}
+                          for r in results if r["failure"]],
+             "tracking": merge_tracking([r["tracking"] for r in results]),
+             "rests": [{"trial": r["trial"], **r["rest"], "replan": r["replan"]}
+                       for r in results]}
+    return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
+            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan),
+            "locations": [entry], "tracking": entry["tracking"],
+            "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
+                        "independent": entry["independent"]}}
+
+
+__all__ = ["SERVE_STAGES", "run_serve_trial", "validate_serve"]

@@ -1,0 +1,161 @@
+"""Planning the serve behaviour: pick a burger up from the grill and tilt it off onto the side
+table (:mod:`flipkit.behaviors.serve`), then return home.
+
+:func:`plan_serve` chains go to burger, scoop, pickup, carry, place and return home by (29) —
+each segment starts at the previous one's final (q, q̇) — and checks the plan independently
+(:func:`~flipkit.planning.verify.verify_plan`) like every planner entry point
+(:mod:`flipkit.planning.planner`): status ``solved`` only if every segment converged and the
+check passes. It is re-exported as :func:`flipkit.planning.planner.plan_serve`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from flipkit.behaviors import serve as sv
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.model.ik import solve_pose
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.planner import (SOLVERS, _finish, _joint_vector, _on_blade,
+                                      _solver_failure, models_for, solve_segment)
+from flipkit.planning.segment import Segment
+
+
+def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
+    """The ``placing`` record of the carry and place segments: the table ``spot`` (x, y) (m),
+    ``on_blade`` (x, y) (m, blade frame) where the burger was planned to sit, the blade's
+    ``heading`` and ``pitch`` at the place's end (rad) (:func:`flipkit.behaviors.serve.place_end`)."""
+    end = sv.place_end(cell, spot, on_blade)
+    return {"spot": [float(v) for v in spot], "on_blade": [float(v) for v in on_blade],
+            "heading": float(end.o[2]), "pitch": float(end.o[1])}
+
+
+def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
+               solver: str = "auto", on_blade=(0.0, 0.0),
+               options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
+    22–25), carry with the friction cone throughout, place by a tilt-off, return home.
+
+    Args:
+        burger: Burger location p^b (m) on the grill (:func:`~flipkit.behaviors.targets.check_location`).
+        table_spot: Where the burger's centre should come to rest on the table (x, y) (m);
+            the whole burger must lie on the table (:func:`~flipkit.behaviors.serve.check_table_spot`).
+        q_start: Start configuration (rad), default q_home — e.g. where the previous motion
+            of a schedule ended. qd_start: Start joint velocities (rad/s), default rest.
+        cell: The cell (default :class:`~flipkit.config.CellConfig`).
+        solver: ``"auto"`` (default: the SQP, then IPOPT where it fails), ``"sqp"`` or
+            ``"ipopt"``.
+        on_blade: Where the burger's centre will sit on the blade (x, y) (m, blade frame)
+            during the carry and place; default the blade centre (:func:`replan_serve`
+            re-plans for a sensed one).
+        options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
+
+    Returns:
+        The :class:`~flipkit.planning.plan_file.Plan`, behaviour ``serve``: status
+        ``solved`` (verified) or ``failed`` with ``plan.failure`` one line; on a segment
+        failure the chain stops there. ``plan.report`` and ``plan.wall_time_s`` (s) as
+        :func:`~flipkit.planning.planner.plan_flip`. It ends at q_home, at rest.
+
+    Raises:
+        UnreachableError: Burger off the grill, spot off the table, or the place pose out of
+            reach. ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
+    """
+    t0, cell = time.perf_counter(), cell or CellConfig()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    pb = tg.check_location(cell, burger)
+    spot = sv.check_table_spot(cell, table_spot)
+    on_blade = _on_blade(on_blade, cell)
+    models = models_for(cell)
+    robot = models.bare
+    q = robot.q_home.copy() if q_start is None else _joint_vector(
+        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
+    qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
+        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    for what, pose in (("carry end", sv.carry_end(cell, spot, on_blade)),
+                       ("place", sv.place_end(cell, spot, on_blade))):
+        try:  # reachability first, one clear line
+            solve_pose(models.loaded, pose.p, pose.o, robot.q_home)
+        except UnreachableError as exc:
+            raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
+                                   f"{exc}") from None
+    return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0)
+
+
+def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -> Plan:
+    """Solve the serve subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
+    segments, failure = list(done), None
+    for name in sv.SERVE_SUBBEHAVIORS[len(done):]:
+        try:
+            nlp = build_segment(name, models, q, qd, location=pb, spot=spot, on_blade=on_blade,
+                                options=options)
+        except FlipkitError as exc:
+            if not segments:
+                raise
+            failure = f"{name}: cannot build the initial guess ({exc})"
+            break
+        result = solve_segment(nlp, solver)
+        seg = Segment.from_solution(nlp, result)
+        if name in ("carry", "place"):
+            seg.placing = placing_record(cell, spot, on_blade)
+        segments.append(seg)
+        if not result.success:
+            failure = _solver_failure(name, nlp, result)
+            break
+        q, qd = seg.q[-1], seg.qd[-1]
+    plan = Plan.from_segments("serve", cell, segments, location=pb, cone=options.cone,
+                              status="failed")
+    return _finish(plan, failure, t0)
+
+
+def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
+                 options: SegmentOptions = SegmentOptions()) -> Plan:
+    """Re-plan place and return home of a solved serve plan for a burger measured at
+    ``on_blade`` on the blade at the end of the carry (sense, plan, act; as
+    :func:`~flipkit.planning.planner.replan_flip`): the carry ends at rest with the blade flat
+    above the table, so the cell can measure where the burger lies on it and wait there while
+    this runs. Go to burger, scoop, pickup and carry are kept; the place is moved so that the
+    burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a
+    burger that shifted on the blade during the pickup and carry was placed 5.5 cm off in
+    MuJoCo.)
+
+    Args:
+        plan: A solved serve plan. on_blade: (x, y) of the burger's centre in the blade frame
+            (m). solver, options: As :func:`plan_serve` (the cone form from the plan).
+
+    Raises:
+        ConfigError: ``plan`` is not a solved serve plan, or ``on_blade`` is off the blade.
+    """
+    t0 = time.perf_counter()
+    if solver not in SOLVERS:
+        raise InvalidChoiceError("solver", solver, SOLVERS)
+    if plan.behavior != "serve" or plan.status != "solved":
+        raise ConfigError("replan_serve needs a solved serve plan")
+    cell = plan.cell()
+    on_blade = _on_blade(on_blade, cell)
+    options = replace(options, cone=plan.cone)
+    done = [s for s in plan.segments if s.name in sv.SERVE_SUBBEHAVIORS[:4]]
+    return _chain(np.asarray(plan.burger["location"], float), table_spot(plan), on_blade,
+                  done[-1].q[-1], done[-1].qd[-1], done, models_for(cell), cell, solver,
+                  options, t0)
+
+
+def table_spot(plan: Plan) -> np.ndarray:
+    """The table spot (x, y) (m) of a serve plan (its carry or place segment's ``placing``).
+
+    Raises:
+        FlipkitError: No segment records one.
+    """
+    rec = next((s.placing for s in plan.segments if getattr(s, "placing", None)), None)
+    if rec is None:
+        raise FlipkitError("serve plan: no segment records the table spot (placing.spot)")
+    return np.asarray(rec["spot"], float)
+
+
+__all__ = ["plan_serve", "replan_serve", "placing_record", "table_spot"]
