@@ -242,3 +242,37 @@ def test_min_clearances_report_every_applied_pair(models):
     table = min_clearances(plan)
     assert len(table) == 27 and all(v["distance"] > 0.02 for v in table.values())
     assert table["blade/grill"]["distance"] == pytest.approx(0.225, abs=0.01)
+
+
+# ------------------------------------------------------------------ planning
+def test_a_hood_where_the_elbow_goes_is_refused_or_avoided(models):
+    """A hood box around the elbow's place at the end of a translate (README's example): the
+    planner either refuses (a failed plan naming the clearance) or finds a motion that keeps
+    every link 2 cm from it — never a solved plan through the hood."""
+    from flipkit.planning.planner import plan_translate
+
+    start, goal = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)
+    free = plan_translate(start, goal, solver="sqp")
+    assert free.status == "solved", free.failure
+    robot = models.bare
+    robot.placement(free.segments[0].q[-1])
+    elbow = robot.data.oMi[3].translation.copy()
+    hood = CellBox("hood", tuple(elbow + (-0.2, -0.2, 0.0)), tuple(elbow + (0.2, 0.2, 0.3)))
+    space = SpaceConfig(walls=(BACK_WALL, hood))
+    report = verify_plan(free, space=space)  # the free plan's elbow goes into the hood
+    assert not report.groups["arm_clearance"].ok
+    hooded = plan_translate(start, goal, cell=replace(models.cell, space=space), solver="sqp")
+    if hooded.status == "solved":
+        d = min_clearances_in(hooded, space)
+        assert d >= 0.02 - 1e-5
+    else:
+        assert "arm_clearance" in hooded.failure or "end_" in hooded.failure, hooded.failure
+
+
+def min_clearances_in(plan, space):
+    """Least applied distance (m) of ``plan`` against ``space``."""
+    report = verify_plan(plan, space=space)
+    assert report.groups["arm_clearance"].ok, report.table()
+    cell = replace(plan.cell(), space=space)
+    geometry = CellGeometry(plan.robot_for(plan.segments[0], cell), cell)
+    return min(geometry.distances(q)[:, -1].min() for seg in plan.segments for q in seg.q[1:])
