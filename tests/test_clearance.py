@@ -142,6 +142,24 @@ def test_block_jacobian_matches_finite_differences(models, shapes):
     assert np.all(block.lo == 0.02) and np.all(np.isinf(block.hi))
 
 
+def test_pitch_rows_match_finite_differences(models):
+    """The orientation rows (Constraint 1): pitch o_y and its Jacobian, through a flip-like
+    roll past ±π where o_x wraps and o_y does not."""
+    from flipkit.transcription.constraints.kinematic import KinematicBlock
+
+    L, robot = Layout(6, 20), models.bare
+    q = robot.q_home + np.outer(np.linspace(0, 1, L.n_nodes), [0.2, -0.3, 0.4, 0.5, 0.1, -3.6])
+    z = np.zeros_like(q)
+    x = L.pack(q, z, z, z, np.zeros((6, 7)), 0.5)
+    block = KinematicBlock("task_orientation", L, "pitch", range(1, L.n_nodes), -1.2, 1.2)
+    vals, jac = block.evaluate(Evaluation(L, robot, x))
+    np.testing.assert_allclose(vals, [rpy(robot.rotation(qi))[1] for qi in q[1:]])
+    J = np.zeros((block.m, L.n))
+    J[block.rows, block.cols] = jac
+    fd = central_fd(lambda v: block.evaluate(Evaluation(L, robot, v))[0], x, h=1e-6)
+    np.testing.assert_allclose(J, fd, atol=1e-6, rtol=1e-6)
+
+
 def test_block_rejects_unknown_names_and_bad_margins(models, shapes):
     L = Layout(6, 20)
     with pytest.raises(ConfigError, match="no arm shape"):
