@@ -1,5 +1,7 @@
 """Constraint sets of the behaviours (paper Sec. IV.C): translate (9), go to burger (22),
-scoop (23–24), pickup (25), flip (26), turn back (27), each chained by (29).
+scoop (23–24), pickup (25), flip (26), turn back (27), each chained by (29); in every segment
+the task-space limits of Constraint 1 (eq. 4: position, velocity, acceleration, pitch) and the
+whole arm's space limits (the cell's boxes, :data:`TOOL_SHAPES`).
 
 :func:`build_segment` turns a behaviour name, a start state and the task (locations) into an
 :class:`~flipkit.transcription.nlp.NLP`.
@@ -70,7 +72,7 @@ SCOOP_ANGLE_BAND = 0.05  # rad: |o_x|, |o_z| during the scoop
 # flip's end velocity and needs room to turn the arm away (measured at (0.75, 0.00): a flip
 # ending on the margin with the flange coming down at ~0.9 m/s, and no turn back from there
 # could keep it; 1.4 cm short at its first node).
-TOOL_SHAPES = ("blade", "handle", "ee", "wrist_3", "wrist_2")
+TOOL_SHAPES = ("blade", "handle", "ee", "wrist_3", "wrist_2")  # ee: the URDF's ee_link box
 AT_GRILL = ("go_to_burger", "scoop", "pickup")
 FLIP_TOOL_FRACTION = 0.25
 FLIP_END_ALLOWANCE = 0.03  # m, our choice: ≈ 0.9 m/s × the turn back's first node (0.06 s) / 2
@@ -359,5 +361,6 @@ def flat_pose(position, yaw: float = 0.0) -> tg.Pose:
     return tg.Pose(tuple(float(v) for v in position), (0.0, 0.0, float(yaw)))
 
 
-__all__ = ["AT_GRILL", "BEHAVIORS", "FLIP_END_ALLOWANCE", "FLIP_TOOL_FRACTION", "T_BOUNDS", "TOOL_SHAPES", "SegmentOptions", "Models",
-           "build_segment", "clearance_excluded", "flat_pose", "grill_floor"]
+__all__ = ["AT_GRILL", "BEHAVIORS", "FLIP_END_ALLOWANCE", "FLIP_TOOL_FRACTION", "T_BOUNDS",
+           "TOOL_SHAPES", "SegmentOptions", "Models", "build_segment", "clearance_excluded",
+           "flat_pose", "grill_floor"]
