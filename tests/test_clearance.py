@@ -76,8 +76,13 @@ def test_distance_matches_a_hand_computed_case(shapes, models):
     """The blade at q_home lies flat 0.30 m above the base, its centre at (0.62, −0.20): its
     underside is 0.30 − 0.003 − 0.072 above the grill's top, and it overhangs the grill area
     (x from 0.54 to 0.70), so that is the distance."""
-    d, _ = shapes.distance(models.bare.q_home, shapes.shape_index("blade"), shapes.box_index("grill"))
+    q, grill = models.bare.q_home, shapes.box_index("grill")
+    d, _ = shapes.distance(q, shapes.shape_index("blade"), grill)
     assert d == pytest.approx(0.30 - 0.003 - 0.072, abs=1e-6)
+    # the handle's axis ends at the heel, (0.54, −0.20, 0.30): 6 cm short of the grill's edge
+    # x = 0.60, 0.228 m above its top; minus the handle's 1 cm radius
+    d, _ = shapes.distance(q, shapes.shape_index("handle"), grill)
+    assert d == pytest.approx(np.hypot(0.06, 0.30 - 0.072) - 0.01, abs=2e-4)
 
 
 FD_H = 1e-5  # m: GJK's tolerance (1e-9 m) over h stays ≤ 1e-4 of the gradients' scale

@@ -16,8 +16,8 @@ for penetration (coal's EPA depth). The gradient of the distance d between a sha
 fixed box is ∂d/∂q = −nᵀ (J_v − [r]× J_ω), with n coal's unit normal from the shape's
 witness point to the box's, r the witness point relative to the joint origin and
 (J_v, J_ω) the joint's world-aligned Jacobian (pinocchio). It is exact wherever the witness
-pair is unique, i.e. almost everywhere (tests/test_collision.py checks it against finite
-differences on the UR10).
+pair is unique, i.e. almost everywhere, for separated and penetrating pairs alike
+(tests/test_clearance.py checks it against finite differences on the UR10).
 """
 
 from __future__ import annotations
@@ -133,11 +133,13 @@ class ArmShapes:
         return np.linalg.inv(self.robot.spatula_in_parent)
 
     def shape_index(self, name: str) -> int:
+        """Index of the shape ``name`` (ConfigError if there is none)."""
         if name not in self.names:
             raise ConfigError(f"no arm shape {name!r}; shapes: {', '.join(self.names)}")
         return self.names.index(name)
 
     def box_index(self, name: str) -> int:
+        """Index of the cell box ``name`` (ConfigError if there is none)."""
         if name not in self.box_names:
             raise ConfigError(f"no cell box {name!r}; boxes: {', '.join(self.box_names)}")
         return self.box_names.index(name)
