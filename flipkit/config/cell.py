@@ -14,6 +14,7 @@ import numpy as np
 
 from flipkit.config.checks import box, finite, positive
 from flipkit.config.physics import PhysicsConfig
+from flipkit.config.space import CellBox, SpaceConfig, cell_boxes
 from flipkit.config.urdf import default_urdf, resolve_urdf
 from flipkit.errors import ConfigError
 
@@ -192,17 +193,30 @@ class TaskLimits:
         p_min, p_max: Spatula-centre position box (m); p_z stays above the grill.
         v_max: Bound on |v_x|, |v_y|, |v_z| (m/s).
         a_max: Bound on |a_x|, |a_y|, |a_z| (m/s²).
+        pitch_range: Bounds of the pitch o_y (rad), the orientation part of eq. (4). Our
+            choice: ±1.2 rad (69°) keeps roll-pitch-yaw away from its singularity at
+            ±π/2 (where the rpy end-orientation constraints lose a direction) and holds every
+            pitch the behaviours command (scoop 0.314, pickup −0.05; the flip's x axis bound
+            of eq. 26, x̂_x ≥ 0.6, allows |o_y| ≤ 0.93; the turn backs of the ten Table I plans
+            reach −0.78). Roll and yaw get no bounds: the flip rolls the blade over (o_x
+            wraps at ±π) and the arm may point the blade anywhere around its base; the
+            flip's x-axis bounds and the scoop's attitude band bound them where it matters.
     """
 
     p_min: tuple = (0.0, -0.9, 0.072)
     p_max: tuple = (1.2, 0.95, 0.9)
     v_max: float = 3.0
     a_max: float = 40.0
+    pitch_range: tuple = (-1.2, 1.2)
 
     def __post_init__(self):
         box("task position", self.p_min, self.p_max, 3)
         positive("v_max", self.v_max)
         positive("a_max", self.a_max)
+        box("pitch range", self.pitch_range[:1], self.pitch_range[1:], 1)
+        if max(abs(float(v)) for v in self.pitch_range) >= 1.5707963267948966:
+            raise ConfigError(f"pitch range must lie inside (-pi/2, pi/2) rad (rpy is singular "
+                              f"at ±pi/2), got {self.pitch_range}")
 
 
 @dataclass(frozen=True)
@@ -217,9 +231,14 @@ class CellConfig:
     limits: TaskLimits = field(default_factory=TaskLimits)
     gravity: tuple = GRAVITY
     physics: PhysicsConfig = field(default_factory=PhysicsConfig)
+    space: SpaceConfig = field(default_factory=SpaceConfig)
 
     def __post_init__(self):
         finite("gravity", self.gravity, (3,))
+
+    def boxes(self) -> tuple[CellBox, ...]:
+        """The solid boxes the arm keeps ``space.margin`` from: grill, table, walls."""
+        return cell_boxes(self.grill, self.table, self.space)
 
 
 TABLE1_LOCATIONS = (  # Table I of the paper: p^b (m), robot base frame (shared/data/paper_table1.csv)

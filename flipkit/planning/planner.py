@@ -119,9 +119,10 @@ def _joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
     return v
 
 
-def _finish(plan: Plan, failure: str | None, t0: float) -> Plan:
-    """Verify ``plan``; set status, ``failure``, ``report`` and ``wall_time_s``."""
-    plan.report = verify_plan(plan)
+def _finish(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
+    """Verify ``plan`` (against the space limits of ``cell``, which the file does not record);
+    set status, ``failure``, ``report`` and ``wall_time_s``."""
+    plan.report = verify_plan(plan, space=None if cell is None else cell.space)
     if failure is None and not plan.report.ok:
         group, k, amount = plan.report.worst()
         failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"
@@ -190,7 +191,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
     result = solve_segment(nlp, solver)
     plan = Plan.from_segments("translate", cell, [Segment.from_solution(nlp, result)],
                               cone=options.cone, status="failed")
-    return _finish(plan, None if result.success else _solver_failure("translate", nlp, result), t0)
+    return _finish(plan, None if result.success else _solver_failure("translate", nlp, result), t0,
+                   cell)
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
@@ -266,7 +268,7 @@ def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options,
         q, qd = seg.q[-1], seg.qd[-1]
     plan = Plan.from_segments("flip", cell, segments, location=pb, cone=options.cone,
                               status="failed")
-    return _finish(plan, failure, t0)
+    return _finish(plan, failure, t0, cell)
 
 
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",

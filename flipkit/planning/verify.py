@@ -38,21 +38,28 @@ placing            serve: the table spot on the table, and the rest point       
 landing            flip: landing recomputed (:mod:`flipkit.planning.verify_flight`):    0.1 mm,
                    within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
 flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
+arm_clearance      every link (URDF collision hull), the handle and the blade  tol
+                   keep cell.space.margin (2 cm) from grill, table and walls,
+                   but the pairs the segment exempts (clearance_excluded);
+                   coal distances, :mod:`flipkit.planning.verify_clearance` (m)
+orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     tol
 =================  ==========================================================  ==============
 
 ``tol`` (:data:`TOL` = 1e-5) is in the solver's scaled units, so every group's tolerance is
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
 and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
 duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
-Task-space bounds (cell.limits) are not recorded in the plan file and not checked; nor is the
-side table (its default :class:`~flipkit.config.TableConfig` is used for a serve plan).
+Task-space position, velocity and acceleration bounds (cell.limits) are not recorded in the
+plan file and not checked; the pitch range, the cell's boxes and margin and the side table are
+not recorded either: ``arm_clearance``, ``orientation`` and ``placing`` check against today's
+defaults of :class:`~flipkit.config.CellConfig` (as ``time_grid`` does against today's T_BOUNDS).
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -65,6 +72,7 @@ from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, FlipkitError, VerificationError
 from flipkit.model.orientation import rpy
 from flipkit.planning.plan_file import Plan
+from flipkit.planning.verify_clearance import CellGeometry, check_space
 from flipkit.planning.verify_flight import check_flight
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
@@ -73,7 +81,8 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
-          "flight_clearance": "m", "placing": "m", "completeness": "segments"}
+          "flight_clearance": "m", "placing": "m", "arm_clearance": "m", "orientation": "rad",
+          "completeness": "segments"}
 
 
 @dataclass
@@ -186,12 +195,15 @@ def _point_height(st, r_local) -> float:
     return float(st.p[2] + (st.R @ np.asarray(r_local, float))[2])
 
 
-def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
+def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
     """Check every segment of ``plan`` and the joints between them.
 
     Args:
         plan: The plan (e.g. :meth:`Plan.load`).
         tol: Tolerance in the solver's scaled units (see the module docstring).
+        space: The cell's walls and margin (:class:`~flipkit.config.space.SpaceConfig`) to
+            check ``arm_clearance`` against; the plan file does not record them, default
+            today's :class:`~flipkit.config.CellConfig` defaults.
 
     Raises:
         PlanFileError: The plan's model cannot be rebuilt (URDF missing, payload mismatch).
@@ -200,6 +212,8 @@ def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
     if not (math.isfinite(tol) and tol > 0):
         raise ConfigError(f"tol must be a positive finite number, got {tol!r}")
     cell = plan.cell()
+    if space is not None:
+        cell = replace(cell, space=space)
     report = VerificationReport(tol, [s.name for s in plan.segments])
     if plan.cone == "paper":
         report.groups["cone"].unit = "1"  # cosine margin, dimensionless
@@ -211,12 +225,15 @@ def verify_plan(plan: Plan, tol: float = TOL) -> VerificationReport:
     missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
                if expected is not None else int(not names))
     report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
-    robots = {}  # one model per payload list
+    robots, geometry = {}, None  # one model per payload list; one geometry (kinematics only)
     for k, seg in enumerate(plan.segments):
         bodies = tuple(seg.payload)
         if bodies not in robots:
             robots[bodies] = plan.robot_for(seg, cell)
+        geometry = geometry or CellGeometry(robots[bodies], cell)
         _check_segment(report, k, seg, robots[bodies], plan, cell, tol)
+        geometry.robot = robots[bodies]
+        check_space(report, k, seg, robots[bodies], cell, geometry, tol)
         if k:
             prev = plan.segments[k - 1]
             jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))

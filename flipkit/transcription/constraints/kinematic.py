@@ -49,6 +49,17 @@ class Rpy(Quantity):
         return rpy_jacobian(st.R, st.Jw)
 
 
+class Pitch(Quantity):
+    """The pitch o_y = −asin(x̂_z) (rad): it depends on the blade's x axis alone, so it stays
+    continuous while the roll o_x wraps at ±π (the flip rolls the blade over)."""
+
+    size = 1
+
+    def __call__(self, st, ctx):
+        o, J = rpy_jacobian(st.R, st.Jw)
+        return o[1:2], J[1:2]
+
+
 class Normal(Quantity):
     def __call__(self, st, ctx):
         return axis_jacobian(st.R, st.Jw, 2)
@@ -107,7 +118,7 @@ class Cone(Quantity):
         return self.cone.jacobians(st)
 
 
-QUANTITIES = {"position": Position, "height": Height, "rpy": Rpy, "normal": Normal,
+QUANTITIES = {"position": Position, "height": Height, "rpy": Rpy, "pitch": Pitch, "normal": Normal,
               "xaxis": XAxis, "tip_height": TipHeight, "blade_heights": BladeEdgeHeights,
               "velocity": Velocity, "acceleration": Acceleration}
 

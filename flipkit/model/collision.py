@@ -1,0 +1,205 @@
+"""The arm's solid shapes and their distances to the cell's boxes, with analytic gradients.
+
+Shapes (all moving with a joint of the arm, named as in :data:`ArmShapes.names`):
+
+* every link's collision mesh of the URDF (UR10: shoulder, upper arm, forearm, three wrists)
+  as its convex hull (coal's qhull): a hull contains its mesh, so a hull clear of a box
+  means the link is; it fills the link's concave parts (a few mm to cm, on the safe side)
+  and gives GJK a convex shape. The URDF's ``ee_link`` collision box is kept too. The base
+  link does not move and is left out.
+* the spatula handle: a capsule on the tool axis from the flange to the blade's heel, of
+  radius ``cell.space.handle_radius`` (our choice, :mod:`flipkit.config.space`);
+* the blade: a box of the spatula's length, width and thickness under its carrying face.
+
+Distances come from coal (the collision library shipped with pinocchio): signed, negative
+for penetration (coal's EPA depth). The gradient of the distance d between a shape and a
+fixed box is ∂d/∂q = −nᵀ (J_v − [r]× J_ω), with n coal's unit normal from the shape's
+witness point to the box's, r the witness point relative to the joint origin and
+(J_v, J_ω) the joint's world-aligned Jacobian (pinocchio). It is exact wherever the witness
+pair is unique, i.e. almost everywhere, for separated and penetrating pairs alike
+(tests/test_clearance.py checks it against finite differences on the UR10).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from flipkit.config import CellConfig
+from flipkit.config.urdf import robots_dir
+from flipkit.errors import ConfigError
+from flipkit.model.robot import LWA, Robot, skew
+
+BLADE, HANDLE = "blade", "handle"
+# GJK's stopping tolerance (m). coal's default, 1e-6, left distances up to 2e-7 m off (seen:
+# blade to table at 0.95 m), enough to spoil finite differences and the SQP's line search;
+# 1e-9 costs ~1.5× per query.
+GJK_TOLERANCE = 1e-9
+
+
+def distance_request():
+    """A coal DistanceRequest with :data:`GJK_TOLERANCE`."""
+    import coal
+
+    req = coal.DistanceRequest()
+    req.gjk_tolerance = GJK_TOLERANCE
+    return req
+
+
+@dataclass
+class Shape:
+    """One rigid shape of the arm: a coal geometry at ``placement`` in joint ``joint``'s frame,
+    with a bounding sphere (``center`` in the shape's own frame, ``radius``, m) for broad
+    phase."""
+
+    name: str
+    joint: int
+    placement: pin.SE3
+    geometry: object
+    center: np.ndarray
+    radius: float
+
+
+def _bounding_sphere(geometry) -> tuple[np.ndarray, float]:
+    geometry.computeLocalAABB()
+    return np.array(geometry.aabb_center), float(geometry.aabb_radius)
+
+
+def _mesh_shapes(robot: Robot) -> list[Shape]:
+    """The URDF's collision geometries on moving joints; meshes as their convex hulls."""
+    import coal
+
+    dirs = [str(robots_dir().parent.parent)] if robots_dir() is not None else []
+    try:
+        gmodel = pin.buildGeomFromUrdf(robot.model, robot.urdf, pin.COLLISION, package_dirs=dirs)
+    except (ValueError, RuntimeError) as exc:
+        raise ConfigError(f"collision meshes of {robot.urdf} cannot be loaded: {exc}") from None
+    shapes = []
+    for go in gmodel.geometryObjects:
+        if go.parentJoint == 0:  # fixed to the world (the base): its distances never change
+            continue
+        geom = go.geometry
+        if isinstance(geom, coal.BVHModelBase):
+            geom.buildConvexHull(True, "Qt")
+            geom = geom.convex
+        name = robot.model.frames[go.parentFrame].name.removesuffix("_link")
+        center, radius = _bounding_sphere(geom)
+        shapes.append(Shape(name, go.parentJoint, go.placement.copy(), geom, center, radius))
+    return shapes
+
+
+class ArmShapes:
+    """The arm's shapes (:func:`_mesh_shapes`, handle, blade) and the cell's boxes.
+
+    Args:
+        robot: The arm with its spatula frame.
+        cell: Cell (boxes, margin, spatula); default ``robot.cell``.
+    """
+
+    def __init__(self, robot: Robot, cell: CellConfig | None = None):
+        import coal
+
+        self.robot, self.cell = robot, cell or robot.cell
+        sp = self.cell.spatula
+        shapes = _mesh_shapes(robot)
+        tool = robot.spatula_in_joint * pin.SE3(self._tool_in_spatula())
+        handle_len = sp.handle - sp.length / 2
+        if handle_len > 0:  # capsule along the tool z axis, flange to heel
+            cap = coal.Capsule(self.cell.space.handle_radius, handle_len)
+            pl = tool * pin.SE3(np.eye(3), np.array([0.0, 0.0, handle_len / 2]))
+            shapes.append(Shape(HANDLE, robot.joint_id, pl, cap, np.zeros(3),
+                                handle_len / 2 + self.cell.space.handle_radius))
+        blade = coal.Box(sp.length, sp.width, sp.thickness)
+        pl = robot.spatula_in_joint * pin.SE3(np.eye(3), np.array([0.0, 0.0, -sp.thickness / 2]))
+        shapes.append(Shape(BLADE, robot.joint_id, pl, blade, np.zeros(3),
+                            float(np.linalg.norm([sp.length, sp.width, sp.thickness]) / 2)))
+        self.shapes = shapes
+        self._joints = sorted({s.joint for s in shapes})
+        self._radii = np.array([s.radius for s in shapes])
+        self.names = tuple(s.name for s in shapes)
+        if len(set(self.names)) != len(self.names):
+            raise ConfigError(f"arm shape names are not unique: {self.names}")
+        self.boxes = self.cell.boxes()
+        self.box_names = tuple(b.name for b in self.boxes)
+        self._lo = np.array([b.lower for b in self.boxes], float)
+        self._hi = np.array([b.upper for b in self.boxes], float)
+        self._box_geoms = [(coal.Box(*b.size), coal.Transform3s(np.eye(3), np.array(b.center)),
+                            np.array(b.lower), np.array(b.upper)) for b in self.boxes]
+
+    def _tool_in_spatula(self) -> np.ndarray:
+        """Placement of the tool flange in the spatula frame (inverse of the spatula's mount)."""
+        return np.linalg.inv(self.robot.spatula_in_parent)
+
+    def shape_index(self, name: str) -> int:
+        """Index of the shape ``name`` (ConfigError if there is none)."""
+        if name not in self.names:
+            raise ConfigError(f"no arm shape {name!r}; shapes: {', '.join(self.names)}")
+        return self.names.index(name)
+
+    def box_index(self, name: str) -> int:
+        """Index of the cell box ``name`` (ConfigError if there is none)."""
+        if name not in self.box_names:
+            raise ConfigError(f"no cell box {name!r}; boxes: {', '.join(self.box_names)}")
+        return self.box_names.index(name)
+
+    def _place(self, q) -> list[pin.SE3]:
+        """Forward kinematics and joint Jacobians at q; the world placement of every shape."""
+        m, d = self.robot.model, self.robot.data
+        pin.computeJointJacobians(m, d, np.asarray(q, float))
+        joints = {j: d.oMi[j] for j in self._joints}
+        return [joints[s.joint] * s.placement for s in self.shapes]
+
+    def _query(self, k: int, M: pin.SE3, b: int, req, res):
+        """coal distance of shape k at world placement M to box b: (d, witness on the shape,
+        unit normal from the shape to the box)."""
+        import coal
+
+        geom, tf, _, _ = self._box_geoms[b]
+        res.clear()
+        d = coal.distance(self.shapes[k].geometry, coal.Transform3s(M.rotation, M.translation),
+                          geom, tf, req, res)
+        return float(d), np.array(res.getNearestPoint1()), np.array(res.normal)
+
+    def nearest(self, q, pairs, cap: float = np.inf) -> tuple[float, np.ndarray, int, int]:
+        """The least distance (m) over the (shape index, box index) ``pairs`` at q, capped at
+        ``cap``: (min(cap, d), its gradient ∂/∂q, the nearest pair's shape and box indices;
+        −1, −1 and a zero gradient when every pair lies farther than ``cap``). A broad phase
+        by bounding spheres skips the pairs that cannot be nearer; the minimum is exact."""
+        import coal
+
+        placed = self._place(q)
+        centers = np.array([M.act(s.center) for M, s in zip(placed, self.shapes)])
+        shapes, boxes = pairs[:, 0], pairs[:, 1]
+        c = centers[shapes]
+        bound = np.sqrt((np.maximum(np.maximum(self._lo[boxes] - c, c - self._hi[boxes]), 0.0)
+                         ** 2).sum(1)) - self._radii[shapes]
+        req, res = distance_request(), coal.DistanceResult()
+        best = (float(cap), None, None, -1, -1)
+        for j in np.argsort(bound, kind="stable"):
+            if bound[j] >= best[0]:
+                break
+            k, b = int(shapes[j]), int(boxes[j])
+            dist, p1, n = self._query(k, placed[k], b, req, res)
+            if dist < best[0]:
+                best = (dist, p1, n, k, b)
+        dist, p1, n, k, b = best
+        grad = np.zeros(self.robot.nq) if k < 0 else self._gradient(k, p1, n)
+        return dist, grad, k, b
+
+    def _gradient(self, k: int, p1: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """∂d/∂q = −nᵀ (J_v − [r]× J_ω) of shape k's witness point p1 (after :meth:`_place`)."""
+        joint = self.shapes[k].joint
+        J = pin.getJointJacobian(self.robot.model, self.robot.data, joint, LWA)
+        r = p1 - self.robot.data.oMi[joint].translation
+        return -(n @ (J[:3] - skew(r) @ J[3:]))
+
+    def distance(self, q, shape: int, box: int) -> tuple[float, np.ndarray]:
+        """Distance (m) of one shape to one box at q and its gradient ∂d/∂q."""
+        import coal
+
+        placed = self._place(q)
+        dist, p1, n = self._query(shape, placed[shape], box, distance_request(),
+                                  coal.DistanceResult())
+        return dist, self._gradient(shape, p1, n)
