@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from test_plan import models  # noqa: F401  (fixture)
 
 import flipkit.planning.planner as planner
 from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
@@ -149,3 +150,31 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
     res = planner.solve_segment(nlp, "auto")
     assert calls == ["sqp"] and res.success and res.solver == "ipopt"
     assert res.wall_time_s > 1.5  # both attempts are counted
+
+
+def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
+    """The scoop at (0.630, −0.347) — wrist 2 near its singularity — has no solution within
+    0.6 s; the planner tries once more with the bound × T_STRETCH and the plan verifies."""
+    from flipkit.behaviors.segments import T_BOUNDS, T_STRETCH
+    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.verify import verify_plan
+
+    plan = plan_flip((0.629686, -0.347136, 0.072))
+    assert plan.status == "solved", plan.failure
+    scoop = next(s for s in plan.segments if s.name == "scoop")
+    assert T_BOUNDS["scoop"][1] < scoop.T <= T_STRETCH * T_BOUNDS["scoop"][1] + 1e-9
+    others = [s for s in plan.segments if s.name != "scoop"]
+    assert all(s.T <= T_BOUNDS[s.name][1] + 1e-9 for s in others)  # stretched only if needed
+    assert verify_plan(plan).ok
+
+
+def test_a_duration_beyond_the_stretched_bound_fails_verify(models):
+    from test_plan import translate_plan
+
+    from flipkit.behaviors.segments import T_BOUNDS, T_STRETCH
+    from flipkit.planning.verify import verify_plan
+
+    ok = translate_plan(models, durations=(T_STRETCH * T_BOUNDS["translate"][1] - 0.01,))
+    bad = translate_plan(models, durations=(T_STRETCH * T_BOUNDS["translate"][1] + 0.01,))
+    assert verify_plan(ok).groups["time_grid"].ok
+    assert not verify_plan(bad).groups["time_grid"].ok

@@ -247,19 +247,40 @@ def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
     return xy
 
 
+def solve_stretched(build, options: SegmentOptions, solver: str):
+    """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
+    duration bound, build and solve it once more with the bound stretched (SegmentOptions
+    ``stretch``, :data:`~flipkit.behaviors.segments.T_STRETCH`). Returns (nlp, result): the
+    stretched one if it succeeded, else the first.
+
+    Raises:
+        FlipkitError: The first build fails (e.g. its initial guess).
+    """
+    nlp = build(options)
+    result = solve_segment(nlp, solver)
+    if result.success or options.stretch:
+        return nlp, result
+    try:
+        longer = build(replace(options, stretch=True))
+    except FlipkitError:
+        return nlp, result
+    second = solve_segment(longer, solver)
+    return (longer, second) if second.success else (nlp, result)
+
+
 def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0) -> Plan:
     """Solve the subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
     segments, failure = list(done), None
     for name in tg.SUBBEHAVIORS[len(done):]:
         try:
-            nlp = build_segment(name, models, q, qd, location=pb, land=spot, on_blade=on_blade,
-                                options=options)
+            nlp, result = solve_stretched(lambda o: build_segment(
+                name, models, q, qd, location=pb, land=spot, on_blade=on_blade, options=o),
+                options, solver)
         except FlipkitError as exc:
             if not segments:
                 raise
             failure = f"{name}: cannot build the initial guess ({exc})"
             break
-        result = solve_segment(nlp, solver)
         seg = Segment.from_solution(nlp, result)
         segments.append(seg)
         if not result.success:

@@ -23,7 +23,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.planner import (SOLVERS, _finish, _joint_vector, _on_blade,
-                                      _solver_failure, models_for, solve_segment)
+                                      _solver_failure, models_for, solve_stretched)
 from flipkit.planning.segment import Segment
 
 
@@ -93,14 +93,14 @@ def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -
     segments, failure = list(done), None
     for name in sv.SERVE_SUBBEHAVIORS[len(done):]:
         try:
-            nlp = build_segment(name, models, q, qd, location=pb, spot=spot, on_blade=on_blade,
-                                options=options)
+            nlp, result = solve_stretched(lambda o: build_segment(
+                name, models, q, qd, location=pb, spot=spot, on_blade=on_blade, options=o),
+                options, solver)
         except FlipkitError as exc:
             if not segments:
                 raise
             failure = f"{name}: cannot build the initial guess ({exc})"
             break
-        result = solve_segment(nlp, solver)
         seg = Segment.from_solution(nlp, result)
         if name in ("carry", "place"):
             seg.placing = placing_record(cell, spot, on_blade)

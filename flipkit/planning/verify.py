@@ -11,7 +11,7 @@ poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row'
 =================  ==========================================================  ==============
 group              what                                                        tolerance
 =================  ==========================================================  ==============
-time_grid          t_i = iT/N; T within the behaviour's T_BOUNDS (s)           1e-9 s; tol
+time_grid          t_i = iT/N; T within T_BOUNDS (upper × T_STRETCH) (s)       1e-9 s; tol
 dynamics           RNEA(q_i, q̇_i, q̈_i) − u_i, payload per segment (N·m)        tol·u_max/10
 defects            Hermite–Simpson interpolation and Simpson defects (rad,     tol
                    rad/s) at the odd nodes, x = (q, q̇), ẋ = (q̇, q̈)
@@ -67,7 +67,8 @@ from flipkit.behaviors.targets import SUBBEHAVIORS
 
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, grill_floor
+from flipkit.behaviors.segments import (SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, T_STRETCH,
+                                       grill_floor)
 from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, FlipkitError, VerificationError
 from flipkit.model.orientation import rpy
@@ -245,7 +246,8 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     """Time grid, dynamics, limits, defects, clearance, cone and behaviour of segment k."""
     N, T, add = seg.N, seg.T, report.add
     add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
-    add("time_grid", k, _outside(T, *T_BOUNDS[seg.name]), tol)
+    T_lo, T_hi = T_BOUNDS[seg.name]
+    add("time_grid", k, _outside(T, T_lo, T_STRETCH * T_hi), tol)
     dyn_tol = tol * robot.u_max / 10
     for i in range(N + 1):
         tau = robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
