@@ -214,7 +214,8 @@ def test_a_hood_over_the_elbow_is_seen_by_the_block(models):
     # verify, told of the hood, fails the same plan; without it the plan passes
     assert verify_plan(plan).groups["arm_clearance"].ok
     report = verify_plan(plan, space=cell.space)
-    assert not report.groups["arm_clearance"].ok and report.groups["arm_clearance"].segment == 0
+    # both segments pass under the hood (out and back along the same arc): either is worst
+    assert not report.groups["arm_clearance"].ok and report.groups["arm_clearance"].segment in (0, 1)
 
 
 # ------------------------------------------------------------------ verify

@@ -56,7 +56,9 @@ def test_step_satisfies_linearised_constraints_and_kkt(setup):
     qp = QPSubproblem(a)
     x = a.project(a.x0)
     c, J, g, h = _load(qp, a, x, box=10.0)
-    sol = qp.solve(eps=1e-9)
+    # eps 1e-9 on the full-space QP of a translate (with the arm's clearance and pitch rows)
+    # takes OSQP ~10⁴ ADMM iterations: more than its default cap
+    sol = qp.solve(eps=1e-9, max_iter=100_000)
     assert sol.status == "optimal"
     lin = c + J @ sol.d
     lo, hi = a.c_scale * a.c_lo, a.c_scale * a.c_hi

@@ -27,6 +27,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import (ConfigError, FlipkitError, InvalidChoiceError, SolverError,
                             UnreachableError)
 from flipkit.model.ik import solve_pose
+from flipkit.planning.inputs import check_joint_vector, check_position
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
 from flipkit.solvers.result import SolveResult, Status
@@ -85,40 +86,6 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     raise InvalidChoiceError("solver", solver, SOLVERS)
 
 
-def _position(what: str, value, cell: CellConfig) -> np.ndarray:
-    """``value`` as a finite 3-vector (m) inside the task-space box of ``cell``."""
-    try:
-        p = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{what} must be three numbers (m), got {value!r}") from None
-    if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ConfigError(f"{what} must be three finite numbers (m), got {np.ravel(p).tolist()}")
-    lo, hi = np.asarray(cell.limits.p_min), np.asarray(cell.limits.p_max)
-    if np.any(p < lo) or np.any(p > hi):
-        box = ", ".join(f"{a} in [{lo[k]:g}, {hi[k]:g}]" for k, a in enumerate("xyz"))
-        raise UnreachableError(f"{what} ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) m is outside the "
-                               f"reachable task area {box} m")
-    return p
-
-
-def _joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
-    """``value`` as a finite joint vector of len(lo) within [lo, hi]."""
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{what} must be {len(lo)} numbers ({unit}), got {value!r}") from None
-    if v.shape != np.shape(lo):
-        raise ConfigError(f"{what} must have {len(lo)} values ({unit}), got {v.size}")
-    if not np.all(np.isfinite(v)):
-        raise ConfigError(f"{what} must be finite, got {v.tolist()}")
-    bad = np.flatnonzero((v < lo) | (v > hi))
-    if bad.size:
-        j = int(bad[0])
-        raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
-                          f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
-    return v
-
-
 def _finish(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
     """Verify ``plan`` (against the space limits of ``cell``, which the file does not record);
     set status, ``failure``, ``report`` and ``wall_time_s``."""
@@ -164,21 +131,21 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
         raise InvalidChoiceError("solver", solver, SOLVERS)
     models = models_for(cell)
     robot = models.for_segment("translate")
-    p_goal = _position("translate goal", goal, cell)
+    p_goal = check_position("translate goal", goal, cell)
     if not np.isfinite(yaw):
         raise ConfigError(f"yaw must be finite (rad), got {yaw!r}")
     if q_start is None:
         if start is None:
             raise ConfigError("translate needs a start position or a start configuration")
-        p_start = _position("translate start", start, cell)
+        p_start = check_position("translate start", start, cell)
         try:
             q0 = solve_pose(robot, p_start, (0.0, 0.0, yaw), robot.q_home)
         except UnreachableError as exc:
             raise UnreachableError(f"translate start: {exc}") from None
     else:
-        q0 = _joint_vector("start configuration", q_start, robot.q_min, robot.q_max, "rad")
+        q0 = check_joint_vector("start configuration", q_start, robot.q_min, robot.q_max, "rad")
         if start is not None:
-            gap = np.linalg.norm(robot.position(q0) - _position("translate start", start, cell))
+            gap = np.linalg.norm(robot.position(q0) - check_position("translate start", start, cell))
             if gap > 1e-3:
                 raise ConfigError(f"start configuration puts the blade {gap * 1e3:.1f} mm from "
                                   "the start position; give one of them")
@@ -229,9 +196,9 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     on_blade = _on_blade(on_blade, cell)
     models = models_for(cell)
     robot = models.bare
-    q = robot.q_home.copy() if q_start is None else _joint_vector(
+    q = robot.q_home.copy() if q_start is None else check_joint_vector(
         "start configuration", q_start, robot.q_min, robot.q_max, "rad")
-    qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
+    qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
     return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0)
 

@@ -22,7 +22,8 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.planner import (SOLVERS, _finish, _joint_vector, _on_blade,
+from flipkit.planning.inputs import check_joint_vector
+from flipkit.planning.planner import (SOLVERS, _finish, _on_blade,
                                       _solver_failure, models_for, solve_stretched)
 from flipkit.planning.segment import Segment
 
@@ -74,9 +75,9 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     on_blade = _on_blade(on_blade, cell)
     models = models_for(cell)
     robot = models.bare
-    q = robot.q_home.copy() if q_start is None else _joint_vector(
+    q = robot.q_home.copy() if q_start is None else check_joint_vector(
         "start configuration", q_start, robot.q_min, robot.q_max, "rad")
-    qd = np.zeros(robot.nq) if qd_start is None else _joint_vector(
+    qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
     for what, pose in (("carry end", sv.carry_end(cell, spot, on_blade)),
                        ("place", sv.place_end(cell, spot, on_blade))):

@@ -1,0 +1,41 @@
+"""Which pairs of the arm's shapes and the cell's boxes each subbehaviour holds to the space
+margin (issue 13's space limits; paper Sec. I: "operate within the boundaries of the walls and
+grill"), and why the tool end is exempt where it works."""
+
+from __future__ import annotations
+
+# Space limits (issue 13; paper Sec. I: "operate within the boundaries of the walls and grill"):
+# every shape of the arm keeps cell.space.margin from every box of the cell, except the tool end
+# and the grill while the tool works on the grill. Going to the burger ends with the blade's tip
+# pressed into the grill, the scoop slides it pressed in and the pickup lifts it from there
+# (SCOOP_PRESS), and the handle is straight, on the flange's axis: with the blade flat on the
+# grill and the flange over it (burgers at x ≥ 0.78 m), the flange and wrist-2 housings reach
+# below the grill's surface (measured: wrist_3 −4 cm, wrist_2 −2 cm at (0.84, 0.12)). There the
+# blade's own floor is grill_clearance (its edges' heights); the other links keep the margin.
+# The flip starts where the pickup ends (eq. 25: 5 cm above the grill, where the flange's
+# housing can still lie 1 cm inside the grill's box), so it holds the tool end to the margin
+# from node FLIP_TOOL_FRACTION·N on: it lifts the tool end clear in its first quarter. It ends
+# FLIP_END_ALLOWANCE farther from the cell than the margin: the turn back starts with the
+# flip's end velocity and needs room to turn the arm away (measured at (0.75, 0.00): a flip
+# ending on the margin with the flange coming down at ~0.9 m/s, and no turn back from there
+# could keep it; 1.4 cm short at its first node).
+# Serving: the place puts the blade's tip 5 mm above the table and tilts it tip down, and the
+# return home first withdraws the blade along its own plane: the tool end works on the table
+# there as it works on the grill above, so the same tool shapes are exempt from the table (the
+# blade's height over the table is the place's own pivot constraint).
+TOOL_SHAPES = ("blade", "handle", "ee", "wrist_3", "wrist_2")  # ee: the URDF's ee_link box
+AT_GRILL = ("go_to_burger", "scoop", "pickup")
+AT_TABLE = ("place", "return_home")
+FLIP_TOOL_FRACTION = 0.25
+FLIP_END_ALLOWANCE = 0.03  # m, our choice: ≈ 0.9 m/s × the turn back's first node (0.06 s) / 2
+
+
+def clearance_excluded(name: str, node: int, N: int) -> frozenset:
+    """(shape, box) pairs segment ``name`` does not hold to the margin at ``node`` of 0..N
+    (see TOOL_SHAPES)."""
+    tool = frozenset((s, "grill") for s in TOOL_SHAPES)
+    if name in AT_GRILL or (name == "flip" and node < FLIP_TOOL_FRACTION * N):
+        return tool
+    if name in AT_TABLE:
+        return frozenset((s, "table") for s in TOOL_SHAPES)
+    return frozenset()

@@ -1,0 +1,43 @@
+"""Checks of the planner's inputs: positions in the task area and joint vectors in their
+limits, each a one-line error naming what is wrong."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, UnreachableError
+
+
+def check_position(what: str, value, cell: CellConfig) -> np.ndarray:
+    """``value`` as a finite 3-vector (m) inside the task-space box of ``cell``."""
+    try:
+        p = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{what} must be three numbers (m), got {value!r}") from None
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ConfigError(f"{what} must be three finite numbers (m), got {np.ravel(p).tolist()}")
+    lo, hi = np.asarray(cell.limits.p_min), np.asarray(cell.limits.p_max)
+    if np.any(p < lo) or np.any(p > hi):
+        box = ", ".join(f"{a} in [{lo[k]:g}, {hi[k]:g}]" for k, a in enumerate("xyz"))
+        raise UnreachableError(f"{what} ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) m is outside the "
+                               f"reachable task area {box} m")
+    return p
+
+
+def check_joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
+    """``value`` as a finite joint vector of len(lo) within [lo, hi]."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{what} must be {len(lo)} numbers ({unit}), got {value!r}") from None
+    if v.shape != np.shape(lo):
+        raise ConfigError(f"{what} must have {len(lo)} values ({unit}), got {v.size}")
+    if not np.all(np.isfinite(v)):
+        raise ConfigError(f"{what} must be finite, got {v.tolist()}")
+    bad = np.flatnonzero((v < lo) | (v > hi))
+    if bad.size:
+        j = int(bad[0])
+        raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
+                          f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
+    return v
