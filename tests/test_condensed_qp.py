@@ -101,13 +101,19 @@ def test_warm_start_cuts_iterations(segments):
 
 
 def test_sqp_condensed_and_full_space_agree(segments):
-    """The SQP takes the same path with either form of the subproblem."""
+    """The SQP reaches the same solution with either form of the subproblem. Since the arm's
+    clearance rows (issue 13: at each node the least distance over the arm's shapes and the
+    cell's boxes, piecewise smooth where the nearest pair changes) the two forms' rounding
+    differences — OSQP's tolerance on the full-space equalities, an exact LU in the condensed
+    form — can switch a nearest pair and the path: measured 11 (condensed) vs 14 (full)
+    iterations, objectives 6e-6 apart alone and 4.5e-5 apart in a full test run. Before them
+    the paths were identical (1e-6, same iteration count)."""
     nlp = segments["translate"]
     a = solve_sqp(nlp, options=SQPOptions(condense=True))
     b = solve_sqp(nlp, options=SQPOptions(condense=False))
     assert a.success and b.success
-    assert a.objective == pytest.approx(b.objective, rel=1e-6)
-    assert a.iterations == b.iterations
+    assert a.objective == pytest.approx(b.objective, rel=1e-4)
+    assert abs(a.iterations - b.iterations) <= 5
 
 
 def test_infeasible_linearisation_is_reported_not_raised():
