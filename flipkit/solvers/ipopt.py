@@ -41,6 +41,7 @@ import numpy as np
 
 from flipkit.errors import NoSolutionFound
 from flipkit.transcription.nlp import NLP
+from flipkit.solvers.threads import single_threaded_blas
 from flipkit.solvers.result import SolveResult, Status
 
 #: IPOPT return statuses treated as convergence (the violation is checked independently).
@@ -270,7 +271,8 @@ def _inconsistent_bounds(nlp: NLP) -> tuple[str, float] | None:
 
 def solve_ipopt(nlp: NLP, x0=None, options: IpoptOptions = IpoptOptions(),
                 raise_on_failure: bool = True) -> IpoptResult:
-    """Solve ``nlp`` with IPOPT (L-BFGS Hessian, MUMPS) from ``x0`` (default ``nlp.x0``).
+    """Solve ``nlp`` with IPOPT (L-BFGS Hessian, MUMPS) from ``x0`` (default ``nlp.x0``), BLAS
+    on one thread (:mod:`flipkit.solvers.threads`).
 
     Args:
         nlp: The collocation NLP.
@@ -294,6 +296,12 @@ def solve_ipopt(nlp: NLP, x0=None, options: IpoptOptions = IpoptOptions(),
             The exception carries the NLP, the status, the worst constraint group and its
             violation, and the result.
     """
+    with single_threaded_blas():
+        return _solve_ipopt(nlp, x0, options, raise_on_failure)
+
+
+def _solve_ipopt(nlp: NLP, x0, options: IpoptOptions, raise_on_failure: bool) -> IpoptResult:
+    """The body of :func:`solve_ipopt`."""
     t0 = time.perf_counter()
     D = nlp.x_scale
     x_start = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)

@@ -41,11 +41,29 @@ class Iterate:
         return self.f + rho * float(self.v.sum())
 
 
-def newton_correction(nlp: NLP, p: Iterate) -> np.ndarray:
+def newton_correction(nlp: NLP, p: Iterate, active: np.ndarray | None = None) -> np.ndarray:
     """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
-    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound."""
-    r = p.cs - np.clip(p.cs, nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi)
-    rows = np.flatnonzero((nlp.c_lo == nlp.c_hi) | (r != 0))
+    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound.
+
+    Args:
+        nlp: The NLP. p: The point to correct.
+        active: Optional (m,) side of each inequality row active in the subproblem that
+            produced ``p`` (+1 at its upper bound, −1 at its lower bound, 0 inactive). These
+            rows are held at that bound too: the second-order correction of a step keeps the
+            step's active set. Without them, the correction of the rows the step violated
+            pushes the rows it left exactly at their bounds — the landing disc and the cone
+            at the flip's optimum — out by as much (measured: in 9 of 14 corrections on a
+            Table I flip the summed violation grew).
+    """
+    lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    r = p.cs - np.clip(p.cs, lo, hi)
+    rows = (nlp.c_lo == nlp.c_hi) | (r != 0)
+    if active is not None:
+        held = (active != 0) & ~rows
+        bound = np.where(active > 0, hi, lo)
+        r = np.where(held & np.isfinite(bound), p.cs - bound, r)
+        rows |= held & np.isfinite(bound)
+    rows = np.flatnonzero(rows)
     JR = p.J[rows]
     K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
     delta = -(JR.T @ spla.spsolve(K, r[rows]))

@@ -37,12 +37,14 @@ class Dynamics(Block):
         return x
 
     def evaluate(self, ev):
-        vals, jac = [], []
-        for i in range(self.layout.n_nodes):
-            tau, dq, dqd, dqdd, du = ev.rnea(i)
-            vals.append(tau - ev.node(i)[3])
-            jac.append(np.hstack([dq, dqd, dqdd, du]).ravel())
-        return np.concatenate(vals), np.concatenate(jac)
+        n, nq = self.layout.n_nodes, self.layout.nq
+        vals, jac = np.empty((n, nq)), np.empty((n, nq, 4 * nq))
+        for i in range(n):  # row-major per node: ∂/∂q, ∂/∂q̇, ∂/∂q̈, ∂/∂u side by side
+            tau, *parts = ev.rnea(i)
+            vals[i] = tau - ev.node(i)[3]
+            for f, block in enumerate(parts):
+                jac[i, :, f * nq:(f + 1) * nq] = block
+        return vals.ravel(), jac.ravel()
 
 
 class HermiteSimpson(Block):
@@ -77,20 +79,21 @@ class HermiteSimpson(Block):
         self._finish(0.0, 0.0, np.tile(group, layout.N // 2))
 
     def evaluate(self, ev):
+        # All intervals at once, in the pattern's order: interval, x = q then q̇, δ then σ,
+        # then the six column groups (x_i / x_b, x_a, ẋ_a, ẋ_i / ẋ_b, ẋ_b, T) of nq entries.
         L, nodes, T = self.layout, self.layout.nodes(ev.x), ev.T
         dt, ddt = 2 * T / L.N, 2 / L.N
-        one = np.ones(L.nq)
-        vals, jac = [], []
-        for i in range(1, L.N, 2):
-            for k in (0, 1):  # x = q (k=0) or q̇ (k=1); ẋ is the next field
-                xa, xi, xb = nodes[i - 1, k], nodes[i, k], nodes[i + 1, k]
-                da, di, db = nodes[i - 1, k + 1], nodes[i, k + 1], nodes[i + 1, k + 1]
-                vals.append(xi - (xa + xb) / 2 - dt * (da - db) / 8)
-                jac += [one, -one / 2, -one / 2, -one * dt / 8, one * dt / 8, -ddt * (da - db) / 8]
-                s = da + 4 * di + db
-                vals.append(xb - xa - dt * s / 6)
-                jac += [one, -one, -one * dt / 6, -one * 4 * dt / 6, -one * dt / 6, -ddt * s / 6]
-        return np.concatenate(vals), np.concatenate(jac)
+        x = nodes[:, :3]  # (N+1, 3, nq): q, q̇, q̈
+        xa, xi, xb = x[0:-1:2, :2], x[1::2, :2], x[2::2, :2]  # (N/2, 2, nq): x = q, q̇
+        da, di, db = x[0:-1:2, 1:], x[1::2, 1:], x[2::2, 1:]  # their derivatives
+        s = da + 4 * di + db
+        vals = np.stack([xi - (xa + xb) / 2 - dt * (da - db) / 8, xb - xa - dt * s / 6], axis=2)
+        one = np.ones_like(xa)
+        jac = np.stack([
+            np.stack([one, -one / 2, -one / 2, -one * dt / 8, one * dt / 8, -ddt * (da - db) / 8], 2),
+            np.stack([one, -one, -one * dt / 6, -one * 4 * dt / 6, -one * dt / 6, -ddt * s / 6], 2),
+        ], axis=2)  # (N/2, 2, 2, 6, nq)
+        return vals.ravel(), jac.ravel()
 
 
 class BezierOutput(Block):
@@ -124,24 +127,23 @@ class BezierOutput(Block):
         self._finish(0.0, 0.0, scale)
 
     def evaluate(self, ev):
+        # All nodes at once, in the pattern's order: per node the q, q̇, q̈ entries (nq each),
+        # then per joint the M+1 α entries and T; then the two start rows per joint.
         L, e, T = self.layout, self.eps, ev.T
         nodes, alpha = L.nodes(ev.x), L.alpha(ev.x)
         B0, B1, B2 = self.B
-        one = np.ones(L.nq)
-        vals, jac = [], []
-        for i in range(L.n_nodes):
-            q, qd, qdd, _ = nodes[i]
-            c = B2[i] / T**2 + 2 * e * B1[i] / T + e**2 * B0[i]
-            dc = -2 * B2[i] / T**3 - 2 * e * B1[i] / T**2
-            vals.append(qdd + 2 * e * qd + e**2 * q - alpha @ c)
-            jac += [e**2 * one, 2 * e * one, one]
-            for j in range(L.nq):
-                jac.append(np.append(-c, -alpha[j] @ dc))
-        M = L.bezier.degree
-        q0, qd0 = nodes[0, 0], nodes[0, 1]
-        vals.append(q0 - alpha[:, 0])
-        jac += [np.array([1.0, -1.0])] * L.nq
-        vals.append(qd0 - M * (alpha[:, 1] - alpha[:, 0]) / T)
-        for j in range(L.nq):
-            jac.append(np.array([1.0, M / T, -M / T, M * (alpha[j, 1] - alpha[j, 0]) / T**2]))
-        return np.concatenate(vals), np.concatenate(jac)
+        nq, n, M = L.nq, L.n_nodes, L.bezier.degree
+        C = B2 / T**2 + 2 * e * B1 / T + e**2 * B0  # (N+1, M+1)
+        dC = -2 * B2 / T**3 - 2 * e * B1 / T**2
+        q, qd, qdd = nodes[:, 0], nodes[:, 1], nodes[:, 2]
+        vals = qdd + 2 * e * qd + e**2 * q - C @ alpha.T  # (N+1, nq)
+        per_joint = np.empty((n, nq, M + 2))
+        per_joint[:, :, : M + 1] = -C[:, None, :]
+        per_joint[:, :, M + 1] = -(dC @ alpha.T)
+        states = np.repeat(np.array([e**2, 2 * e, 1.0]), nq)
+        jac_nodes = np.concatenate([np.broadcast_to(states, (n, 3 * nq)), per_joint.reshape(n, -1)], 1)
+        a0, a1 = alpha[:, 0], alpha[:, 1]
+        start = np.column_stack([np.ones(nq), np.full(nq, M / T), np.full(nq, -M / T),
+                                 M * (a1 - a0) / T**2])
+        return (np.concatenate([vals.ravel(), q[0] - a0, qd[0] - M * (a1 - a0) / T]),
+                np.concatenate([jac_nodes.ravel(), np.tile([1.0, -1.0], nq), start.ravel()]))

@@ -86,8 +86,9 @@ class BladeEdgeHeights(Quantity):
 
     def __call__(self, st, ctx):
         l, w = ctx["length"] / 2, ctx["width"] / 2
-        parts = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
-        return np.concatenate([p[0] for p in parts]), np.vstack([p[1] for p in parts])
+        r = st.R @ np.array([[l, -l, 0.0, 0.0], [0.0, 0.0, w, -w], [0.0, 0.0, 0.0, 0.0]])
+        # height p_z + r_z; ∂/∂q: ∂p_z/∂q − (r × J_ω)_z = ∂p_z/∂q + r_y J_ωx − r_x J_ωy
+        return st.p[2] + r[2], st.dp_dq[2] + np.outer(r[1], st.Jw[0]) - np.outer(r[0], st.Jw[1])
 
 
 class Velocity(Quantity):
@@ -150,13 +151,14 @@ class KinematicBlock(Block):
                      np.broadcast_to(scale, shape).ravel())
 
     def evaluate(self, ev):
-        vals, jac = [], []
+        k, nq = self.quantity.size, self.layout.nq
+        vals = np.empty((len(self.nodes), k))
+        jac = np.empty((len(self.nodes), k, (self.quantity.order + 1) * nq))
         point = getattr(self.quantity, "point", None)
-        for i in self.nodes:
+        for r, i in enumerate(self.nodes):
             st = ev.state(i) if point is None else ev.point_state(i, point)
             out = self.quantity(st, self.ctx)
-            vals.append(out[0])
-            jac.append(np.hstack(out[1:]).ravel())
-        if not vals:
-            return np.zeros(0), np.zeros(0)
-        return np.concatenate(vals), np.concatenate(jac)
+            vals[r] = out[0]
+            for f, block in enumerate(out[1:]):  # ∂/∂q, ∂/∂q̇, ∂/∂q̈ side by side per row
+                jac[r, :, f * nq:(f + 1) * nq] = block
+        return vals.ravel(), jac.ravel()
