@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from flipkit.errors import InvalidChoiceError
+from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.transcription.nlp import NLP
 from flipkit.transcription.ocp_graph import OcpGraph
 from flipkit.solvers.result import SolveResult, Status
@@ -101,16 +101,29 @@ class ExactSolver:
                                   options.plugin_options(solver, self.graph))
         self.build_time_s = time.perf_counter() - t0
 
-    def solve(self, x0=None) -> SolveResult:
+    def solve(self, x0=None, graph: OcpGraph | None = None) -> SolveResult:
         """Solve from ``x0`` (unscaled; default ``nlp.x0``, clipped to the bounds).
+
+        Args:
+            x0: Start point of the NLP (unscaled).
+            graph: Solve this graph's NLP instead (its own bounds and start), with the solver
+                built for this one: their :attr:`OcpGraph.key` must be equal (e.g. two
+                translates between different poses).
 
         Returns:
             The result: ``x`` the unscaled NLP point (inside the bounds), ``objective`` the
             unscaled Σu² (N²·m²), ``iterations`` the solver's count, ``wall_time_s`` the solve
             alone (s), ``solver`` ``"fatrop"`` or ``"ipopt_exact"``; status ``"solved"``, or
             IPOPT's own failure status, ``"fatrop_failed"``, or ``"violation_above_tol"``.
+
+        Raises:
+            ConfigError: ``graph`` is not the same graph as this solver's (up to bounds).
         """
-        nlp, g = self.nlp, self.graph
+        g = self.graph if graph is None else graph
+        if g.key != self.graph.key:
+            raise ConfigError(f"segment {g.nlp.name!r}: its graph differs from the one this "
+                              f"{self.name} solver was built for")
+        nlp = g.nlp
         x_start = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
         t0 = time.perf_counter()
         sol = self.function(x0=g.from_nlp_point(x_start), lbx=g.lbx, ubx=g.ubx, lbg=g.lbg,

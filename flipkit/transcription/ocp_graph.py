@@ -23,6 +23,8 @@ the same solutions.
 
 from __future__ import annotations
 
+import hashlib
+
 import casadi as ca
 import numpy as np
 
@@ -143,6 +145,19 @@ class OcpGraph:
         self.lbg = np.where(gap, 0.0, nlp.c_scale[src] * nlp.c_lo[src])
         self.ubg = np.where(gap, 0.0, nlp.c_scale[src] * nlp.c_hi[src])
         self.constraints = ca.Function("g", [w], [self.problem["g"]])
+
+    @property
+    def key(self) -> str:
+        """Hash of the graph's functions (objective, rows), structure and scales: graphs with
+        equal keys differ only in their bounds (start state, targets, limits) and can share
+        one built solver."""
+        if not hasattr(self, "_key"):
+            h = hashlib.sha1(ca.Function("fg", [self.problem["x"]],
+                                         [self.problem["f"], self.problem["g"]]).serialize().encode())
+            for arr in (self.index, self.row_source, np.array(self.nx + self.nu + self.ng)):
+                h.update(np.ascontiguousarray(arr).tobytes())
+            self._key = h.hexdigest()
+        return self._key
 
     @property
     def structure(self) -> dict:
