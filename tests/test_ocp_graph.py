@@ -84,7 +84,8 @@ def test_stage_structure(translate):
     NLP's scaled Σu²."""
     nlp, graph = translate
     s = graph.structure
-    assert s["N"] == nlp.layout.N // 2 and len(s["nx"]) == len(s["nu"]) == len(s["ng"]) == s["N"] + 1
+    assert s["N"] == nlp.layout.N // 2
+    assert len(s["nx"]) == len(s["nu"]) == len(s["ng"]) == s["N"] + 1
     assert sum(s["nx"]) + sum(s["nu"]) == graph.n
     assert sum(s["nx"][1:]) + sum(s["ng"]) == graph.problem["g"].numel()
     assert set(graph.index) == set(range(nlp.n))

@@ -158,8 +158,8 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         for name in names:
             d, s = r[name], r["sqp"]
             both = d["status"] == s["status"] == "solved"
-            d["rel_objective_diff_vs_sqp"] = ((d["objective"] - s["objective"]) / abs(s["objective"])
-                                              if both else None)
+            d["rel_objective_diff_vs_sqp"] = (
+                (d["objective"] - s["objective"]) / abs(s["objective"]) if both else None)
             rel = d["rel_objective_diff_vs_sqp"]
             print(f"{r['segment']:<6}{TRANSLATE_SOLVERS[name]:<14}{d['time_s']:8.3f}"
                   f"{d['iterations']:5d}{d['objective']:12.6g}"
@@ -179,8 +179,8 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         print(f"{'':<6}{TRANSLATE_SOLVERS[name]:<14}{m['time_s']:8.3f}{m['iterations']:5.0f}"
               f"{m['max_abs_rel_objective_diff_vs_sqp']:12.1e}{m['solved']:>9d}/{len(rows)}")
     print(f"T = executed duration (s), bounds {T_BOUNDS['translate']} s; dJ = (J − J_SQP)/J_SQP, "
-          "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the solver "
-          "calls alone (FATROP's and exact IPOPT's without building their graphs)")
+          "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
+          "solver calls alone (FATROP's and exact IPOPT's without building their graphs)")
     return {"machine": machine(), "key_points": TRANSLATE_KEY_POINTS, "full": full, "jit": jit,
             "build_s": build, "rows": rows, "median": med}
 

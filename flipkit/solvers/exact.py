@@ -45,7 +45,8 @@ class ExactOptions:
         tol: Overall convergence tolerance (KKT residual, scaled).
         constr_viol_tol: Largest scaled violation accepted; also the independent check.
         max_iter: Iteration cap.
-        jit: Compile the graph's functions to C (CasADi JIT, ``-O1``) before solving.
+        jit: Compile the graph's functions to C before solving (CasADi JIT, ``-O0``: the
+            graph's C is ~40 MB; gcc -O1 on it ran for over 3 min and 3 GB, not finished).
         print_level: Solver verbosity (0 silent).
     """
 
@@ -60,7 +61,7 @@ class ExactOptions:
         common = {"print_time": False}
         if self.jit:
             common.update({"jit": True, "compiler": "shell",
-                           "jit_options": {"flags": ["-O1"], "verbose": False}})
+                           "jit_options": {"flags": ["-O0"], "verbose": False}})
         if solver == "fatrop":
             return {**common, **graph.structure, "structure_detection": "manual",
                     "fatrop": {"print_level": self.print_level, "max_iter": self.max_iter,

@@ -110,7 +110,8 @@ def _hermite_simpson(b: HermiteSimpson, acc) -> Rows:
             da, di, db = na[k + 1], ni[k + 1], nb[k + 1]
             delta = xi - (xa + xb) / 2 - dt * (da - db) / 8
             sigma = xb - xa - dt * (da + 4 * di + db) / 6
-            out.append((s, ca.vertcat(delta, sigma), np.arange(row, row + 2 * nq)))
+            out.append((s, delta, np.arange(row, row + nq)))
+            out.append((s, sigma, np.arange(row + nq, row + 2 * nq)))
             row += 2 * nq
     return out
 
