@@ -3,7 +3,8 @@
 import pytest
 
 from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
-from flipkit.errors import InvalidChoiceError
+from flipkit.config import TABLE1_LOCATIONS
+from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.exact import ExactSolver, solve_exact
 from flipkit.solvers.sqp import solve_sqp
@@ -46,3 +47,13 @@ def test_agrees_with_sqp(translate, sqp, graph, solver):
 def test_unknown_solver(translate):
     with pytest.raises(InvalidChoiceError, match="fatrop"):
         solve_exact(translate, "snopt")
+
+
+def test_other_graph_refused(cell, translate, graph):
+    """A solver built for one graph does not solve another one's NLP."""
+    models = Models(cell)
+    pickup = OcpGraph(build_segment("pickup", models, models.bare.q_home,
+                                    location=TABLE1_LOCATIONS[1],
+                                    options=SegmentOptions(arm_clearance=False)))
+    with pytest.raises(ConfigError, match="differs"):
+        ExactSolver(translate, "ipopt", graph=graph).solve(graph=pickup)

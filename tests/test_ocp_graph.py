@@ -101,3 +101,13 @@ def test_clearance_rows_have_no_symbolic_form(models):
     assert "arm_clearance" in nlp.block_slices
     with pytest.raises(NoSymbolicFormError, match="arm_clearance"):
         OcpGraph(nlp)
+
+
+def test_key_shared_by_translates_only(models, translate, pickup):
+    """Two translates between other poses differ only in their bounds: one built solver serves
+    both (bench relies on it); a pickup's graph is another."""
+    q0 = solve_pose(models.loaded, (0.45, 0.74, 0.19), (0, 0, 0))
+    other = OcpGraph(build_segment("translate", models, q0, goal=flat_pose((0.32, 0.62, 0.20)),
+                                   options=NO_CLEARANCE))
+    assert other.key == translate[1].key != pickup[1].key
+    assert not np.array_equal(other.lbg, translate[1].lbg)
