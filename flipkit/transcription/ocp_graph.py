@@ -7,7 +7,8 @@ solver (FATROP) needs them. With K = N/2 Hermite–Simpson intervals:
 
 * stage k < K holds the state x_k = (q_2k, q̇_2k, q̈_2k, α, T) and the controls
   u_k = (u_2k, q_2k+1, q̇_2k+1, q̈_2k+1, u_2k+1, q'_2k+2, q̇'_2k+2, q̈'_2k+2): the midpoint node
-  and a copy of the next interval's start, on which the interval's defects are stated;
+  and a copy of the interval's end node (the next stage's), on which the interval's defects
+  are stated;
 * the gap rows x_{k+1} − (q'_2k+2, q̇'_2k+2, q̈'_2k+2, α, T) = 0 carry the copies, the Bezier
   coefficients and the duration to the next stage;
 * the last stage K holds x_K = (q_N, q̇_N, q̈_N, α, T) and u_K = u_N.
