@@ -72,3 +72,9 @@ class SingularBasisError(SolverError):
 
 class VerificationError(FlipkitError):
     """A plan that fails the independent residual check."""
+
+
+class NoSymbolicFormError(FlipkitError):
+    """A constraint block that cannot be stated as a CasADi symbolic expression (the arm's
+    clearance rows, coal distances), asked for by an exact-derivative solver (FATROP,
+    exact-Hessian IPOPT)."""

@@ -90,6 +90,10 @@ class SegmentOptions:
             (``flipkit verify`` then fails its ``landing`` group).
         stretch: Allow the duration up to T_STRETCH × the upper bound of T_BOUNDS (the
             planner's second attempt at a segment infeasible within its bound).
+        arm_clearance: Impose the whole arm's space limits (coal distances to the cell's
+            boxes). ``False`` leaves them out: the problem that exact-derivative solvers
+            (FATROP, exact-Hessian IPOPT; :mod:`flipkit.transcription.ocp_graph`) and the SQP
+            can all be given, for the solver comparison of ``bench``.
     """
 
     N: int = 20
@@ -100,6 +104,7 @@ class SegmentOptions:
     landing: bool = True
     mu_safety: float = MU_SAFETY
     stretch: bool = False
+    arm_clearance: bool = True
 
     def __post_init__(self):
         if self.epsilon <= 0 or not np.isfinite(self.epsilon):
@@ -248,8 +253,9 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     margins = np.full(L.N, cell.space.margin)  # nodes 1..N
     if name == "flip":
         margins[-1] += FLIP_END_ALLOWANCE
-    blocks.append(ArmClearance(L, models.shapes, moving,
-                               lambda i: clearance_excluded(name, i, L.N), margins))
+    if options.arm_clearance:
+        blocks.append(ArmClearance(L, models.shapes, moving,
+                                   lambda i: clearance_excluded(name, i, L.N), margins))
     # Orientation limits (Constraint 1, eq. 4): the pitch; roll and yaw are free (TaskLimits).
     blocks.append(KinematicBlock("task_orientation", L, "pitch", moving, *lim.pitch_range))
     # the burger's contact acceleration is that of the blade point under its centre

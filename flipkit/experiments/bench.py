@@ -1,10 +1,14 @@
 """Solve-time benchmarks against the paper's budgets: SQP (cvxpy/OSQP) beside IPOPT.
 
-    python -m flipkit.experiments.bench translate [--json OUT]
+    python -m flipkit.experiments.bench translate [--full] [--jit] [--json OUT]
     python -m flipkit.experiments.bench flip [--locations N] [--batch K] [--json OUT]
 
 ``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
-NLP solved by both solvers from the same start point ``nlp.x0``. ``flip``: the full
+NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP and
+exact-Hessian IPOPT (:mod:`flipkit.solvers.exact`, on the NLP's stage-wise CasADi graph) and
+IPOPT with L-BFGS through callbacks, all on the same scaled NLP — without the arm's clearance
+rows, which have no symbolic form (``--full``: the planner's NLP with them, the SQP and
+L-BFGS IPOPT only). ``flip``: the full
 pickup-and-flip (five segments) at the first N Table I locations with both solvers, then
 a batch of the first K locations with the SQP, beside the paper's budgets (Sec. I: < 20 s
 per trajectory, 4–5 burgers within 90 s). Times are wall-clock seconds of the solver calls
@@ -27,12 +31,14 @@ import warnings
 import numpy as np
 
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import T_BOUNDS, build_segment, flat_pose
+from flipkit.behaviors.segments import T_BOUNDS, SegmentOptions, build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
 from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.sqp import SQPOptions, solve_sqp
+from flipkit.transcription.ocp_graph import OcpGraph
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
 # table), blade-centre positions (m) with the spatula flat, yaw 0. Grill: h_g = 0.072 m,
@@ -75,49 +81,113 @@ def _med(values) -> float:
     return statistics.median(values) if values else float("nan")
 
 
-def bench_translate(cell: CellConfig) -> dict:
-    """Solve the six translate segments with both solvers; print the table; return rows."""
+# The translate comparison's solvers: the SQP and IPOPT (L-BFGS, callbacks) on the NLP, FATROP
+# and exact-Hessian IPOPT on its SX graph (flipkit.solvers.exact); labels for the table.
+TRANSLATE_SOLVERS = {"sqp": "SQP", "fatrop": "FATROP", "ipopt_exact": "IPOPT exact",
+                     "ipopt": "IPOPT L-BFGS"}
+
+
+def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
+    """FATROP and exact-Hessian IPOPT for each graph, built once per distinct graph
+    (:attr:`OcpGraph.key`: the translates differ only in their bounds); build times (s)."""
+    solvers, build = {}, {}
+    for name, plugin in (("fatrop", "fatrop"), ("ipopt_exact", "ipopt")):
+        for g in graphs:
+            key = (plugin, g.key, jit)
+            if key not in cache:
+                cache[key] = ExactSolver(g.nlp, plugin, ExactOptions(jit=jit), graph=g)
+                build[name] = build.get(name, 0.0) + cache[key].build_time_s
+            solvers[(name, id(g))] = cache[key]
+    return solvers, build
+
+
+def _translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
     models = models_for(cell)
     robot = models.for_segment("translate")
-    pts = TRANSLATE_KEY_POINTS
-    nlps = []
+    pts, nlps = TRANSLATE_KEY_POINTS, []
     for k, a in enumerate(pts):
         q0 = solve_pose(robot, a, (0.0, 0.0, 0.0), robot.q_home)
-        nlps.append(build_segment("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)])))
+        nlps.append(build_segment("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)]),
+                                  options=options))
+    return nlps
+
+
+def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> dict:
+    """Solve the six translate segments with every solver; print the table; return rows.
+
+    Args:
+        cell: The cell.
+        full: The planner's NLP with the arm's clearance rows (coal distances, no symbolic
+            form): the SQP and L-BFGS IPOPT only. Default: the comparison NLP without them,
+            solved by the SQP, FATROP, exact-Hessian IPOPT and L-BFGS IPOPT, all on the same
+            scaled problem from the same start ``nlp.x0``.
+        jit: Compile FATROP's and exact IPOPT's functions to C (CasADi JIT).
+    """
+    names = ("sqp", "ipopt") if full else tuple(TRANSLATE_SOLVERS)
+    nlps = _translate_nlps(cell, SegmentOptions(arm_clearance=full))
     print(machine())
+    print(f"problem: translate NLP {'with' if full else 'without'} the arm's clearance rows"
+          f"{'' if full else ' (no symbolic form: left out for every solver)'}; "
+          f"{nlps[0].n} variables, {nlps[0].m} rows")
     print(f"warm-up: one SQP iteration on the translate structure (cvxpy compile): "
           f"{warm_up(nlps[:1]):.1f} s, not counted below")
-    head = (f"{'seg':<6}{'SQP s':>8}{'it':>5}{'objective':>11}{'status':>11}{'T s':>6} |"
-            f"{'IPOPT s':>8}{'it':>5}{'objective':>11}{'status':>11}{'T s':>6} |{'rel dJ':>9}")
-    print(head, flush=True)
+    build = {}
+    if not full:
+        t0 = time.perf_counter()
+        graphs = [OcpGraph(nlp) for nlp in nlps]
+        build["graphs"] = time.perf_counter() - t0
+        exact, more = _exact_solvers(graphs, jit, {})
+        build.update(more)
+        print("build, not counted below: SX graphs of the six NLPs " + ", ".join(
+            f"{k} {v:.1f} s" for k, v in build.items()) + f" ({len(set(g.key for g in graphs))}"
+            f" distinct graph(s){', JIT-compiled' if jit else ''}); "
+            f"FATROP structure N={graphs[0].K}, nx={graphs[0].nx[0]}, nu={graphs[0].nu[0]}")
+    print(f"{'seg':<6}{'solver':<14}{'time s':>8}{'it':>5}{'objective':>12}{'dJ vs SQP':>11}"
+          f"{'status':>14}{'T s':>6}", flush=True)
     rows = []
     for k, nlp in enumerate(nlps):
-        r = {"segment": f"{k + 1}->{(k + 1) % len(pts) + 1}"}
-        for name in ("sqp", "ipopt"):
-            res = solve_segment(nlp, name)
+        r = {"segment": f"{k + 1}->{(k + 1) % len(nlps) + 1}"}
+        for name in names:
+            if name in ("fatrop", "ipopt_exact"):
+                res = exact[(name, id(graphs[k]))].solve(graph=graphs[k])
+            else:
+                res = solve_segment(nlp, name)
             r[name] = {"time_s": res.wall_time_s, "iterations": res.iterations,
-                       "objective": res.objective, "status": res.status,
+                       "objective": res.objective, "status": str(res.status),
                        "T_s": float(res.x[nlp.layout.T_index])}
-        s, i = r["sqp"], r["ipopt"]
-        both = s["status"] == i["status"] == "solved"
-        r["rel_objective_diff"] = ((s["objective"] - i["objective"]) / abs(i["objective"])
-                                   if both else None)
+        for name in names:
+            d, s = r[name], r["sqp"]
+            both = d["status"] == s["status"] == "solved"
+            d["rel_objective_diff_vs_sqp"] = (
+                (d["objective"] - s["objective"]) / abs(s["objective"]) if both else None)
+            rel = d["rel_objective_diff_vs_sqp"]
+            print(f"{r['segment']:<6}{TRANSLATE_SOLVERS[name]:<14}{d['time_s']:8.3f}"
+                  f"{d['iterations']:5d}{d['objective']:12.6g}"
+                  f"{(f'{rel:11.1e}' if rel is not None else '-'.rjust(11))}"
+                  f"{d['status'][:13]:>14}{d['T_s']:6.2f}", flush=True)
         rows.append(r)
-        rel = f"{r['rel_objective_diff']:9.1e}" if both else f"{'-':>9}"
-        print(f"{r['segment']:<6}" + " |".join(
-            f"{d['time_s']:8.2f}{d['iterations']:5d}{d['objective']:11.4g}{d['status'][:10]:>11}"
-            f"{d['T_s']:6.2f}" for d in (s, i)) + f" |{rel}", flush=True)
     med = {name: {key: _med([r[name][key] for r in rows])
-                  for key in ("time_s", "iterations", "T_s")} for name in ("sqp", "ipopt")}
-    med["rel_objective_diff"] = _med([r["rel_objective_diff"] for r in rows])
-    print(f"{'median':<6}" + " |".join(
-        f"{med[n]['time_s']:8.2f}{med[n]['iterations']:5.0f}{'':>22}{med[n]['T_s']:6.2f}"
-        for n in ("sqp", "ipopt")) + f" |{med['rel_objective_diff']:9.1e}")
-    solved = {n: sum(r[n]["status"] == "solved" for r in rows) for n in ("sqp", "ipopt")}
-    print(f"solved: SQP {solved['sqp']}/{len(rows)}, IPOPT {solved['ipopt']}/{len(rows)}; "
-          f"T = executed duration (s), bounds {T_BOUNDS['translate']} s; "
-          "rel dJ = (J_SQP − J_IPOPT)/J_IPOPT")
-    return {"machine": machine(), "key_points": pts, "rows": rows, "median": med}
+                  for key in ("time_s", "iterations", "T_s")} for name in names}
+    for name in names:
+        med[name]["max_abs_rel_objective_diff_vs_sqp"] = max(
+            (abs(r[name]["rel_objective_diff_vs_sqp"]) for r in rows
+             if r[name]["rel_objective_diff_vs_sqp"] is not None), default=float("nan"))
+        med[name]["solved"] = sum(r[name]["status"] == "solved" for r in rows)
+        med[name]["ms_per_iteration"] = 1e3 * _med(
+            [r[name]["time_s"] / r[name]["iterations"] for r in rows if r[name]["iterations"]])
+    print(f"{'median':<7}{'solver':<13}{'time s':>8}{'it':>5}{'ms/it':>7}{'max |dJ|':>10}"
+          f"{'solved':>9}")
+    for name in names:
+        m = med[name]
+        print(f"{'':<6}{TRANSLATE_SOLVERS[name]:<14}{m['time_s']:8.3f}{m['iterations']:5.0f}"
+              f"{m['ms_per_iteration']:7.0f}{m['max_abs_rel_objective_diff_vs_sqp']:10.1e}"
+              f"{m['solved']:>7d}/{len(rows)}")
+    print(f"T = executed duration (s), bounds {T_BOUNDS['translate']} s; dJ = (J − J_SQP)/J_SQP "
+          "over the segments both solved, ms/it = median time per iteration, "
+          "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
+          "solver calls alone (FATROP's and exact IPOPT's without building their graphs)")
+    return {"machine": machine(), "key_points": TRANSLATE_KEY_POINTS, "full": full, "jit": jit,
+            "build_s": build, "rows": rows, "median": med}
 
 
 def _flip_row(plan) -> dict:
@@ -204,13 +274,19 @@ def main(argv=None) -> int:
                         help="flip: the first N Table I locations (default all ten)")
     parser.add_argument("--batch", type=int, default=5, metavar="K",
                         help="flip: batch of the first K locations with the SQP (0: none)")
+    parser.add_argument("--full", action="store_true",
+                        help="translate: the planner's NLP with the arm's clearance rows, SQP and "
+                             "L-BFGS IPOPT only (default: the comparison NLP without them, four "
+                             "solvers)")
+    parser.add_argument("--jit", action="store_true",
+                        help="translate: JIT-compile FATROP's and exact IPOPT's functions")
     parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
     args = parser.parse_args(argv)
     if not 1 <= args.locations <= len(TABLE1_LOCATIONS) or not 0 <= args.batch <= 5:
         parser.error(f"--locations must be 1..{len(TABLE1_LOCATIONS)} and --batch 0..5")
     warnings.filterwarnings("ignore", message="Solution may be inaccurate")
     cell = CellConfig()
-    result = (bench_translate(cell) if args.which == "translate"
+    result = (bench_translate(cell, args.full, args.jit) if args.which == "translate"
               else bench_flip(cell, args.locations, args.batch))
     if args.json:
         with open(args.json, "w") as fh:

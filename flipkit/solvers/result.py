@@ -26,6 +26,7 @@ class Status(StrEnum):
     QP_SOLVER_ERROR = "qp_solver_error"  #: SQP: OSQP broke down inside a subproblem
     INCONSISTENT_BOUNDS = "inconsistent_bounds"  #: a lower bound above its upper bound
     VIOLATION_ABOVE_TOL = "violation_above_tol"  #: IPOPT converged, our violation check did not
+    FATROP_FAILED = "fatrop_failed"  #: FATROP did not report success
     # IPOPT's failure statuses, verbatim.
     INFEASIBLE_PROBLEM_DETECTED = "Infeasible_Problem_Detected"
     SEARCH_DIRECTION_TOO_SMALL = "Search_Direction_Becomes_Too_Small"

@@ -1,2 +1,3 @@
 """Transcription layer: the collocation variable layout, initial guesses, the fixed-sparsity
-constraint blocks and the NLP that stacks them. Imports the model layer and below."""
+constraint blocks and the NLP that stacks them, and the NLP restated as one stage-wise CasADi
+SX graph. Imports the model layer and below."""

@@ -1,0 +1,155 @@
+"""FATROP and exact-Hessian IPOPT on the segment NLP stated as one CasADi SX graph.
+
+The peers of the SQP on the very same problem: :class:`~flipkit.transcription.ocp_graph.
+OcpGraph` states the segment's NLP — same rows, bounds, variable and row scales, and the
+SQP's scaled objective obj_scale · Σ u_i² — stage by stage with exact first and second
+derivatives (CasADi's SX algorithmic differentiation).
+
+* ``fatrop``: FATROP, the structure-exploiting interior-point solver for optimal control
+  shipped in CasADi's wheel, given the stage structure by hand (``structure_detection:
+  manual`` with the graph's N, nx, nu, ng; the automatic detection takes the last stage's
+  inverse-dynamics rows for a gap-closing step). FATROP has no automatic scaling: it gets the
+  scaled problem the SQP solves.
+* ``ipopt``: IPOPT with the exact Hessian of the Lagrangian (MUMPS) on the same graph;
+  :mod:`flipkit.solvers.ipopt` is IPOPT with an L-BFGS Hessian through callbacks on the
+  numerical NLP.
+
+Building a solver (the graph, its derivatives, optionally JIT-compiled C) is done once per
+problem by :class:`ExactSolver`; :meth:`ExactSolver.solve` times the solve alone. A solve is
+``"solved"`` only if the solver reports success and the maximum scaled violation recomputed
+by :meth:`NLP.evaluate` at the returned point (clipped to the bounds) is at most
+``constr_viol_tol`` — the SQP's criterion.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.transcription.nlp import NLP
+from flipkit.transcription.ocp_graph import OcpGraph
+from flipkit.solvers.result import SolveResult, Status
+
+EXACT_SOLVERS = ("fatrop", "ipopt")
+
+
+@dataclass(frozen=True)
+class ExactOptions:
+    """Settings of both exact-derivative solvers (tolerances in the scaled units).
+
+    Attributes:
+        tol: Overall convergence tolerance (KKT residual, scaled).
+        constr_viol_tol: Largest scaled violation accepted; also the independent check.
+        max_iter: Iteration cap.
+        jit: Compile the graph's functions to C before solving (CasADi JIT, ``-O0``: the
+            graph's C is ~40 MB; gcc -O1 on it ran for over 3 min and 3 GB, not finished).
+        print_level: Solver verbosity (0 silent).
+    """
+
+    tol: float = 1e-8
+    constr_viol_tol: float = 1e-6
+    max_iter: int = 1000
+    jit: bool = False
+    print_level: int = 0
+
+    def plugin_options(self, solver: str, graph: OcpGraph) -> dict:
+        """The :func:`casadi.nlpsol` options of ``solver`` for ``graph``."""
+        common = {"print_time": False}
+        if self.jit:
+            common.update({"jit": True, "compiler": "shell",
+                           "jit_options": {"flags": ["-O0"], "verbose": False}})
+        if solver == "fatrop":
+            return {**common, **graph.structure, "structure_detection": "manual",
+                    "fatrop": {"print_level": self.print_level, "max_iter": self.max_iter,
+                               "tol": self.tol, "constr_viol_tol": self.constr_viol_tol}}
+        return {**common, "ipopt": {"print_level": self.print_level, "sb": "yes",
+                                    "linear_solver": "mumps", "tol": self.tol,
+                                    "constr_viol_tol": self.constr_viol_tol,
+                                    "max_iter": self.max_iter,
+                                    "hessian_approximation": "exact"}}
+
+
+class ExactSolver:
+    """One solver (FATROP or exact-Hessian IPOPT) built for one segment NLP.
+
+    Args:
+        nlp: The NLP (every block with a symbolic form; e.g. built with
+            ``SegmentOptions(arm_clearance=False)``).
+        solver: ``"fatrop"`` or ``"ipopt"``.
+        options: Settings.
+        graph: The NLP's stage-wise graph, when already built (it can be shared).
+
+    Attributes:
+        build_time_s: Wall time (s) of building the graph (when not given) and the solver.
+
+    Raises:
+        InvalidChoiceError: ``solver`` is not one of :data:`EXACT_SOLVERS`.
+        NoSymbolicFormError: A block of ``nlp`` has no symbolic form.
+    """
+
+    def __init__(self, nlp: NLP, solver: str = "fatrop", options: ExactOptions = ExactOptions(),
+                 graph: OcpGraph | None = None):
+        if solver not in EXACT_SOLVERS:
+            raise InvalidChoiceError("exact-derivative solver", solver, EXACT_SOLVERS)
+        t0 = time.perf_counter()
+        self.nlp, self.name, self.options = nlp, solver, options
+        self.graph = graph or OcpGraph(nlp)
+        self.function = ca.nlpsol(f"{solver}_{nlp.name}", solver, self.graph.problem,
+                                  options.plugin_options(solver, self.graph))
+        self.build_time_s = time.perf_counter() - t0
+
+    def solve(self, x0=None, graph: OcpGraph | None = None) -> SolveResult:
+        """Solve from ``x0`` (unscaled; default ``nlp.x0``, clipped to the bounds).
+
+        Args:
+            x0: Start point of the NLP (unscaled).
+            graph: Solve this graph's NLP instead (its own bounds and start), with the solver
+                built for this one: their :attr:`OcpGraph.key` must be equal (e.g. two
+                translates between different poses).
+
+        Returns:
+            The result: ``x`` the unscaled NLP point (inside the bounds), ``objective`` the
+            unscaled Σu² (N²·m²), ``iterations`` the solver's count, ``wall_time_s`` the solve
+            alone (s), ``solver`` ``"fatrop"`` or ``"ipopt_exact"``; status ``"solved"``, or
+            IPOPT's own failure status, ``"fatrop_failed"``, or ``"violation_above_tol"``.
+
+        Raises:
+            ConfigError: ``graph`` is not the same graph as this solver's (up to bounds).
+        """
+        g = self.graph if graph is None else graph
+        if g.key != self.graph.key:
+            raise ConfigError(f"segment {g.nlp.name!r}: its graph differs from the one this "
+                              f"{self.name} solver was built for")
+        nlp = g.nlp
+        x_start = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
+        t0 = time.perf_counter()
+        sol = self.function(x0=g.from_nlp_point(x_start), lbx=g.lbx, ubx=g.ubx, lbg=g.lbg,
+                            ubg=g.ubg)
+        wall = time.perf_counter() - t0
+        stats = self.function.stats()
+        x = np.clip(g.to_nlp_point(sol["x"]), nlp.x_lb, nlp.x_ub)
+        violation = float(nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0))
+        if stats.get("success", False):
+            status = (Status.SOLVED if violation <= self.options.constr_viol_tol
+                      else Status.VIOLATION_ABOVE_TOL)
+        elif self.name == "ipopt":
+            status = Status.from_ipopt(str(stats.get("return_status", "")))
+        else:
+            status = Status.FATROP_FAILED
+        return SolveResult(x=x, status=status, iterations=int(stats.get("iter_count", 0)),
+                           wall_time_s=wall, objective=nlp.objective(x), max_violation=violation,
+                           solver="fatrop" if self.name == "fatrop" else "ipopt_exact")
+
+
+def solve_exact(nlp: NLP, solver: str = "fatrop", x0=None,
+                options: ExactOptions = ExactOptions()) -> SolveResult:
+    """Build :class:`ExactSolver` for ``nlp`` and solve from ``x0``; ``wall_time_s`` counts the
+    solve alone (the build time is the solver's ``build_time_s``)."""
+    return ExactSolver(nlp, solver, options).solve(x0)
+
+
+__all__ = ["EXACT_SOLVERS", "ExactOptions", "ExactSolver", "solve_exact"]

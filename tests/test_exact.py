@@ -1,0 +1,59 @@
+"""FATROP and exact-Hessian IPOPT (flipkit.solvers.exact) against the SQP, on the same NLP."""
+
+import pytest
+
+from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
+from flipkit.config import TABLE1_LOCATIONS
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.model.ik import solve_pose
+from flipkit.solvers.exact import ExactSolver, solve_exact
+from flipkit.solvers.sqp import solve_sqp
+from flipkit.transcription.ocp_graph import OcpGraph
+
+
+@pytest.fixture(scope="module")
+def translate(cell):
+    """The first translate of bench (key point 1 to 2), without the arm's clearance rows."""
+    models = Models(cell)
+    q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
+    return build_segment("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
+                         options=SegmentOptions(arm_clearance=False))
+
+
+@pytest.fixture(scope="module")
+def sqp(translate):
+    return solve_sqp(translate, raise_on_failure=False)
+
+
+@pytest.fixture(scope="module")
+def graph(translate):
+    return OcpGraph(translate)
+
+
+@pytest.mark.parametrize("solver", ["fatrop", "ipopt"])
+def test_agrees_with_sqp(translate, sqp, graph, solver):
+    """Both solve the segment, feasible by the NLP's own check, with Σu² within 1 % of the
+    SQP's (a wrong row, scale or objective in the graph moves the optimum)."""
+    result = ExactSolver(translate, solver, graph=graph).solve()
+    assert sqp.success, sqp.status
+    assert result.success, (result.status, result.max_violation)
+    assert result.solver == ("fatrop" if solver == "fatrop" else "ipopt_exact")
+    assert result.iterations > 0 and result.max_violation <= 1e-6
+    assert abs(result.objective - sqp.objective) <= 0.01 * abs(sqp.objective)
+    T = translate.layout.T_index
+    assert result.x[T] == pytest.approx(sqp.x[T], abs=0.02)
+
+
+def test_unknown_solver(translate):
+    with pytest.raises(InvalidChoiceError, match="fatrop"):
+        solve_exact(translate, "snopt")
+
+
+def test_other_graph_refused(cell, translate, graph):
+    """A solver built for one graph does not solve another one's NLP."""
+    models = Models(cell)
+    pickup = OcpGraph(build_segment("pickup", models, models.bare.q_home,
+                                    location=TABLE1_LOCATIONS[1],
+                                    options=SegmentOptions(arm_clearance=False)))
+    with pytest.raises(ConfigError, match="differs"):
+        ExactSolver(translate, "ipopt", graph=graph).solve(graph=pickup)
