@@ -78,3 +78,8 @@ class NoSymbolicFormError(FlipkitError):
     """A constraint block that cannot be stated as a CasADi symbolic expression (the arm's
     clearance rows, coal distances), asked for by an exact-derivative solver (FATROP,
     exact-Hessian IPOPT)."""
+
+
+class AtlasError(FlipkitError):
+    """A warm-start atlas that cannot be read, or was built for other planning options, another
+    cell or an NLP that has changed since (rebuild it with ``flipkit atlas build``)."""

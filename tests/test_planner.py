@@ -5,6 +5,7 @@ import pytest
 from test_plan import models  # noqa: F401  (fixture)
 
 import flipkit.planning.planner as planner
+import flipkit.planning.chain as chain
 from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
@@ -56,7 +57,7 @@ def _fake_solver(status):
 
 
 def test_solver_failure_is_reported_with_group(monkeypatch):
-    monkeypatch.setattr(planner, "solve_segment", _fake_solver("max_iter"))
+    monkeypatch.setattr(chain, "solve_segment", _fake_solver("max_iter"))
     plan = plan_translate(GRILL_A, GRILL_B, solver="ipopt")
     assert plan.status == "failed"
     assert plan.failure.startswith("translate: ") and "violated by" in plan.failure
@@ -67,7 +68,7 @@ def test_solver_failure_is_reported_with_group(monkeypatch):
 
 
 def test_solved_claim_is_overruled_by_verification(monkeypatch):
-    monkeypatch.setattr(planner, "solve_segment", _fake_solver("solved"))
+    monkeypatch.setattr(chain, "solve_segment", _fake_solver("solved"))
     plan = plan_translate(GRILL_A, GRILL_B)
     assert plan.segments[0].solver.status == "solved"
     assert plan.status == "failed" and plan.failure.endswith("(verify)")

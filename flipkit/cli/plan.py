@@ -72,6 +72,10 @@ def register(subparsers) -> None:
                    help="landing spot X Y (m) on the grill; default where the burger lies")
     f.add_argument("--r-land", default="0.02", metavar="M",
                    help="radius (m) of the landing disc about the spot (default 0.02)")
+    f.add_argument("--atlas", metavar="FILE",
+                   help="warm-start atlas (`flipkit atlas build`); default: the package's "
+                        "atlas when it serves these options, else cold starts")
+    f.add_argument("--no-atlas", action="store_true", help="cold starts (no atlas)")
     common(f)
     f.set_defaults(run=run_flip)
 
@@ -203,9 +207,32 @@ def run_flip(args: argparse.Namespace) -> int:
     q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
     land = None if args.land is None else _numbers("--land", args.land, 2)
     options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
-    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options)
+    atlas = _atlas(args, options)
+    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
+                     atlas=atlas)
     plan.to_json(args.json)
+    if atlas is not None:
+        print(f"  warm start: atlas of {len(atlas)} locations")
     return _report(plan, args.json)
+
+
+def _atlas(args: argparse.Namespace, options):
+    """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
+    package's when it exists and serves ``options``, else ``None`` (cold starts)."""
+    from flipkit.config import CellConfig
+    from flipkit.errors import AtlasError
+    from flipkit.planning.atlas import Atlas, default_path
+
+    if args.no_atlas:
+        return None
+    if args.atlas:
+        return Atlas.load(args.atlas, CellConfig(), options)
+    if not default_path().exists():
+        return None
+    try:
+        return Atlas.load(default_path(), CellConfig(), options)
+    except AtlasError:  # built for other options (e.g. --r-land): cold starts
+        return None
 
 
 def run_serve(args: argparse.Namespace) -> int:

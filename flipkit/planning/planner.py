@@ -24,16 +24,17 @@ import numpy as np
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
 from flipkit.config import CellConfig
-from flipkit.errors import (ConfigError, FlipkitError, InvalidChoiceError, SolverError,
+from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoiceError,
                             UnreachableError)
 from flipkit.model.ik import solve_pose
 from flipkit.planning.inputs import check_joint_vector, check_position
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
-from flipkit.solvers.result import SolveResult, Status
-from flipkit.planning.verify import verify_plan
+from flipkit.planning import chain
+from flipkit.planning.atlas import options_hash
+from flipkit.planning.chain import (SOLVERS, chain_segments, finish_plan, solve_segment,  # noqa: F401
+                                    solver_failure)
 
-SOLVERS = ("sqp", "ipopt", "auto")
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 _MODELS: dict = {}
 
@@ -47,60 +48,6 @@ def models_for(cell: CellConfig) -> Models:
     if models is None:
         models = _MODELS[cell] = Models(cell)
     return models
-
-
-def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
-    """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
-
-    ``auto`` runs the SQP and, when it fails, IPOPT from the same start; the segment's
-    ``solver.name`` in the plan file records which one produced it and the wall time counts
-    both.
-
-    Returns the result whatever its status (``result.success`` tells); the worst constraint
-    group of a failure is ``nlp.worst_group(result.x)``.
-
-    Raises:
-        InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
-    """
-    if solver == "sqp":
-        from flipkit.solvers.sqp import solve_sqp
-
-        try:
-            return solve_sqp(nlp, x0, raise_on_failure=False)
-        except SolverError:  # OSQP or a factorisation broke down inside a subproblem
-            x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
-            return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
-                               objective=nlp.objective(x), max_violation=float(
-                                   nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
-    if solver == "ipopt":
-        from flipkit.solvers.ipopt import solve_ipopt
-
-        return solve_ipopt(nlp, x0, raise_on_failure=False)
-    if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
-        first = solve_segment(nlp, "sqp", x0)
-        if first.success:
-            return first
-        second = solve_segment(nlp, "ipopt", x0)
-        second.wall_time_s += first.wall_time_s
-        return second
-    raise InvalidChoiceError("solver", solver, SOLVERS)
-
-
-def _finish(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
-    """Verify ``plan`` (against the space limits of ``cell``, which the file does not record);
-    set status, ``failure``, ``report`` and ``wall_time_s``."""
-    plan.report = verify_plan(plan, space=None if cell is None else cell.space)
-    if failure is None and not plan.report.ok:
-        group, k, amount = plan.report.worst()
-        failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"
-    plan.status, plan.failure = ("failed", failure) if failure else ("solved", None)
-    plan.wall_time_s = time.perf_counter() - t0
-    return plan
-
-
-def _solver_failure(name: str, nlp, result) -> str:
-    group, amount = nlp.worst_group(result.x)
-    return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status})"
 
 
 def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "auto",
@@ -155,16 +102,16 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
                             goal=flat_pose(p_goal, yaw), options=options)
     except UnreachableError as exc:
         raise UnreachableError(f"translate goal: {exc}") from None
-    result = solve_segment(nlp, solver)
+    result = chain.solve_segment(nlp, solver)  # through the module: one place to stub it
     plan = Plan.from_segments("translate", cell, [Segment.from_solution(nlp, result)],
                               cone=options.cone, status="failed")
-    return _finish(plan, None if result.success else _solver_failure("translate", nlp, result), t0,
+    return finish_plan(plan, None if result.success else solver_failure("translate", nlp, result), t0,
                    cell)
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
               solver: str = "auto", land=None, on_blade=(0.0, 0.0),
-              options: SegmentOptions = SegmentOptions()) -> Plan:
+              options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.behaviors.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -178,6 +125,9 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         on_blade: Where the burger's centre will sit on the blade (x, y) (blade frame, m)
             when it is released; default the blade centre.
         cell, solver, options: As :func:`plan_translate`.
+        atlas: A warm-start :class:`~flipkit.planning.atlas.Atlas` built for ``cell`` and
+            ``options``: each segment starts from the atlas's interpolated solution (and
+            from its own initial guess if that fails); ``None`` (default): cold starts.
 
     Returns:
         The plan. On a segment failure the chain stops there: the plan holds the segments
@@ -187,10 +137,14 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     Raises:
         UnreachableError: Location off the grill, or the first segment out of reach.
         ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
+        AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
     t0, cell = time.perf_counter(), cell or CellConfig()
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
+    if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
+        raise AtlasError("stale atlas: built for other planning options or another cell; "
+                         "rebuild it with `flipkit atlas build`")
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
     on_blade = _on_blade(on_blade, cell)
@@ -200,7 +154,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         "start configuration", q_start, robot.q_min, robot.q_max, "rad")
     qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
-    return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0)
+    guess = None if atlas is None else (lambda name, nlp: atlas.guess(name, pb, nlp))
+    return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0, guess)
 
 
 def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
@@ -214,49 +169,15 @@ def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
     return xy
 
 
-def solve_stretched(build, options: SegmentOptions, solver: str):
-    """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
-    duration bound, build and solve it once more with the bound stretched (SegmentOptions
-    ``stretch``, :data:`~flipkit.behaviors.segments.T_STRETCH`). Returns (nlp, result): the
-    stretched one if it succeeded, else the first.
+def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0,
+           guess=None) -> Plan:
+    """The flip's subbehaviours after the segments ``done`` from (q, q̇)."""
+    def build(name, q, qd, o):
+        return build_segment(name, models, q, qd, location=pb, land=spot, on_blade=on_blade,
+                             options=o)
 
-    Raises:
-        FlipkitError: The first build fails (e.g. its initial guess).
-    """
-    nlp = build(options)
-    result = solve_segment(nlp, solver)
-    if result.success or options.stretch:
-        return nlp, result
-    try:
-        longer = build(replace(options, stretch=True))
-    except FlipkitError:
-        return nlp, result
-    second = solve_segment(longer, solver)
-    return (longer, second) if second.success else (nlp, result)
-
-
-def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0) -> Plan:
-    """Solve the subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
-    segments, failure = list(done), None
-    for name in tg.SUBBEHAVIORS[len(done):]:
-        try:
-            nlp, result = solve_stretched(lambda o: build_segment(
-                name, models, q, qd, location=pb, land=spot, on_blade=on_blade, options=o),
-                options, solver)
-        except FlipkitError as exc:
-            if not segments:
-                raise
-            failure = f"{name}: cannot build the initial guess ({exc})"
-            break
-        seg = Segment.from_solution(nlp, result)
-        segments.append(seg)
-        if not result.success:
-            failure = _solver_failure(name, nlp, result)
-            break
-        q, qd = seg.q[-1], seg.qd[-1]
-    plan = Plan.from_segments("flip", cell, segments, location=pb, cone=options.cone,
-                              status="failed")
-    return _finish(plan, failure, t0, cell)
+    return chain_segments("flip", tg.SUBBEHAVIORS, build, q, qd, done, cell, solver, options,
+                          t0, pb, guess=guess)
 
 
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",

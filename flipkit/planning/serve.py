@@ -23,9 +23,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.inputs import check_joint_vector
-from flipkit.planning.planner import (SOLVERS, _finish, _on_blade,
-                                      _solver_failure, models_for, solve_stretched)
-from flipkit.planning.segment import Segment
+from flipkit.planning.planner import SOLVERS, _on_blade, chain_segments, models_for
 
 
 def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
@@ -90,29 +88,18 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
 
 
 def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -> Plan:
-    """Solve the serve subbehaviours after the segments ``done`` (already solved) from (q, q̇)."""
-    segments, failure = list(done), None
-    for name in sv.SERVE_SUBBEHAVIORS[len(done):]:
-        try:
-            nlp, result = solve_stretched(lambda o: build_segment(
-                name, models, q, qd, location=pb, spot=spot, on_blade=on_blade, options=o),
-                options, solver)
-        except FlipkitError as exc:
-            if not segments:
-                raise
-            failure = f"{name}: cannot build the initial guess ({exc})"
-            break
-        seg = Segment.from_solution(nlp, result)
+    """The serve's subbehaviours after the segments ``done`` from (q, q̇); the carry and
+    place segments record the ``placing``."""
+    def build(name, q, qd, o):
+        return build_segment(name, models, q, qd, location=pb, spot=spot, on_blade=on_blade,
+                             options=o)
+
+    def decorate(name, seg):
         if name in ("carry", "place"):
             seg.placing = placing_record(cell, spot, on_blade)
-        segments.append(seg)
-        if not result.success:
-            failure = _solver_failure(name, nlp, result)
-            break
-        q, qd = seg.q[-1], seg.qd[-1]
-    plan = Plan.from_segments("serve", cell, segments, location=pb, cone=options.cone,
-                              status="failed")
-    return _finish(plan, failure, t0)
+
+    return chain_segments("serve", sv.SERVE_SUBBEHAVIORS, build, q, qd, done, cell, solver,
+                          options, t0, pb, decorate)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",

@@ -1,0 +1,165 @@
+"""Solving a chain of segments: one segment with a solver, one with its duration bound
+stretched if need be, and the whole chain of a behaviour, each segment from the previous
+one's final state (eq. 29), checked at the end (:func:`~flipkit.planning.verify.verify_plan`).
+
+The loop behind every planner entry point of :mod:`flipkit.planning.planner` and
+:mod:`flipkit.planning.serve`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from flipkit.behaviors.segments import SegmentOptions
+from flipkit.config import CellConfig
+from flipkit.errors import AtlasError, FlipkitError, InvalidChoiceError, SolverError
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.segment import Segment
+from flipkit.planning.verify import verify_plan
+from flipkit.solvers.result import SolveResult, Status
+
+SOLVERS = ("sqp", "ipopt", "auto")
+
+
+def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
+    """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
+
+    ``auto`` runs the SQP and, when it fails, IPOPT from the same start; the segment's
+    ``solver.name`` in the plan file records which one produced it and the wall time counts
+    both.
+
+    Returns the result whatever its status (``result.success`` tells); the worst constraint
+    group of a failure is ``nlp.worst_group(result.x)``.
+
+    Raises:
+        InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
+    """
+    if solver == "sqp":
+        from flipkit.solvers.sqp import solve_sqp
+
+        try:
+            return solve_sqp(nlp, x0, raise_on_failure=False)
+        except SolverError:  # OSQP or a factorisation broke down inside a subproblem
+            x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
+            return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
+                               objective=nlp.objective(x), max_violation=float(
+                                   nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
+    if solver == "ipopt":
+        from flipkit.solvers.ipopt import solve_ipopt
+
+        return solve_ipopt(nlp, x0, raise_on_failure=False)
+    if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
+        first = solve_segment(nlp, "sqp", x0)
+        if first.success:
+            return first
+        second = solve_segment(nlp, "ipopt", x0)
+        second.wall_time_s += first.wall_time_s
+        return second
+    raise InvalidChoiceError("solver", solver, SOLVERS)
+
+
+def finish_plan(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
+    """Verify ``plan`` (against the space limits of ``cell``, which the file does not record);
+    set status, ``failure``, ``report`` and ``wall_time_s``."""
+    plan.report = verify_plan(plan, space=None if cell is None else cell.space)
+    if failure is None and not plan.report.ok:
+        group, k, amount = plan.report.worst()
+        failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"
+    plan.status, plan.failure = ("failed", failure) if failure else ("solved", None)
+    plan.wall_time_s = time.perf_counter() - t0
+    return plan
+
+
+def solver_failure(name: str, nlp, result) -> str:
+    group, amount = nlp.worst_group(result.x)
+    return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status})"
+
+
+def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
+    """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
+    duration bound, build and solve it once more with the bound stretched (SegmentOptions
+    ``stretch``, :data:`~flipkit.behaviors.segments.T_STRETCH`). Returns (nlp, result): the
+    stretched one if it succeeded, else the first.
+
+    ``guess(nlp) -> x0`` (optional) seeds the first solve (a warm start, e.g. from an atlas);
+    if that solve fails, the segment is solved again from its own initial guess (cold) before
+    the bound is stretched, and the result's wall time counts both.
+
+    Raises:
+        FlipkitError: The first build fails (e.g. its initial guess), or ``guess`` raises.
+    """
+    nlp = build(options)
+    x0 = None if guess is None else guess(nlp)
+    result = solve_segment(nlp, solver, x0)
+    if not result.success and x0 is not None:
+        cold = solve_segment(nlp, solver)
+        cold.wall_time_s += result.wall_time_s
+        result = cold
+    if result.success or options.stretch:
+        return nlp, result
+    try:
+        longer = build(replace(options, stretch=True))
+    except FlipkitError:
+        return nlp, result
+    second = solve_segment(longer, solver)
+    return (longer, second) if second.success else (nlp, result)
+
+
+def chain_segments(behavior: str, names, build, q, qd, done: list, cell: CellConfig,
+                   solver: str, options: SegmentOptions, t0: float, location,
+                   decorate=None, guess=None) -> Plan:
+    """Solve the segments ``names`` after those ``done`` (already solved), each from the
+    previous one's final (q, q̇) (eq. 29), and verify the chain: the one loop behind
+    :func:`plan_flip`, :func:`replan_flip` and the serve planners.
+
+    Args:
+        behavior: The plan's behaviour (``flip``, ``serve``).
+        names: All the behaviour's segment names in order; those after ``len(done)`` are solved.
+        build: ``build(name, q, qd, options) -> NLP``.
+        q, qd: Start state of the first segment to solve (rad, rad/s).
+        done: Segments kept from an earlier plan. cell, solver, options: As the planners.
+        t0: ``time.perf_counter()`` when planning began (the plan's wall time counts from it).
+        location: The burger's location p^b (m), recorded in the plan.
+        decorate: Optional ``decorate(name, segment)`` adding records to a solved segment.
+        guess: Optional ``guess(name, nlp) -> x0`` warm-starting each segment's solve
+            (:func:`solve_stretched`).
+
+    Returns:
+        The verified plan; on a segment failure the chain stops there and ``plan.failure``
+        names the segment, its worst constraint group and the violation.
+
+    Raises:
+        FlipkitError: The first segment to solve cannot be built (e.g. its initial guess),
+            with nothing solved before it. AtlasError: ``guess`` refuses (a stale atlas).
+    """
+    segments, failure = list(done), None
+    for name in list(names)[len(done):]:
+        try:
+            nlp, result = solve_stretched(lambda o: build(name, q, qd, o), options, solver,
+                                          None if guess is None else
+                                          (lambda nlp, name=name: guess(name, nlp)))
+        except AtlasError:
+            raise
+        except FlipkitError as exc:
+            if not segments:
+                raise
+            failure = f"{name}: cannot build the initial guess ({exc})"
+            break
+        seg = Segment.from_solution(nlp, result)
+        if decorate is not None:
+            decorate(name, seg)
+        segments.append(seg)
+        if not result.success:
+            failure = solver_failure(name, nlp, result)
+            break
+        q, qd = seg.q[-1], seg.qd[-1]
+    plan = Plan.from_segments(behavior, cell, segments, location=location, cone=options.cone,
+                              status="failed")
+    return finish_plan(plan, failure, t0, cell)
+
+
+__all__ = ["SOLVERS", "chain_segments", "finish_plan", "solve_segment", "solve_stretched",
+           "solver_failure"]

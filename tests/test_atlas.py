@@ -1,0 +1,117 @@
+"""The warm-start atlas: file round trip, staleness refused, interpolation, warm-started plans."""
+
+import numpy as np
+import pytest
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import SegmentOptions
+from flipkit.cli import main
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.errors import AtlasError
+from flipkit.experiments.atlas import solve_entry
+from flipkit.planning.atlas import BRANCH_TOL, Atlas, default_path, options_hash
+from flipkit.planning.planner import plan_flip
+from flipkit.planning.verify import verify_plan
+
+LOC = TABLE1_LOCATIONS[6]
+
+
+@pytest.fixture(scope="module")
+def entry():
+    """The chain solved at Table I location 7, as an atlas builder's worker returns it."""
+    out = solve_entry((LOC, CellConfig(), SegmentOptions()))
+    assert out["status"] == "solved"
+    return out
+
+
+def _atlas(entry, locations=None, shift=None):
+    """An atlas of ``entry``'s solution at ``locations`` (default its own), the k-th copy
+    with joint angles moved by shift[k] (rad)."""
+    locations = [entry["location"]] if locations is None else locations
+    shift = [0.0] * len(locations) if shift is None else shift
+    sols = {}
+    for name in tg.SUBBEHAVIORS:
+        x = np.array(entry["x"][name])
+        rows = []
+        for s in shift:
+            y = x.copy()
+            y[: 21 * 4 * 6].reshape(21, 4, 6)[:, 0] += s
+            rows.append(y)
+        sols[name] = np.array(rows)
+    meta = {"options_hash": options_hash(CellConfig(), SegmentOptions()), "grid": [1, 1],
+            "failed": []}
+    return Atlas(locations, sols, entry["structure"], meta)
+
+
+def test_file_round_trip(entry, tmp_path):
+    atlas = _atlas(entry)
+    back = Atlas.load(atlas.save(tmp_path / "a.npz"), CellConfig(), SegmentOptions())
+    assert len(back) == 1 and back.meta["grid"] == [1, 1]
+    for name in tg.SUBBEHAVIORS:  # stored as float32: a guess needs no more
+        np.testing.assert_allclose(back.solutions[name], atlas.solutions[name], rtol=1e-6,
+                                   atol=1e-6)
+    assert back.structure == atlas.structure
+
+
+def test_stale_or_broken_atlas_is_refused(entry, tmp_path):
+    path = _atlas(entry).save(tmp_path / "a.npz")
+    with pytest.raises(AtlasError, match="stale atlas.*flipkit atlas build"):
+        Atlas.load(path, CellConfig(), SegmentOptions(r_land=0.03))
+    with pytest.raises(AtlasError, match="stale atlas"):
+        plan_flip(LOC, atlas=Atlas.load(path), options=SegmentOptions(r_land=0.03))
+    changed = _atlas(entry)
+    changed.structure["go_to_burger"] = "0" * 40  # the NLP changed since it was built
+    with pytest.raises(AtlasError, match="'go_to_burger' segment's NLP has changed"):
+        plan_flip(LOC, atlas=changed)
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not an npz")
+    with pytest.raises(AtlasError, match="cannot read atlas"):
+        Atlas.load(bad)
+
+
+def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
+    from flipkit.behaviors.segments import Models, build_segment
+
+    class _NLP:  # the layout and structure key guess() reads
+        def __init__(self, nlp):
+            self.layout, self.structure_key = nlp.layout, entry["structure"]["flip"]
+
+    models = Models(CellConfig())
+    p = tg.pickup_end(CellConfig(), LOC)
+    from flipkit.model.ik import solve_pose
+    nlp = _NLP(build_segment("flip", models, solve_pose(models.loaded, p.p, p.o), np.zeros(6),
+                             location=LOC))
+    a, b, c = (0.70, -0.10, LOC[2]), (0.74, -0.10, LOC[2]), (0.72, -0.14, LOC[2])
+    atlas = _atlas(entry, [a, b, c], shift=[0.0, 0.2, 3 * BRANCH_TOL])
+    x = atlas.solutions["flip"]
+    np.testing.assert_array_equal(atlas.guess("flip", a, nlp), x[0])  # at an entry: itself
+    mid = atlas.guess("flip", (0.71, -0.10), nlp)  # 1 cm from a, 3 cm from b; c left out
+    w = np.array([1 / 0.01**2, 1 / 0.03**2])
+    np.testing.assert_allclose(mid, (w[0] * x[0] + w[1] * x[1]) / w.sum(), rtol=1e-12)
+
+
+def test_warm_started_plan_is_solved_and_verified(entry):
+    """From an atlas whose entry is this very location, the chain is solved and checked
+    like any plan (the guess seeds the solver, the plan stands on its own)."""
+    plan = plan_flip(LOC, atlas=_atlas(entry))
+    assert plan.status == "solved" and verify_plan(plan, space=CellConfig().space).ok
+
+
+def test_cli_refuses_a_broken_atlas_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.npz"
+    bad.write_text("{}")
+    code = main(["plan", "flip", "--burger", *map(str, LOC), "--atlas", str(bad), "--json",
+                 str(tmp_path / "p.json")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "cannot read atlas" in err[0]
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_the_shipped_atlas_serves_the_default_options():
+    """The package's atlas is rebuilt whenever the NLP or its options change: a stale one
+    fails here (rebuild: ``flipkit atlas build``)."""
+    if not default_path().exists():
+        pytest.skip("no atlas shipped")
+    atlas = Atlas.load(default_path(), CellConfig(), SegmentOptions())
+    plan = plan_flip(TABLE1_LOCATIONS[0], atlas=atlas)  # guess() checks each structure key
+    assert plan.status == "solved"
