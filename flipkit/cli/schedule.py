@@ -12,13 +12,14 @@ nothing written.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import warnings
 from pathlib import Path
 
 from flipkit.cli.common import SOLVER_CHOICES, write_json
-from flipkit.errors import FlipkitError
+from flipkit.errors import ConfigError, FlipkitError
 
 DESCRIPTION = (
     "Flip every burger of a cook order at its 90 s mark and serve it to a table spot after "
@@ -46,6 +47,9 @@ def register(subparsers) -> None:
                    help="plan the flips alone (no serves; serve_time stays null)")
     p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
                    help="NLP solver (default auto: the SQP, then IPOPT where it fails)")
+    p.add_argument("--workers", type=int, default=None, metavar="K",
+                   help="plan the motions ahead in K worker processes (default: the CPU "
+                        "count; 1: one after another in this process)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -70,8 +74,24 @@ def run(args: argparse.Namespace) -> int:
     plans = Path(args.plans) if args.plans else timeline_path.with_name(
         timeline_path.stem + "_plans")
     q_home = cell.robot.q_home
-    timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
-                             progress=not args.no_progress)
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
+    if workers < 1:
+        raise ConfigError(f"--workers must be a positive integer, got {workers}")
+    executor = None
+    if workers > 1:
+        from flipkit.experiments.sweep import make_executor
+        from flipkit.planning.cook import check_cook, table_spots
+        from flipkit.planning.prefetch import PrefetchPlanners
+
+        executor = make_executor(workers=workers)
+        planners = PrefetchPlanners(check_cook(burgers, cell), kinds, q_home,
+                                    table_spots(cell), executor, cell, args.solver)
+    try:
+        timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
+                                 progress=not args.no_progress)
+    finally:
+        if executor is not None:
+            executor.shutdown(cancel_futures=True)
     try:
         plans.mkdir(parents=True, exist_ok=True)
         for k, m in enumerate(timeline.motions, 1):

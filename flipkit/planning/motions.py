@@ -21,6 +21,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError
 
 KINDS = ("flip", "serve")
+REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
 SERVE_PLANNER = "flipkit.planning.planner.plan_serve"
 
 
@@ -60,6 +61,8 @@ class PlannedMotion:
         landing: Flip only: the burger's predicted landing point (x, y) (m).
         plan: The plan (anything with ``to_json(path)``), or ``None``.
         failure: One line saying why it is not ``ok``.
+        ready_s: Planned ahead (:mod:`flipkit.planning.prefetch`): when the plan was in, in s
+            from the start of planning; ``None``: planned on demand, in ``planning_time_s``.
     """
 
     ok: bool
@@ -70,6 +73,7 @@ class PlannedMotion:
     landing: tuple | None = None
     plan: object | None = None
     failure: str | None = None
+    ready_s: float | None = None
 
 
 class MotionPlanner(Protocol):
@@ -187,6 +191,6 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
     return out
 
 
-__all__ = ["KINDS", "SERVE_PLANNER", "MissingPlannerError", "MotionJob", "MotionPlanner",
+__all__ = ["KINDS", "REST_TOL", "SERVE_PLANNER", "MissingPlannerError", "MotionJob", "MotionPlanner",
            "PlannedMotion", "available_kinds", "default_planners", "flip_planner",
            "from_plan", "serve_planner"]

@@ -12,7 +12,8 @@ Policy — earliest deadline first, one arm, no early starts:
    burgers already flipped. The next motion is the pending one whose burger event is due
    first (a flip's landing mark, a serve's lift-off mark; ties: the burger dropped first).
 2. It is planned from the configuration the previous motion ended at (at rest; the first
-   from ``q_start``), which gives its duration and the time from its start to the event.
+   from ``q_start``; an end within 1e-6 rad of ``q_start`` is taken as ``q_start`` itself,
+   the rest configuration every motion returns to, to the solver's tolerance), which gives its duration and the time from its start to the event.
 3. It starts when the arm is free, but never so early that its event comes before the mark
    (so no side is cooked shorter than 90 s / 60 s), and never before its plan exists
    (below).
@@ -22,8 +23,9 @@ Lateness, reported per burger: landing − (``t_drop`` + 90 s) and lift-off − 
 
 Planning runs ahead of execution: the motions are planned one after another, in the order
 above, on a planning clock that starts at ``plan_start`` (default: the first drop). A
-motion's plan is ready at ``planned_at`` = ``plan_start`` + the planning times so far; its
-slack = (when the arm would start it: free and due) − ``planned_at``. A negative slack
+motion's plan is ready at ``planned_at`` = ``plan_start`` + the planning times so far (or,
+planned ahead in parallel worker processes by :mod:`flipkit.planning.prefetch`, + when its
+plan was in); its slack = (when the arm would start it: free and due) − ``planned_at``. A negative slack
 means planning fell behind: the motion then waits for its plan and its lateness shows it.
 
 What is optimal about it: no motion starts early, so cook times are never shortened; when
@@ -49,7 +51,8 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.cook import SECOND_SIDE_S, CookBurger, check_cook, table_spots
-from flipkit.planning.motions import KINDS, MissingPlannerError, MotionJob, MotionPlanner
+from flipkit.planning.motions import (KINDS, REST_TOL, MissingPlannerError, MotionJob,
+                                     MotionPlanner)
 
 FORMAT = "flipkit-timeline/1"
 
@@ -120,8 +123,9 @@ class Timeline:
 
     @property
     def planning_time_s(self) -> float:
-        """Total planning wall time (s)."""
-        return float(sum(m.planning_time_s for m in self.motions))
+        """Planning wall time (s): from the start of planning to the last plan in (the sum of
+        the motions' planning times when they are planned one after another)."""
+        return max((m.planned_at - self.plan_start for m in self.motions), default=0.0)
 
     @property
     def min_slack_s(self) -> float | None:
@@ -212,6 +216,7 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
     if not np.isfinite(clock):
         raise ConfigError(f"plan_start must be finite (s), got {plan_start!r}")
     t0, q = clock, np.asarray(q_start, float)
+    q_rest = q.copy()
     arm_free = -np.inf
     # pending: (due, drop rank, kind rank, burger index, kind)
     pending = [(b.burger.flip_mark, k, 0, k, "flip") for k, b in enumerate(records)]
@@ -230,7 +235,9 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
             job = MotionJob("serve", b.burger, (*rec.landing, cell.grill.height),
                             rec.table_spot)
         pm = planners[kind](job, q)
-        clock += float(pm.planning_time_s)
+        ready = getattr(pm, "ready_s", None)  # planned ahead, in parallel: when it was in
+        clock = (max(clock, t0 + ready) if ready is not None
+                 else clock + float(pm.planning_time_s))
         wanted = max(arm_free, due - pm.event_s)  # arm free, and the event not early
         start = max(wanted, clock)  # and the plan ready
         run = pm.duration_s if pm.ok else 0.0  # a failed plan is not executed
@@ -248,6 +255,8 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
                 bar.total -= 1  # its serve will not be planned
             continue
         arm_free, q = m.end, np.asarray(pm.q_end, float)
+        if np.abs(q - q_rest).max() <= REST_TOL:  # back at rest to the solver's tolerance
+            q = q_rest
         if kind == "flip":
             rec.flip_time = m.event
             rec.landing = pm.landing if pm.landing is not None else (b.x, b.y)

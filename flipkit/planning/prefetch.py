@@ -1,0 +1,101 @@
+"""Planning a cook's motions ahead, in parallel worker processes.
+
+Every flip and serve starts at rest at the rest configuration (q_home) and ends there (turn
+back and return home end at it), so the flips of a cook order are independent of one another
+and each serve depends only on its flip's predicted landing and its table spot.
+:class:`PrefetchPlanners` submits every flip to an executor as soon as it is made, and each
+serve as soon as its flip's plan is in, with the spot the scheduler will give it when every
+serve succeeds and they come in drop order (the k-th burger dropped, the k-th spot). The
+scheduler (:func:`~flipkit.planning.schedule.schedule_cook`) asks for motions as before; a
+request whose job and start configuration match a prefetched one gets that plan, any other
+(a spot shifted by a failed serve, a start elsewhere) is planned on demand, in this process.
+
+The plans are those of the serial run: the same planner with the same inputs, each in its
+own process (the solvers are deterministic and start from nothing a previous solve left;
+tested). Each prefetched motion records ``ready_s``, when its plan was in, from the start of
+planning, so the schedule's planning clock and slack follow the real (parallel) planning.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.planning.motions import REST_TOL, MotionJob, PlannedMotion, default_planners
+
+
+def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str
+                ) -> PlannedMotion:
+    """Plan one motion with the real planner of ``kind`` (a worker's task)."""
+    return default_planners((kind,), cell, solver)[kind](job, np.asarray(q_start, float))
+
+
+class PrefetchPlanners(Mapping):
+    """Planners (by kind) that serve plans computed ahead on ``executor``.
+
+    Args:
+        order: The cook's burgers (:class:`~flipkit.planning.cook.CookBurger`), checked.
+        kinds: Motion kinds planned (``("flip",)`` or ``("flip", "serve")``).
+        q_rest: The rest configuration every motion starts and ends at (rad).
+        spots: Table spots (x, y) (m), handed out in drop order.
+        executor: A :class:`concurrent.futures.Executor` (worker processes or Dask).
+        cell, solver: As :func:`~flipkit.planning.motions.default_planners`.
+    """
+
+    def __init__(self, order, kinds, q_rest, spots, executor: cf.Executor,
+                 cell: CellConfig, solver: str = "auto"):
+        self.kinds, self.cell, self.solver = tuple(kinds), cell, solver
+        self.q_rest, self.executor = np.asarray(q_rest, float), executor
+        self._spots = {b.burger: tuple(spots[k]) for k, b in enumerate(order) if k < len(spots)}
+        self._t0 = time.perf_counter()
+        self._futures: dict[tuple, cf.Future] = {}
+        self._ready: dict[tuple, float] = {}
+        for b in order:
+            self._submit(MotionJob("flip", b.burger, b.location(cell)))
+        self.on_demand = 0  # motions planned in this process (no prefetched match)
+
+    def _key(self, job: MotionJob) -> tuple:
+        return (job.kind, job.burger, tuple(np.round(job.location, 9)),
+                None if job.table_spot is None else tuple(np.round(job.table_spot, 9)))
+
+    def _submit(self, job: MotionJob) -> None:
+        fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
+                                   self.solver)
+        key = self._key(job)
+        fut.add_done_callback(lambda _f, key=key: self._ready.setdefault(
+            key, time.perf_counter() - self._t0))
+        self._futures[key] = fut
+
+    def _result(self, job: MotionJob, q_start) -> PlannedMotion:
+        fut = self._futures.get(self._key(job))
+        if fut is None or np.abs(np.asarray(q_start, float) - self.q_rest).max() > REST_TOL:
+            self.on_demand += 1
+            t = time.perf_counter()
+            pm = plan_motion(job.kind, job, q_start, self.cell, self.solver)
+            pm.ready_s = time.perf_counter() - self._t0
+            pm.planning_time_s = time.perf_counter() - t
+            return pm
+        pm = fut.result()
+        pm.ready_s = self._ready.get(self._key(job), time.perf_counter() - self._t0)
+        if job.kind == "flip" and "serve" in self.kinds and pm.ok and job.burger in self._spots:
+            self._submit(MotionJob("serve", job.burger, (*pm.landing, self.cell.grill.height),
+                                   self._spots[job.burger]))
+        return pm
+
+    def __getitem__(self, kind: str):
+        if kind not in self.kinds:
+            raise KeyError(kind)
+        return self._result
+
+    def __iter__(self):
+        return iter(self.kinds)
+
+    def __len__(self) -> int:
+        return len(self.kinds)
+
+
+__all__ = ["PrefetchPlanners", "plan_motion"]
