@@ -42,3 +42,22 @@ def test_prefetched_cook_equals_the_serial_one():
             np.testing.assert_allclose(sa.u, sb.u, rtol=1e-3, atol=1e-2)
     # the planning clock follows when plans were in, not the sum of their times
     assert parallel.planning_time_s <= sum(m.planning_time_s for m in parallel.motions)
+
+
+@pytest.mark.slow
+def test_parallel_batch_equals_the_serial_one():
+    from flipkit.config import TABLE1_LOCATIONS
+    from flipkit.planning.planner import plan_batch
+
+    locs = [TABLE1_LOCATIONS[6], TABLE1_LOCATIONS[8]]
+    serial = plan_batch(locs, progress=False, solver="sqp")
+    executor = make_executor(workers=2)
+    try:
+        parallel = plan_batch(locs, progress=False, solver="sqp", executor=executor)
+    finally:
+        executor.shutdown()
+    assert [p.status for p in serial] == [p.status for p in parallel] == ["solved"] * 2
+    for a, b in zip(serial, parallel):
+        for sa, sb in zip(a.segments, b.segments):
+            assert sa.name == sb.name
+            np.testing.assert_allclose(sa.q, sb.q, rtol=0, atol=1e-4)

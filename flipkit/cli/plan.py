@@ -15,6 +15,7 @@ passed the check.
 from __future__ import annotations
 
 import argparse
+import os
 import csv
 import math
 import sys
@@ -99,6 +100,9 @@ def register(subparsers) -> None:
     b.add_argument("--burgers", required=True, metavar="FILE.csv",
                    help="CSV with header x,y,z (or px,py,pz); lines starting with # skipped")
     b.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    b.add_argument("--workers", type=int, default=None, metavar="K",
+                   help="plan the burgers in K worker processes (default: the CPU count; 1: "
+                        "one after another in this process)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
     common(b, json_out=False)
     b.set_defaults(run=run_batch)
@@ -220,19 +224,13 @@ def _atlas(args: argparse.Namespace, options):
     """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
     package's when it exists and serves ``options``, else ``None`` (cold starts)."""
     from flipkit.config import CellConfig
-    from flipkit.errors import AtlasError
-    from flipkit.planning.atlas import Atlas, default_path
+    from flipkit.planning.atlas import Atlas, default_atlas
 
     if args.no_atlas:
         return None
     if args.atlas:
         return Atlas.load(args.atlas, CellConfig(), options)
-    if not default_path().exists():
-        return None
-    try:
-        return Atlas.load(default_path(), CellConfig(), options)
-    except AtlasError:  # built for other options (e.g. --r-land): cold starts
-        return None
+    return default_atlas(CellConfig(), options)  # else cold starts (e.g. another --r-land)
 
 
 def run_serve(args: argparse.Namespace) -> int:
@@ -254,7 +252,20 @@ def run_batch(args: argparse.Namespace) -> int:
 
     _quiet()
     locations = read_locations(args.burgers)
-    plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress)
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
+    if workers < 1:
+        raise ConfigError(f"--workers must be a positive integer, got {workers}")
+    executor = None
+    if workers > 1 and len(locations) > 1:
+        from flipkit.experiments.sweep import make_executor
+
+        executor = make_executor(workers=workers)
+    try:
+        plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
+                           executor=executor)
+    finally:
+        if executor is not None:
+            executor.shutdown(cancel_futures=True)
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)

@@ -50,6 +50,9 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=None, metavar="K",
                    help="plan the motions ahead in K worker processes (default: the CPU "
                         "count; 1: one after another in this process)")
+    p.add_argument("--no-atlas", action="store_true",
+                   help="flips from cold starts (default: warm-started from the package's "
+                        "atlas, `flipkit atlas build`, when it serves the default options)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -62,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     """Read, check, plan, write, report."""
     from flipkit.config import CellConfig
     from flipkit.planning.cook import read_cook_csv
+    from flipkit.planning.atlas import default_atlas
     from flipkit.planning.motions import default_planners
     from flipkit.planning.schedule import format_timeline, schedule_cook
 
@@ -69,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     cell = CellConfig()
     burgers = read_cook_csv(args.burgers, cell)
     kinds = ("flip",) if args.flip_only else ("flip", "serve")
-    planners = default_planners(kinds, cell, args.solver)  # MissingPlannerError before planning
+    atlas = None if args.no_atlas else default_atlas(cell)
+    planners = default_planners(kinds, cell, args.solver, atlas)  # MissingPlannerError first
     timeline_path = Path(args.json)
     plans = Path(args.plans) if args.plans else timeline_path.with_name(
         timeline_path.stem + "_plans")
@@ -85,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
 
         executor = make_executor(workers=workers)
         planners = PrefetchPlanners(check_cook(burgers, cell), kinds, q_home,
-                                    table_spots(cell), executor, cell, args.solver)
+                                    table_spots(cell), executor, cell, args.solver, atlas)
     try:
         timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
                                  progress=not args.no_progress)

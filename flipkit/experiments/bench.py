@@ -37,8 +37,9 @@ from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import T_BOUNDS, SegmentOptions, build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.planning.atlas import Atlas, default_path
+from flipkit.planning.atlas import Atlas, default_atlas
 from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
+from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.compiled import SUBPROBLEMS
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.sqp import SQPOptions, solve_sqp
@@ -265,12 +266,35 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
         plans = plan_batch(TABLE1_LOCATIONS[:n_batch], cell=cell, solver="sqp", progress=False)
         wall = time.perf_counter() - t0
         batch = [_flip_row(p) for p in plans]
+        workers = os.cpu_count() or 1
+        executor = make_executor(workers=workers)
+        try:  # a warm pool, as a running cell keeps it: imports and cvxpy compiles done
+            t_warm = time.perf_counter()
+            list(executor.map(_warm_worker, range(workers)))
+            t_warm = time.perf_counter() - t_warm
+            t0 = time.perf_counter()
+            par = plan_batch(TABLE1_LOCATIONS[:n_batch], cell=cell, solver="sqp",
+                             progress=False, executor=executor)
+            wall_par = time.perf_counter() - t0
+        finally:
+            executor.shutdown()
+        same = all(np.allclose(a.segments[-1].q, b.segments[-1].q, atol=1e-4)
+                   for a, b in zip(plans, par) if len(a.segments) == len(b.segments))
         print(f"batch of {n_batch} (Table I 1..{n_batch}, SQP): "
               f"{sum(b['status'] == 'solved' for b in batch)}/{n_batch} solved, solve "
-              f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s "
+              f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s one after another; "
+              f"{workers} worker processes: wall {wall_par:.1f} s "
+              f"({sum(p.status == 'solved' for p in par)}/{n_batch} solved, same plans: {same}; "
+              f"pool warm-up {t_warm:.1f} s not counted) "
               f"(paper: {PAPER_FIVE_BURGERS_S:.0f} s for 4-5 burgers)")
-        out["batch"] = {"n": n_batch, "wall_s": wall, "plans": batch}
+        out["batch"] = {"n": n_batch, "wall_s": wall, "plans": batch, "workers": workers,
+                        "wall_parallel_s": wall_par, "same_plans": same}
     return out
+
+
+def _warm_worker(_) -> None:
+    """Import the planner and compile the five segment structures in a pool worker."""
+    plan_flip(TABLE1_LOCATIONS[1], solver="sqp")
 
 
 def _plain(obj):
@@ -314,8 +338,9 @@ def main(argv=None) -> int:
         result = bench_translate(cell, args.full, args.jit)
     else:
         atlas = None
-        if not args.no_atlas and (args.atlas or default_path().exists()):
-            atlas = Atlas.load(args.atlas or default_path(), cell, SegmentOptions())
+        if not args.no_atlas:
+            atlas = (Atlas.load(args.atlas, cell, SegmentOptions()) if args.atlas
+                     else default_atlas(cell))
         result = bench_flip(cell, args.locations, args.batch, atlas, not args.no_ipopt)
     if args.json:
         with open(args.json, "w") as fh:

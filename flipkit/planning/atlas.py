@@ -50,6 +50,16 @@ def options_hash(cell: CellConfig, options: SegmentOptions) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
+def default_atlas(cell: CellConfig | None = None, options: SegmentOptions = SegmentOptions()):
+    """The package's atlas if it exists and serves ``cell`` and ``options``, else ``None``."""
+    if not default_path().exists():
+        return None
+    try:
+        return Atlas.load(default_path(), cell or CellConfig(), options)
+    except AtlasError:
+        return None
+
+
 class Atlas:
     """Solved chains by location.
 
@@ -141,4 +151,4 @@ class Atlas:
         return (w[:, None] * X[keep]).sum(0) / w.sum()
 
 
-__all__ = ["Atlas", "FORMAT", "default_path", "options_hash"]
+__all__ = ["Atlas", "FORMAT", "default_atlas", "default_path", "options_hash"]

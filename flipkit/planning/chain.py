@@ -84,20 +84,25 @@ def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
     ``stretch``, :data:`~flipkit.behaviors.segments.T_STRETCH`). Returns (nlp, result): the
     stretched one if it succeeded, else the first.
 
-    ``guess(nlp) -> x0`` (optional) seeds the first solve (a warm start, e.g. from an atlas);
-    if that solve fails, the segment is solved again from its own initial guess (cold) before
-    the bound is stretched, and the result's wall time counts both.
+    ``guess(nlp) -> x0`` (optional) seeds a first SQP solve (a warm start, e.g. from an
+    atlas); if it fails, the segment is solved as without it, from its own initial guess with
+    ``solver``, before the bound is stretched, and the result's wall time counts both. With
+    ``solver="ipopt"`` the guess is not used: an interior-point method started on another
+    solution's active bounds is slow (measured: a Table I chain with IPOPT from the atlas was
+    stopped after 10 CPU-minutes).
 
     Raises:
         FlipkitError: The first build fails (e.g. its initial guess), or ``guess`` raises.
     """
     nlp = build(options)
-    x0 = None if guess is None else guess(nlp)
-    result = solve_segment(nlp, solver, x0)
-    if not result.success and x0 is not None:
-        cold = solve_segment(nlp, solver)
-        cold.wall_time_s += result.wall_time_s
-        result = cold
+    x0 = None if guess is None or solver == "ipopt" else guess(nlp)
+    if x0 is None:
+        result = solve_segment(nlp, solver)
+    else:  # the SQP from the warm start; failing that, the usual cold solve (auto: + IPOPT)
+        warm = solve_segment(nlp, "sqp", x0)
+        result = warm if warm.success else solve_segment(nlp, solver)
+        if result is not warm:
+            result.wall_time_s += warm.wall_time_s
     if result.success or options.stretch:
         return nlp, result
     try:

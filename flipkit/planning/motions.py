@@ -117,23 +117,27 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
                          failure=None if ok else getattr(plan, "failure", "plan failed"))
 
 
-def flip_planner(cell: CellConfig | None = None, solver: str = "auto") -> MotionPlanner:
+def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
+                 ) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planner.plan_flip` from ``q_start``, landing
-    where the burger was picked up (its default)."""
+    where the burger was picked up (its default), warm-started from ``atlas`` if given."""
     from flipkit.planning.planner import plan_flip
 
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_flip(job.location, q_start, cell=cell, solver=solver)
+        p = plan_flip(job.location, q_start, cell=cell, solver=solver, atlas=atlas)
         return from_plan(p, "flip", time.perf_counter() - t0)
 
     return plan
 
 
-def serve_planner(cell: CellConfig | None = None, solver: str = "auto") -> MotionPlanner:
+def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
+                  ) -> MotionPlanner:
     """The real serve: ``flipkit.planning.planner.plan_serve(burger, table_spot,
     q_start=..., cell=..., solver=...)`` (``cell`` and ``solver`` passed where its signature
     takes them).
+
+    ``atlas`` is accepted for a uniform signature and not used (the atlas holds flips).
 
     Raises:
         MissingPlannerError: ``plan_serve`` does not exist in :mod:`flipkit.planning.planner`.
@@ -171,9 +175,9 @@ def available_kinds() -> tuple[str, ...]:
     return KINDS if hasattr(planner, "plan_serve") else ("flip",)
 
 
-def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = "auto"
-                     ) -> Mapping[str, MotionPlanner]:
-    """The real planners of ``kinds``.
+def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = "auto",
+                     atlas=None) -> Mapping[str, MotionPlanner]:
+    """The real planners of ``kinds`` (flips warm-started from ``atlas`` if given).
 
     Raises:
         MissingPlannerError: A kind without a planner (``serve`` before ``plan_serve``).
@@ -187,7 +191,7 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
     for kind in kinds:
         if kind not in makers:
             raise InvalidChoiceError("motion kind", kind, KINDS)
-        out[kind] = makers[kind](cell, solver)
+        out[kind] = makers[kind](cell, solver, atlas)
     return out
 
 

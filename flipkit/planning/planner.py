@@ -217,23 +217,32 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
 
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
-               progress: bool = True, options: SegmentOptions = SegmentOptions()) -> list[Plan]:
+               progress: bool = True, options: SegmentOptions = SegmentOptions(),
+               executor=None) -> list[Plan]:
     """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
 
     Burger k starts where the last *solved* plan ended (a solved flip ends at q_home at
-    rest); a failed plan is not executed, so it does not move the start of the next one.
+    rest, and an end within :data:`~flipkit.planning.motions.REST_TOL` of it is taken as
+    q_home itself); a failed plan is not executed, so it does not move the start of the next
+    one. Since every solved plan ends at q_home, the burgers after the first are independent:
+    with an ``executor`` (worker processes or Dask) they are planned at once, from q_home, and
+    a burger whose start that assumption got wrong (every plan before it failed, and the
+    batch started elsewhere) is planned again, here, from the right start.
 
     Args:
         locations: Burger locations p^b (m), in order.
         q_start: Start configuration of the first burger (rad), default q_home.
         progress: Show a tqdm progress bar (stderr).
         cell, solver, options: As :func:`plan_flip`.
+        executor: Optional :class:`concurrent.futures.Executor` to plan in parallel.
 
     Raises:
         ConfigError: No location, more than :data:`MAX_BATCH`, or a malformed start.
         UnreachableError: A location off the grill (named by its index, from 1).
     """
     from tqdm import tqdm
+
+    from flipkit.planning.motions import REST_TOL
 
     cell = cell or CellConfig()
     if solver not in SOLVERS:
@@ -247,17 +256,26 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
             checked.append(tg.check_location(cell, loc))
         except UnreachableError as exc:
             raise UnreachableError(f"burger {k}: {exc}") from None
+    home = models_for(cell).bare.q_home
+    kw = {"cell": cell, "solver": solver, "options": options}
+    ahead = None if executor is None else [
+        executor.submit(plan_flip, pb, q_start if k == 0 else home, None, **kw)
+        for k, pb in enumerate(checked)]
     q, qd, plans = q_start, None, []
     bar = tqdm(checked, desc="burgers", unit="burger", disable=not progress)
     for k, pb in enumerate(bar, 1):
         try:
-            plan = plan_flip(pb, q, qd, cell=cell, solver=solver, options=options)
+            start_ok = ahead is not None and (k == 1 or any(p.status == "solved" for p in plans)
+                                              or q_start is None)
+            plan = ahead[k - 1].result() if start_ok else plan_flip(pb, q, qd, **kw)
         except FlipkitError as exc:
             raise type(exc)(f"burger {k}: {exc}") from None
         plans.append(plan)
         bar.set_postfix_str(f"burger {k}: {plan.status}")
         if plan.status == "solved":
             q, qd = plan.segments[-1].q[-1], plan.segments[-1].qd[-1]
+            if max(np.abs(q - home).max(), np.abs(qd).max()) <= REST_TOL:
+                q, qd = home, None  # at rest at q_home, to the solver's tolerance
     return plans
 
 

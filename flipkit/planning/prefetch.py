@@ -28,10 +28,10 @@ from flipkit.config import CellConfig
 from flipkit.planning.motions import REST_TOL, MotionJob, PlannedMotion, default_planners
 
 
-def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str
-                ) -> PlannedMotion:
+def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str,
+                atlas=None) -> PlannedMotion:
     """Plan one motion with the real planner of ``kind`` (a worker's task)."""
-    return default_planners((kind,), cell, solver)[kind](job, np.asarray(q_start, float))
+    return default_planners((kind,), cell, solver, atlas)[kind](job, np.asarray(q_start, float))
 
 
 class PrefetchPlanners(Mapping):
@@ -43,12 +43,12 @@ class PrefetchPlanners(Mapping):
         q_rest: The rest configuration every motion starts and ends at (rad).
         spots: Table spots (x, y) (m), handed out in drop order.
         executor: A :class:`concurrent.futures.Executor` (worker processes or Dask).
-        cell, solver: As :func:`~flipkit.planning.motions.default_planners`.
+        cell, solver, atlas: As :func:`~flipkit.planning.motions.default_planners`.
     """
 
     def __init__(self, order, kinds, q_rest, spots, executor: cf.Executor,
-                 cell: CellConfig, solver: str = "auto"):
-        self.kinds, self.cell, self.solver = tuple(kinds), cell, solver
+                 cell: CellConfig, solver: str = "auto", atlas=None):
+        self.kinds, self.cell, self.solver, self.atlas = tuple(kinds), cell, solver, atlas
         self.q_rest, self.executor = np.asarray(q_rest, float), executor
         self._spots = {b.burger: tuple(spots[k]) for k, b in enumerate(order) if k < len(spots)}
         self._t0 = time.perf_counter()
@@ -64,7 +64,7 @@ class PrefetchPlanners(Mapping):
 
     def _submit(self, job: MotionJob) -> None:
         fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
-                                   self.solver)
+                                   self.solver, self.atlas)
         key = self._key(job)
         fut.add_done_callback(lambda _f, key=key: self._ready.setdefault(
             key, time.perf_counter() - self._t0))
@@ -75,7 +75,7 @@ class PrefetchPlanners(Mapping):
         if fut is None or np.abs(np.asarray(q_start, float) - self.q_rest).max() > REST_TOL:
             self.on_demand += 1
             t = time.perf_counter()
-            pm = plan_motion(job.kind, job, q_start, self.cell, self.solver)
+            pm = plan_motion(job.kind, job, q_start, self.cell, self.solver, self.atlas)
             pm.ready_s = time.perf_counter() - self._t0
             pm.planning_time_s = time.perf_counter() - t
             return pm
