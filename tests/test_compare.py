@@ -20,7 +20,7 @@ from flipkit.planning.verify import verify_plan
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
 COLLOCATION_KEYS = {"status", "reason", "time_s", "judge"}
 EE_IK_KEYS = {"status", "reason", "class", "subbehavior", "amount", "time_scaling", "time_s",
-              "time_breakdown_s"}
+              "time_breakdown_s", "durations_s"}
 
 
 @pytest.fixture(scope="module")

@@ -32,6 +32,7 @@ METHODS = ("collocation", "ee_ik")
 _PRIVATE = "_segment_time_s"  # per-segment solve times, used by the summary only
 RATE = 500.0  # Hz: the judge's sample rate for both methods (issue 14)
 IK = "analytic"  # the baseline's IK: the UR10's closed form (flipkit.model.ur_ik)
+EE = "scp"  # the baseline's EE optimisation: position, orientation, duration free (issue 14)
 
 
 def _number(x) -> float | None:
@@ -80,14 +81,15 @@ def _judge(plan) -> dict:
 def _ee_ik(location) -> dict:
     from flipkit.baseline import run_baseline
 
-    res = run_baseline(location, rate=RATE, ik=IK)
+    res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
     failure = res.failure
     return {"status": res.status, "reason": res.reason,
             "class": failure.failure_class if failure else None,
             "subbehavior": res.subbehavior, "amount": _number(res.amount),
             "time_scaling": _number(failure.time_scaling) if failure else None,
             "time_s": float(sum(v["ee"] + v["ik"] for v in res.time_s.values())),
-            "time_breakdown_s": res.time_s}
+            "time_breakdown_s": res.time_s,
+            "durations_s": {t.name: float(t.T) for t in res.trajectories}}
 
 
 def compare_location(job: dict) -> dict:
@@ -102,7 +104,8 @@ def compare_location(job: dict) -> dict:
         ``{"location", "collocation": {status, reason, time_s (s, the whole planning call),
         judge: {status, reason, class, subbehavior, amount} or None, ...}, "ee_ik": {status,
         reason, class, subbehavior, amount, time_scaling, time_s (s, EE + IK of every
-        subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}}}``.
+        subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}, durations_s:
+        {subbehaviour: T (s), the baseline's chosen duration}}}``.
     """
     loc = [float(v) for v in job["location"]]
     return {"location": loc, "collocation": _collocation(loc, job["solver"], job["plans_dir"]),
@@ -185,7 +188,7 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
         Path(plans_dir).mkdir(parents=True, exist_ok=True)
         plans_dir = str(Path(plans_dir).resolve())
     jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir, "judge_rate": RATE,
-             "ik": IK} for loc in locs]  # judge and IK in the job: caches of other setups miss
+             "ik": IK, "ee": EE} for loc in locs]  # judge and IK in the job: caches of other setups miss
     records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
                         desc="compare-ik")
     entries = [{"location": r["location"],
