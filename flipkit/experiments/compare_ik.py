@@ -89,7 +89,21 @@ def _ee_ik(location) -> dict:
             "time_scaling": _number(failure.time_scaling) if failure else None,
             "time_s": float(sum(v["ee"] + v["ik"] for v in res.time_s.values())),
             "time_breakdown_s": res.time_s,
-            "durations_s": {t.name: float(t.T) for t in res.trajectories}}
+            "durations_s": {t.name: float(t.T) for t in res.trajectories},
+            "segments": [{"subbehavior": v.subbehavior, "status": v.status, "reason": v.reason,
+                          "class": v.failure_class, "amount": _number(v.amount)}
+                         for v in res.segments]}
+
+
+def worst_class(ee_ik: dict) -> str:
+    """The worst class over a baseline record's subbehaviours (each judged on its own, the IK
+    restarting after a failure): ``ee`` > ``kinematic`` > ``dynamic`` > ``time_scalable`` >
+    ``solved``; the first failure's class when the record lists no segments."""
+    order = ("solved", "time_scalable", "dynamic", "kinematic", "ee")
+    classes = [s["class"] or "solved" for s in ee_ik.get("segments") or []]
+    if not classes:
+        return ee_ik.get("class") or "solved"
+    return max(classes, key=order.index)
 
 
 def compare_location(job: dict) -> dict:
@@ -105,7 +119,8 @@ def compare_location(job: dict) -> dict:
         judge: {status, reason, class, subbehavior, amount} or None, ...}, "ee_ik": {status,
         reason, class, subbehavior, amount, time_scaling, time_s (s, EE + IK of every
         subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}, durations_s:
-        {subbehaviour: T (s), the baseline's chosen duration}}}``.
+        {subbehaviour: T (s), the baseline's chosen duration}, segments: [{subbehavior,
+        status, reason, class, amount}, ...] (every subbehaviour run)}}``.
     """
     loc = [float(v) for v in job["location"]]
     return {"location": loc, "collocation": _collocation(loc, job["solver"], job["plans_dir"]),
@@ -120,6 +135,9 @@ def _median(values) -> float | None:
 def summarize(records: list) -> dict:
     """Success fraction per method, failure counts and median wall times (s) per subbehaviour.
 
+    ``ik_failure_classes`` counts the class of each failed baseline's first failure,
+    ``ik_worst_classes`` the worst class over its subbehaviours (:func:`worst_class`).
+
     ``collocation_failures`` counts the subbehaviour where each failed plan stopped (the
     prefix of its reason; ``other`` when there is none).
     """
@@ -128,6 +146,7 @@ def summarize(records: list) -> dict:
             for m in METHODS}
     reasons = Counter(r["ee_ik"]["reason"] for r in records if r["ee_ik"]["status"] != "solved")
     classes = Counter(r["ee_ik"]["class"] for r in records if r["ee_ik"]["status"] != "solved")
+    worst = Counter(worst_class(r["ee_ik"]) for r in records)
     judged = Counter((r["collocation"].get("judge") or {}).get("class") or "solved"
                      for r in records if r["collocation"]["status"] == "solved")
     stops = Counter()
@@ -145,6 +164,7 @@ def summarize(records: list) -> dict:
     return {"locations": n, "success_fraction": frac,
             "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
             "ik_failure_classes": {k: classes.get(k, 0) for k in FAILURE_CLASSES},
+            "ik_worst_classes": {k: worst.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "collocation_judge": {k: judged.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
                                         for s in tg.SUBBEHAVIORS},
@@ -217,4 +237,5 @@ def format_summary(summary: dict) -> str:
 
 
 __all__ = ["LOCATION_SETS", "compare_location", "compare_ik", "summarize", "format_summary",
+           "worst_class",
            "plan_filename"]
