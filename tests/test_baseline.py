@@ -26,7 +26,7 @@ RATE = 200.0
 
 @pytest.fixture(scope="module")
 def benign(cell):
-    return run_baseline(BENIGN, cell, rate=RATE)
+    return run_baseline(BENIGN, cell, rate=RATE, ee="fixed")
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +131,7 @@ def test_narrowed_joint_limit_is_reported(benign, cell, tmp_path):
     urdf = tmp_path / "ur10_narrow.urdf"
     urdf.write_text(text)
     narrow = replace(cell, robot=RobotConfig(urdf=str(urdf)))
-    result = run_baseline(BENIGN, narrow, rate=RATE)
+    result = run_baseline(BENIGN, narrow, rate=RATE, ee="fixed")
     assert result.subbehavior == "go_to_burger" and result.reason == "joint_limit"
     assert result.amount == pytest.approx(5e-4, abs=5e-5)
     assert "joint 4" in result.failure.detail
@@ -139,7 +139,7 @@ def test_narrowed_joint_limit_is_reported(benign, cell, tmp_path):
 
 def test_infeasible_cone_is_ee_infeasible(cell):
     slippery = replace(cell, burger=replace(cell.burger, mu=0.01))
-    result = run_baseline(BENIGN, slippery, rate=RATE)
+    result = run_baseline(BENIGN, slippery, rate=RATE, ee="fixed")
     assert result.reason == "ee_infeasible" and result.subbehavior in ("pickup", "flip")
     assert len(result.segments) < 5
 

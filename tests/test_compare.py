@@ -20,7 +20,7 @@ from flipkit.planning.verify import verify_plan
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
 COLLOCATION_KEYS = {"status", "reason", "time_s", "judge"}
 EE_IK_KEYS = {"status", "reason", "class", "subbehavior", "amount", "time_scaling", "time_s",
-              "time_breakdown_s"}
+              "time_breakdown_s", "durations_s", "segments"}
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +52,14 @@ def test_output_schema(run):
     assert s["locations"] == 1 and set(s["success_fraction"]) == {"collocation", "ee_ik"}
     assert set(s["ik_failure_reasons"]) == set(REASONS)
     assert set(s["ik_failure_classes"]) == set(FAILURE_CLASSES)
+    segs = entry["ee_ik"]["segments"]  # every subbehaviour run, the first failure among them
+    assert [g["subbehavior"] for g in segs] == list(SUBBEHAVIORS)[:len(segs)]
+    first = next(g for g in segs if g["status"] != "solved")
+    assert first["subbehavior"] == entry["ee_ik"]["subbehavior"]
+    assert first["class"] == entry["ee_ik"]["class"]
+    order = ("solved", "time_scalable", "dynamic", "kinematic", "ee")
+    worst = max((g["class"] or "solved" for g in segs), key=order.index)
+    assert s["ik_worst_classes"][worst] == 1 and sum(s["ik_worst_classes"].values()) == 1
     judge = entry["collocation"]["judge"]
     assert judge["status"] in ("solved", "failed") and sum(s["collocation_judge"].values()) == 1
     assert set(s["median_time_s"]["collocation"]) == set(SUBBEHAVIORS) | {"total"}

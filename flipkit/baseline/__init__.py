@@ -1,21 +1,29 @@
 """End-effector-space + inverse-kinematics baseline (the paper's reference [8] approach,
-Sec. I): optimise the spatula trajectory of each subbehaviour in task space
-(:mod:`.ee_opt`), track it with placo IK at a controller rate (:mod:`.ik_track`) and
-classify what goes wrong (:mod:`.classify`).
+Sec. I): optimise the spatula trajectory of each subbehaviour in task space, track it with
+inverse kinematics at a controller rate (:mod:`.analytic_track`: the UR10's closed form;
+:mod:`.ik_track`: placo) and classify what goes wrong (:mod:`.classify`).
 
-Durations are :data:`BASELINE_T` (s): the upper duration bounds collocation had before its
-chain was shortened from 4.0 s to 3.4 s. At the shorter bounds this baseline's go-to-burger
-already exceeds the joint acceleration limit (24 vs 20 rad/s² at Table I location 6, measured),
-so every location would fail there and say nothing about the flip; freeing the baseline's
-durations within collocation's bounds is issue 14's work. Each subbehaviour's
-end-effector QP starts at the previous one's end state (position, velocity, orientation);
-the IK continues from the previous IK configuration, except after a failed subbehaviour,
-where it restarts from an exact single-pose IK solution of the planned start pose
-(:func:`flipkit.model.ik.solve_pose`, see :func:`_restart`) so that every subbehaviour is judged
-on its own rather than on the previous one's lag.
+Two end-effector optimisations (``ee``):
+
+* ``scp`` (default, issue 14): position, orientation and duration free
+  (:mod:`.ee_scp`, sequential convex programming over the rpy Bezier; the duration by a
+  golden-section search within collocation's bounds :data:`~flipkit.behaviors.segments.T_BOUNDS`),
+  with collocation's task-space endpoint constraints, friction cone and flip landing.
+* ``fixed``: the earlier single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep
+  profile to a fixed flip end orientation, the durations :data:`BASELINE_T` (s) — the upper
+  bounds collocation had before its chain was shortened from 4.0 s to 3.4 s.
+
+Each subbehaviour's end-effector problem starts at the previous one's end state (position,
+velocity, orientation, orientation rate); the IK continues from the previous IK
+configuration, except after a failed subbehaviour, where it restarts from an exact
+single-pose IK solution of the planned start pose (:func:`flipkit.model.ik.solve_pose`, see
+:func:`_restart`) so that every subbehaviour is judged on its own rather than on the previous
+one's lag.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 
@@ -28,6 +36,7 @@ from flipkit.model.orientation import rpy
 from flipkit.baseline.classify import (CLASSES, REASONS, BaselineResult, SegmentVerdict,
                                       Thresholds, classify_plan, classify_segment)
 from flipkit.baseline.ee_opt import EEState, EETrajectory, plan_segment
+from flipkit.baseline.ee_scp import plan_segment_scp
 
 BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
 from flipkit.baseline.ik_track import IKTrack, PlacoTracker  # noqa: E402
@@ -35,11 +44,13 @@ from flipkit.baseline.analytic_track import AnalyticTracker  # noqa: E402
 
 
 IK_METHODS = ("placo", "analytic")
+EE_METHODS = ("scp", "fixed")
 
 
 def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: float = 200.0,
                  *, iterations: int = 3, velocity_limits: bool = True,
-                 thresholds: Thresholds = Thresholds(), ik: str = "placo") -> BaselineResult:
+                 thresholds: Thresholds = Thresholds(), ik: str = "placo",
+                 ee: str = "scp") -> BaselineResult:
     """Plan pickup-and-flip at ``location`` with the end-effector-space + IK baseline.
 
     Args:
@@ -53,6 +64,7 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
         ik: ``placo`` (differential IK with joint and velocity limits, warm-started) or
             ``analytic`` (the UR10's closed form, the branch continuous with the start;
             :mod:`.analytic_track`).
+        ee: End-effector optimisation, one of :data:`EE_METHODS` (see the module docstring).
 
     Returns:
         The per-subbehaviour verdicts (with EE and IK wall times), trajectories and tracks.
@@ -60,10 +72,12 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     Raises:
         UnreachableError: ``location`` is not on the grill.
         ConfigError: Bad ``q_start`` or ``rate``.
-        InvalidChoiceError: ``ik`` is not one of :data:`IK_METHODS`.
+        InvalidChoiceError: ``ik`` or ``ee`` is not one of :data:`IK_METHODS`, :data:`EE_METHODS`.
     """
     if ik not in IK_METHODS:
         raise InvalidChoiceError("IK method", ik, IK_METHODS)
+    if ee not in EE_METHODS:
+        raise InvalidChoiceError("end-effector method", ee, EE_METHODS)
     cell = cell or CellConfig()
     if not (np.isfinite(rate) and rate > 0):
         raise ConfigError(f"IK rate must be a positive number of Hz, got {rate!r}")
@@ -81,11 +95,16 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
                PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits))
     result = BaselineResult(tuple(float(x) for x in pb), [])
     for name in tg.SUBBEHAVIORS:
+        tic = time.perf_counter()
         try:
-            traj = plan_segment(name, cell, pb, start, BASELINE_T[name], home=home, rate=rate)
+            if ee == "scp":
+                traj = plan_segment_scp(name, cell, pb, start, home=home, rate=rate)
+            else:
+                traj = plan_segment(name, cell, pb, start, BASELINE_T[name], home=home, rate=rate)
         except NoSolutionFound as exc:
-            result.segments.append(SegmentVerdict(name, "failed", "ee_infeasible",
-                                                  detail=f"end-effector QP: {exc.status}"))
+            result.segments.append(SegmentVerdict(
+                name, "failed", "ee_infeasible", detail=f"end-effector QP: {exc.status}",
+                ee_time_s=time.perf_counter() - tic))
             break
         track = tracker.track(traj, q)
         verdict = classify_segment(name, models.for_segment(name), track.t, track.q, traj.p,
@@ -118,4 +137,4 @@ def _restart(robot, traj: EETrajectory, q_track: np.ndarray) -> np.ndarray:
 
 __all__ = ["run_baseline", "BaselineResult", "SegmentVerdict", "Thresholds", "REASONS",
            "classify_segment", "EEState", "EETrajectory", "plan_segment", "IKTrack",
-           "PlacoTracker", "AnalyticTracker", "IK_METHODS", "CLASSES", "classify_plan"]
+           "PlacoTracker", "AnalyticTracker", "IK_METHODS", "EE_METHODS", "plan_segment_scp", "CLASSES", "classify_plan"]

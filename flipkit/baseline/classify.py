@@ -16,7 +16,8 @@ The checks run in this order and the first one that fails is the verdict:
 4. ``joint_velocity`` / ``joint_acceleration`` — finite differences of q (second order,
    ``np.gradient``) above qd_max / qdd_max.
 5. ``torque`` — RNEA along (q, q̇, q̈) with the segment's payload above u_max.
-6. ``below_grill`` — a blade edge (tip, heel, sides) lower than h_g − 1 mm (in the scoop,
+6. ``below_grill`` — a blade edge (tip, heel, sides) lower than h_g − 1 mm (in go-to-burger,
+   scoop and pickup, which end, run or start with the blade pressed into the grill,
    h_g − 1 mm − the commanded press and its band).
 
 ``ee_infeasible`` marks a subbehaviour whose end-effector QP had no solution.
@@ -53,6 +54,7 @@ UNITS = {"ee_infeasible": "", "unreachable": "s", "singularity": "1",
          "configuration_jump": "rad", "joint_velocity": "rad/s",
          "joint_acceleration": "rad/s^2", "torque": "N m", "below_grill": "m"}
 EDGES = ("tip", "heel", "left", "right")
+PRESSED = ("go_to_burger", "scoop", "pickup")  # subbehaviours where the blade is pressed
 
 
 @dataclass(frozen=True)
@@ -174,9 +176,9 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
     a_ratio, ak, aj = _worst_ratio(qdd, robot.qdd_max)
     u_ratio, uk, uj = _worst_ratio(u, robot.u_max)
     # the scoop commands the tip SCOOP_PRESS into the grill (±SCOOP_TIP_BAND), for both methods'
-    # plans alike: the blade may go that deep there (collocation's scoop; the baseline's tip
-    # stays on the surface)
-    depth = th.grill_margin + (SCOOP_PRESS + SCOOP_TIP_BAND if name == "scoop" else 0.0)
+    # plans alike: the blade may go that deep where it is pressed (behaviors.segments.grill_floor:
+    # the go-to-burger's end, the scoop, the pickup's start)
+    depth = th.grill_margin + (SCOOP_PRESS + SCOOP_TIP_BAND if name in PRESSED else 0.0)
     floor = cell.grill.height - depth
     measures = {"tracking_position_m": float(e_pos.max()),
                 "tracking_rotation_rad": float(e_rot.max()),

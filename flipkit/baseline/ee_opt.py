@@ -36,11 +36,13 @@ COST_SCALE = 1e-4  # numerical scaling of the objective only
 
 @dataclass(frozen=True)
 class EEState:
-    """Spatula state at a segment boundary: position p (m), velocity v (m/s), rpy o (rad)."""
+    """Spatula state at a segment boundary: position p (m), velocity v (m/s), rpy o (rad),
+    rpy rate w (rad/s)."""
 
     p: tuple
     v: tuple
     o: tuple
+    w: tuple = (0.0, 0.0, 0.0)
 
 
 @dataclass
@@ -56,6 +58,11 @@ class EETrajectory:
         solve_time_s: Wall time of the QP (s): building and compiling it on the first call
             for its shape, parameter update, solve.
         objective: Optimal cost. status: Solver status.
+        od: rpy rates (rad/s), (n, 3), or None (the fixed profile: zero at both ends).
+        o_coeffs: Bezier control points of o (rad), or None (the fixed profile).
+        iterations: SCP iterations at the chosen duration (0: a single QP).
+        max_violation: Scaled violation of the linearised constraints at the solution.
+        durations_tried: Durations the search evaluated (1: fixed duration).
     """
 
     name: str
@@ -71,10 +78,16 @@ class EETrajectory:
     solve_time_s: float
     objective: float
     status: str
+    od: np.ndarray | None = None
+    o_coeffs: np.ndarray | None = None
+    iterations: int = 0
+    max_violation: float = 0.0
+    durations_tried: int = 1
 
     def end_state(self) -> EEState:
         """The state the next subbehaviour starts from."""
-        return EEState(tuple(self.p[-1]), tuple(self.v[-1]), tuple(self.o[-1]))
+        w = (0.0, 0.0, 0.0) if self.od is None else tuple(self.od[-1])
+        return EEState(tuple(self.p[-1]), tuple(self.v[-1]), tuple(self.o[-1]), w)
 
 
 def smoothstep(s) -> np.ndarray:

@@ -32,6 +32,7 @@ METHODS = ("collocation", "ee_ik")
 _PRIVATE = "_segment_time_s"  # per-segment solve times, used by the summary only
 RATE = 500.0  # Hz: the judge's sample rate for both methods (issue 14)
 IK = "analytic"  # the baseline's IK: the UR10's closed form (flipkit.model.ur_ik)
+EE = "scp"  # the baseline's EE optimisation: position, orientation, duration free (issue 14)
 
 
 def _number(x) -> float | None:
@@ -80,14 +81,29 @@ def _judge(plan) -> dict:
 def _ee_ik(location) -> dict:
     from flipkit.baseline import run_baseline
 
-    res = run_baseline(location, rate=RATE, ik=IK)
+    res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
     failure = res.failure
     return {"status": res.status, "reason": res.reason,
             "class": failure.failure_class if failure else None,
             "subbehavior": res.subbehavior, "amount": _number(res.amount),
             "time_scaling": _number(failure.time_scaling) if failure else None,
             "time_s": float(sum(v["ee"] + v["ik"] for v in res.time_s.values())),
-            "time_breakdown_s": res.time_s}
+            "time_breakdown_s": res.time_s,
+            "durations_s": {t.name: float(t.T) for t in res.trajectories},
+            "segments": [{"subbehavior": v.subbehavior, "status": v.status, "reason": v.reason,
+                          "class": v.failure_class, "amount": _number(v.amount)}
+                         for v in res.segments]}
+
+
+def worst_class(ee_ik: dict) -> str:
+    """The worst class over a baseline record's subbehaviours (each judged on its own, the IK
+    restarting after a failure): ``ee`` > ``kinematic`` > ``dynamic`` > ``time_scalable`` >
+    ``solved``; the first failure's class when the record lists no segments."""
+    order = ("solved", "time_scalable", "dynamic", "kinematic", "ee")
+    classes = [s["class"] or "solved" for s in ee_ik.get("segments") or []]
+    if not classes:
+        return ee_ik.get("class") or "solved"
+    return max(classes, key=order.index)
 
 
 def compare_location(job: dict) -> dict:
@@ -102,7 +118,9 @@ def compare_location(job: dict) -> dict:
         ``{"location", "collocation": {status, reason, time_s (s, the whole planning call),
         judge: {status, reason, class, subbehavior, amount} or None, ...}, "ee_ik": {status,
         reason, class, subbehavior, amount, time_scaling, time_s (s, EE + IK of every
-        subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}}}``.
+        subbehaviour run), time_breakdown_s: {subbehaviour: {"ee": s, "ik": s}}, durations_s:
+        {subbehaviour: T (s), the baseline's chosen duration}, segments: [{subbehavior,
+        status, reason, class, amount}, ...] (every subbehaviour run)}}``.
     """
     loc = [float(v) for v in job["location"]]
     return {"location": loc, "collocation": _collocation(loc, job["solver"], job["plans_dir"]),
@@ -117,6 +135,9 @@ def _median(values) -> float | None:
 def summarize(records: list) -> dict:
     """Success fraction per method, failure counts and median wall times (s) per subbehaviour.
 
+    ``ik_failure_classes`` counts the class of each failed baseline's first failure,
+    ``ik_worst_classes`` the worst class over its subbehaviours (:func:`worst_class`).
+
     ``collocation_failures`` counts the subbehaviour where each failed plan stopped (the
     prefix of its reason; ``other`` when there is none).
     """
@@ -125,6 +146,7 @@ def summarize(records: list) -> dict:
             for m in METHODS}
     reasons = Counter(r["ee_ik"]["reason"] for r in records if r["ee_ik"]["status"] != "solved")
     classes = Counter(r["ee_ik"]["class"] for r in records if r["ee_ik"]["status"] != "solved")
+    worst = Counter(worst_class(r["ee_ik"]) for r in records)
     judged = Counter((r["collocation"].get("judge") or {}).get("class") or "solved"
                      for r in records if r["collocation"]["status"] == "solved")
     stops = Counter()
@@ -142,6 +164,7 @@ def summarize(records: list) -> dict:
     return {"locations": n, "success_fraction": frac,
             "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
             "ik_failure_classes": {k: classes.get(k, 0) for k in FAILURE_CLASSES},
+            "ik_worst_classes": {k: worst.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "collocation_judge": {k: judged.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
                                         for s in tg.SUBBEHAVIORS},
@@ -185,7 +208,7 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
         Path(plans_dir).mkdir(parents=True, exist_ok=True)
         plans_dir = str(Path(plans_dir).resolve())
     jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir, "judge_rate": RATE,
-             "ik": IK} for loc in locs]  # judge and IK in the job: caches of other setups miss
+             "ik": IK, "ee": EE} for loc in locs]  # judge and IK in the job: caches of other setups miss
     records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
                         desc="compare-ik")
     entries = [{"location": r["location"],
@@ -214,4 +237,5 @@ def format_summary(summary: dict) -> str:
 
 
 __all__ = ["LOCATION_SETS", "compare_location", "compare_ik", "summarize", "format_summary",
+           "worst_class",
            "plan_filename"]

@@ -10,6 +10,8 @@
   pickup-and-flip, per solver and location.
 * :func:`plan_targets` — the Table I plans, once, for several validations.
 * :func:`flip_execution` — one unperturbed execution (open loop or replanned) to render.
+* :func:`ik_example` — the joint paths of the EE + IK baseline and of collocation at one
+  location where the baseline fails (figure ``ik_failure``).
 """
 
 from __future__ import annotations
@@ -270,5 +272,81 @@ def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = Tru
     return ex, ok
 
 
+# ------------------------------------------------------------------ EE + IK vs collocation
+def example_location(entries):
+    """The location shown beside the maps of ``ik_failure``: the first entry (in order) whose
+    baseline fails with a joint path to show (kinematic, dynamic or time-scalable) while the
+    collocation plan passes the judge; else the first whose baseline fails while collocation
+    solves; else None."""
+    def coll_ok(e, judged):
+        c = e["collocation"]
+        return c["status"] == "solved" and (not judged or (c.get("judge") or {}).get(
+            "status", "solved") == "solved")
+
+    for judged, classes in ((True, ("kinematic", "dynamic", "time_scalable")), (False, None)):
+        for e in entries:
+            b = e["ee_ik"]
+            if b["status"] != "solved" and coll_ok(e, judged) and (
+                    classes is None or b.get("class") in classes):
+                return [float(v) for v in e["location"]]
+    return None
+
+
+def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
+    """Both methods' joint paths at ``location`` (m), on one time axis each, at the judge's
+    rate (:data:`flipkit.experiments.compare_ik.RATE`).
+
+    The baseline is re-run as ``compare-ik`` runs it; the collocation plan is read from
+    ``plans_dir`` (``compare-ik --plans``) when it holds one, else planned with ``solver``.
+
+    Returns:
+        ``{"location", "ee_ik": path, "collocation": path}``, each path ``{"t" (s), "q"
+        (rad), "boundaries" (s), "names", "failed" (subbehaviour or None), "label"}``.
+    """
+    from pathlib import Path
+
+    from scipy.interpolate import CubicHermiteSpline
+
+    from flipkit.baseline import run_baseline
+    from flipkit.baseline.classify import classify_plan
+    from flipkit.baseline.ee_opt import sample_times
+    from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
+    from flipkit.planning.plan_file import Plan
+
+    res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
+    ts, qs, edges, t0 = [], [], [0.0], 0.0
+    for track in res.tracks:
+        ts.append(t0 + track.t)
+        qs.append(track.q)
+        t0 += track.t[-1]
+        edges.append(t0)
+    f = res.failure
+    ee = {"t": np.concatenate(ts), "q": np.vstack(qs), "boundaries": edges,
+          "names": [tr.name for tr in res.trajectories], "failed": res.subbehavior,
+          "label": (f"{f.subbehavior}: {f.reason.replace('_', ' ')}, {f.detail}" if f
+                    else "solved")}
+    path = Path(plans_dir) / plan_filename(location, solver) if plans_dir else None
+    if path is not None and path.exists():
+        plan = Plan.load(path)
+    else:
+        from flipkit.planning.planner import plan_flip
+        plan = plan_flip(location, solver=solver)
+    ts, qs, edges, t0 = [], [], [0.0], 0.0
+    for seg in plan.segments:
+        t = sample_times(seg.T, RATE)
+        ts.append(t0 + t)
+        qs.append(CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(t))
+        t0 += seg.T
+        edges.append(t0)
+    bad = next((v for v in classify_plan(plan, RATE) if v.status != "solved"), None)
+    coll = {"t": np.concatenate(ts), "q": np.vstack(qs), "boundaries": edges,
+            "names": [seg.name for seg in plan.segments],
+            "failed": bad.subbehavior if bad else None,
+            "label": (f"{plan.status}; judge: " + (f"{bad.subbehavior}: {bad.reason}"
+                                                   if bad else "passes"))}
+    return {"location": [float(v) for v in location], "ee_ik": ee, "collocation": coll}
+
+
 __all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
-           "solve_time_sweep", "solve_time_table", "plan_targets", "flip_execution"]
+           "solve_time_sweep", "solve_time_table", "plan_targets", "flip_execution",
+           "example_location", "ik_example"]

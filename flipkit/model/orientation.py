@@ -23,6 +23,26 @@ def rpy_matrix(o) -> np.ndarray:
     return np.array(pin.rpy.rpyToMatrix(*np.asarray(o, dtype=float)))
 
 
+def rpy_matrix_derivatives(o) -> np.ndarray:
+    """∂R/∂o_j of R = R_z(o_z) R_y(o_y) R_x(o_x), shape (3, 3, 3) with index [j] = ∂R/∂o_j
+    (1/rad)."""
+    x, y, z = np.asarray(o, dtype=float)
+    cx, sx, cy, sy, cz, sz = np.cos(x), np.sin(x), np.cos(y), np.sin(y), np.cos(z), np.sin(z)
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    dRx = np.array([[0, 0, 0], [0, -sx, -cx], [0, cx, -sx]])
+    dRy = np.array([[-sy, 0, cy], [0, 0, 0], [-cy, 0, -sy]])
+    dRz = np.array([[-sz, -cz, 0], [cz, -sz, 0], [0, 0, 0]])
+    return np.stack([Rz @ Ry @ dRx, Rz @ dRy @ Rx, dRz @ Ry @ Rx])
+
+
+def rpy_rate_matrix(o) -> np.ndarray:
+    """E(o) (3×3) with ω = E(o) ȯ: world angular velocity (rad/s) from the rpy rates (rad/s)."""
+    return np.array(pin.rpy.computeRpyJacobian(np.asarray(o, dtype=float),
+                                               pin.ReferenceFrame.WORLD))
+
+
 def rpy_jacobian(R: np.ndarray, Jw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """o(R) and ∂o/∂q = E(o)⁻¹ Jw, E mapping rpy rates to world angular velocity."""
     o = rpy(R)

@@ -1,0 +1,339 @@
+"""The strong end-effector-space optimisation of one subbehaviour: position, orientation and
+duration free, by sequential convex programming (issue 14).
+
+What it keeps of the paper's reference [8] (Tsuji et al., dynamic object manipulation with a
+tool, planned in task space): the motion is planned for the tool alone — blade-centre
+position p(t) and orientation R(t) as smooth polynomials in time — under the contact
+condition of the carried object (the friction cone of the specific contact force,
+f = Rᵀ(a − g), eq. 5, with collocation's friction safety factor μ × 0.8) and the task's
+endpoint conditions; the joints enter only afterwards, through inverse kinematics. What it
+adds so that the comparison with joint-space collocation is fair: the task-space constraints
+of collocation's segments (:func:`flipkit.behaviors.segments.build_segment`) — endpoint
+poses and rest, the position/velocity/acceleration box and pitch range (eq. 4), the blade's
+edges above the grill (the scoop's press included), the scoop's tip band, lateral band and
+attitude band, the flip's end-normal box, x-axis box at every sample, end-height band, cone
+up to the release at 0.7 T and the ballistic landing within r_land of the pickup spot, top
+face ≥ 150° from up — and a duration free within the same bounds
+(:data:`flipkit.behaviors.segments.T_BOUNDS`). Not kept: the flip's flight clearance and the
+arm's space limits (joint-space quantities the task-space method cannot see).
+
+Method. p(s) and the rpy angles o(s) are Bezier polynomials of degree 7 in s = t/T; their
+control points C, D (m, rad) are the decision variables. The constraints are imposed at
+:data:`SAMPLES` evenly spaced s (the velocity, acceleration and pitch bounds on the control
+points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints,
+boxes, pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised about the
+previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
+differences of :func:`flipkit.model.flight.predict_landing`) and relaxed by one elastic slack
+σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
+(subbehaviour, samples), written once with Parameters (DPP) and cached; the duration enters
+only through Parameters (bounds scaled by T, T²; cost weights), so a duration search and a
+sweep over burger locations recompile nothing. A step is taken when the merit — cost plus
+penalty × the exact violation — falls by at least a tenth of what the subproblem predicts;
+the box trust region (Δ rad on D, 0.3 Δ m on C) halves when it falls by less than a quarter
+and doubles when by more than three quarters at its edge. The cost
+is ∫ |p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT`
+(m²/rad²): a radian of blade rotation weighs as much as a translation by the arm's reach,
+≈ 1 m, both being about a radian of joint motion. (With w_o = (l/2)², a blade-tip
+displacement, rotations were so cheap that the go-to-burger pitched back 0.34 rad and
+forward again to keep the tip off the grill, and wrist 1 reached 8 rad/s; measured at
+Table I location 6.) The duration is chosen by a golden-section search of the converged cost over
+the bounds (infeasible durations cost +∞), each solve warm-started from the best so far.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import cvxpy as cp
+import numpy as np
+
+from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
+from flipkit.baseline.scp_problem import ORIENTATION_WEIGHT, REST, SCPProblem
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, RELEASE_FRACTION, SCOOP_PRESS,
+                                        SCOOP_TIP_BAND, T_BOUNDS, grill_floor, _flip_guess_pose)
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
+from flipkit.model.bezier import Bezier
+from flipkit.model.flight import TILT_MIN_DEG, predict_landing
+from flipkit.model.orientation import rpy_matrix, rpy_rate_matrix
+
+DEGREE = 7
+SAMPLES = 31  # constraint samples on s ∈ [0, 1] (collocation: 21 nodes)
+ITERATIONS = 30  # SCP iterations per duration, at most
+TRUST0 = 0.3  # rad: initial trust region on the rpy control points
+TRUST_WARM = 0.05  # rad: the initial region of a solve warm-started at another duration
+TRUST_MAX = 1.0  # rad: the trust region doubles after an accepted step that reached it
+STEP_TOL = 1e-4  # rad: the search at a duration stops when the trust region is below this
+# converged: the exact scaled violation below FEAS_TOL ...
+FEAS_TOL = 1e-4  # ... and the exact scaled violation below this
+OBJ_TOL = 0.02  # ... and the merit decreases by less than this, relative
+RHO_ACCEPT = 0.1  # a step is taken when the merit falls by this share of the model's decrease
+GOLDEN_STEPS = 3  # golden-section reductions of the duration interval
+EDGES = np.array([[0.5, 0, 0], [-0.5, 0, 0], [0, 0.5, 0], [0, -0.5, 0]])  # × (l, w, ·)
+
+
+def _guess_coeffs(bez: Bezier, s: np.ndarray, start: EEState, goal: tg.Pose) -> tuple:
+    """Control points of the smoothstep interpolation from ``start`` to ``goal``."""
+    w = (s**3 * (10 - 15 * s + 6 * s**2))[:, None]
+    P = np.asarray(start.p) + (np.asarray(goal.p) - np.asarray(start.p)) * w
+    O = np.asarray(start.o) + (np.asarray(goal.o) - np.asarray(start.o)) * w
+    pinv = np.linalg.pinv(bez.basis(s))
+    return pinv @ P, pinv @ O
+
+
+class Task:
+    """The task data of one subbehaviour at one location (all SI)."""
+
+    def __init__(self, name: str, cell: CellConfig, pb: np.ndarray, start: EEState,
+                 home: tg.Pose | None):
+        self.name, self.cell, self.pb, self.start = name, cell, pb, start
+        sp, hg = cell.spatula, cell.grill.height
+        self.edges = (EDGES * np.array([sp.length, sp.width, 0.0])).T  # (3, 4) blade frame
+        self.goal = {"go_to_burger": tg.scoop_ready(cell, pb), "scoop": tg.scoop_end(cell, pb),
+                     "pickup": tg.pickup_end(cell, pb), "turn_back": home}.get(name)
+        self.guess_goal = self.goal or _flip_guess_pose(cell, pb)
+        n = SAMPLES
+        self.floor = grill_floor(name, cell, n - 1)
+        self.p_lo = np.array(cell.limits.p_min, float)
+        if name in ("go_to_burger", "scoop", "pickup"):
+            self.p_lo[2] -= SCOOP_PRESS + SCOOP_TIP_BAND
+        self.tip = hg - SCOOP_PRESS
+        self.cone_frac = {"pickup": 1.0, "flip": max(RELEASE_FRACTION, tg.FLIP_CONE_FRACTION)}
+        self.release = int(np.ceil(RELEASE_FRACTION * (n - 1) - 1e-9))
+        self.mu = cell.burger.mu * MU_SAFETY
+        self.g = np.asarray(cell.gravity, float)
+
+    def cone_idx(self, n: int) -> np.ndarray:
+        frac = self.cone_frac.get(self.name, 0.0)
+        return np.flatnonzero(np.linspace(0, 1, n) <= frac + 1e-12) if frac else np.array([], int)
+
+    def landing(self, z: np.ndarray) -> np.ndarray:
+        """(x, y, cos tilt) of the landing from the release state z = (p, v, o, ȯ)."""
+        o = z[6:9]
+        out = predict_landing(z[:3], z[3:6], rpy_matrix(o), rpy_rate_matrix(o) @ z[9:],
+                              thickness=self.cell.burger.thickness,
+                              grill_height=self.cell.grill.height, gravity=self.g)
+        return np.array([*out["point"][:2], math.cos(math.radians(out["tilt_deg"]))])
+
+    def landing_jacobian(self, z: np.ndarray, h: float = 1e-6) -> tuple:
+        """Landing (3,) and its central-difference Jacobian (3, 12) at z."""
+        J = np.empty((3, 12))
+        for k in range(12):
+            e = np.zeros(12)
+            e[k] = h
+            J[:, k] = (self.landing(z + e) - self.landing(z - e)) / (2 * h)
+        return self.landing(z), J
+
+
+def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
+    """Largest scaled violation of each linearised (nonconvex) constraint group at the
+    samples (≤ 0: satisfied): edge heights, tip band and landing in cm, cone rows in g, axes
+    and cos tilt unitless."""
+    P, A, O = B[0] @ C, B[2] @ C / T**2, B[0] @ D
+    R = np.array([rpy_matrix(o) for o in O])
+    h = P[:, 2:3] + R[:, 2] @ task.edges  # (n, 4)
+    out = {"grill_clearance": float(np.max(task.floor[:, None] - h)) / 0.01}
+    if task.name == "scoop":
+        out["scoop_tip"] = (np.max(np.abs(h[1:-1, 0] - task.tip)) - SCOOP_TIP_BAND) / 0.01
+    idx = task.cone_idx(len(P))
+    if len(idx):
+        S = SCPProblem.cone_rows(task.mu)
+        f = np.einsum("kji,kj->ki", R[idx], A[idx] - task.g)
+        out["cone"] = float(np.max(-(f @ S.T))) / np.linalg.norm(task.g)
+    if task.name == "flip":
+        lo_n, hi_n = (np.array(b) for b in tg.FLIP_NORMAL_BOUNDS)
+        n_end = R[-1][:, 2]
+        out["flip_normal"] = float(max(np.max(lo_n - n_end), np.max(n_end - hi_n)))
+        out["flip_xaxis"] = float(np.max(tg.FLIP_XAXIS_BOUNDS[0][0] - R[1:, 0, 0]))
+        land = task.landing(_release_state(B, C, D, T, task.release))
+        out["landing"] = (np.linalg.norm(land[:2] - task.pb[:2]) - R_LAND) / 0.01
+        out["landing_tilt"] = land[2] - math.cos(math.radians(TILT_MIN_DEG))
+    return out
+
+
+def violation(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> float:
+    """The largest of :func:`violations`, or 0 when all hold."""
+    return float(max(0.0, *violations(task, B, C, D, T).values()))
+
+
+def _release_state(B, C, D, T, r) -> np.ndarray:
+    return np.concatenate([B[0][r] @ C, B[1][r] @ C / T, B[0][r] @ D, B[1][r] @ D / T])
+
+
+def _objective(B, C, D, T, w_o) -> float:
+    ds = 1.0 / (len(B[0]) - 1)
+    acc = lambda X: ds / T**3 * np.sum((B[2] @ X) ** 2)  # noqa: E731
+    jerk = lambda X: ds / T**5 * np.sum((B[3] @ X) ** 2)  # noqa: E731
+    from flipkit.baseline.scp_problem import ACC_WEIGHT, COST_SCALE
+    return COST_SCALE * (jerk(C) + ACC_WEIGHT * acc(C) + w_o * (jerk(D) + ACC_WEIGHT * acc(D)))
+
+
+_CACHE: dict = {}  # (name, samples, cone samples) -> SCPProblem
+
+
+def _problem(task: Task, n: int) -> SCPProblem:
+    key = (task.name, n, len(task.cone_idx(n)))
+    if key not in _CACHE:
+        _CACHE[key] = SCPProblem(task.name, n, DEGREE, task.cone_idx(n), task.release)
+    return _CACHE[key]
+
+
+def _meet_ends(task: Task, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
+    """Copies of (C0, D0) whose end control points meet the start state at duration T and
+    the end pose (and rest), so that a trust region about them admits the end rows."""
+    C, D, st, d = C0.copy(), D0.copy(), task.start, len(C0) - 1
+    C[0], D[0] = st.p, st.o
+    C[1], D[1] = np.asarray(st.p) + np.asarray(st.v) * T / d, np.asarray(st.o) + np.asarray(st.w) * T / d
+    if task.goal is not None:
+        C[-1], D[-1] = task.goal.p, task.goal.o
+        if task.name in REST:
+            C[-2], D[-2] = C[-1], D[-1]
+    return C, D
+
+
+def scp_at_duration(task: Task, T: float, C0: np.ndarray, D0: np.ndarray,
+                    trust: float = TRUST0) -> dict:
+    """The SCP at a fixed duration T (s) from the iterate (C0, D0), trust region ``trust`` (rad).
+
+    Returns:
+        ``{"C", "D", "objective", "violation", "iterations", "qp_solves"}``; ``objective`` is
+        +∞ when the final violation exceeds :data:`FEAS_TOL`.
+    """
+    qp = _problem(task, SAMPLES)
+    B, w_o, W = qp.B, ORIENTATION_WEIGHT, qp.PENALTY
+    C, D = _meet_ends(task, C0, D0, T)
+    viol = violation(task, B, C, D, T)
+    merit = _objective(B, C, D, T, w_o) + W * max(viol, 0.0)
+    solves, it = 0, 0
+    feasible_linear = False  # (C, D) meets the linear rows (a subproblem's solution)
+    for it in range(1, ITERATIONS + 1):
+        qp.set_task(task, T)
+        # until a subproblem solution is taken, the position is free: the start and end
+        # rows (the start velocity × T) cannot be met near a guess or a warm start
+        qp.linearise(task, C, D, T, trust, free_position=not feasible_linear)
+        status = qp.solve()
+        solves += 1
+        if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or qp.C.value is None:
+            trust /= 2
+            continue
+        Cn, Dn = qp.C.value.copy(), qp.D.value.copy()
+        vn = violation(task, B, Cn, Dn, T)
+        mn = _objective(B, Cn, Dn, T, w_o) + W * max(vn, 0.0)
+        predicted = merit - float(qp.problem.value)  # the subproblem's model of the merit
+        actual = merit - mn
+        if feasible_linear and predicted <= OBJ_TOL * max(abs(merit), 1e-9):  # no decrease left
+            if viol <= FEAS_TOL:
+                break
+            trust /= 2
+            continue
+        rho = actual / predicted
+        if rho >= RHO_ACCEPT or not feasible_linear:
+            C, D, viol, merit, feasible_linear = Cn, Dn, vn, mn, True
+            if viol <= FEAS_TOL and actual <= OBJ_TOL * max(abs(merit), 1e-9):
+                break
+        if rho < 0.25:
+            trust /= 2
+        elif rho > 0.75 and float(np.max(np.abs(Dn - qp.par["Dk"].value))) >= 0.99 * trust:
+            trust = min(2 * trust, TRUST_MAX)
+        if trust < STEP_TOL:
+            break
+    obj = _objective(B, C, D, T, w_o)
+    ok = feasible_linear and viol <= FEAS_TOL
+    return {"C": C, "D": D, "objective": obj if ok else math.inf,
+            "merit": merit if feasible_linear else math.inf,
+            "violation": viol, "iterations": it, "qp_solves": solves}
+
+
+def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
+                     home: tg.Pose | None = None, rate: float = 500.0,
+                     T_bounds: tuple | None = None) -> EETrajectory:
+    """Optimise position, orientation and duration of subbehaviour ``name`` in task space.
+
+    Args:
+        name: One of :data:`flipkit.behaviors.targets.SUBBEHAVIORS`.
+        cell: Cell configuration.
+        location: Burger location p^b (m).
+        start: Start state (position, velocity, rpy and rpy rate; the previous subbehaviour's
+            end, or the pose at q_start at rest).
+        home: Home spatula pose (``turn_back`` only).
+        rate: Sample rate of the output (Hz).
+        T_bounds: Duration bounds (s); default collocation's :data:`T_BOUNDS`.
+
+    Returns:
+        The trajectory; ``solve_time_s`` is the whole duration search (all QP solves, their
+        first compilation included).
+
+    Raises:
+        NoSolutionFound: No duration within the bounds gives a feasible SCP solution.
+        ConfigError: Bad start state, rate or bounds, or ``turn_back`` without ``home``.
+    """
+    if name not in tg.SUBBEHAVIORS:
+        raise InvalidChoiceError("subbehaviour", name, tg.SUBBEHAVIORS)
+    if name == "turn_back" and home is None:
+        raise ConfigError("turn_back needs the home pose")
+    if not (np.isfinite(rate) and rate > 0):
+        raise ConfigError(f"rate must be a positive number of Hz, got {rate!r}")
+    lo, hi = T_BOUNDS[name] if T_bounds is None else (float(T_bounds[0]), float(T_bounds[1]))
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
+        raise ConfigError(f"duration bounds must satisfy 0 < lo <= hi, got {(lo, hi)}")
+    for field_name in ("p", "v", "o", "w"):
+        value = np.asarray(getattr(start, field_name), dtype=float)
+        if value.shape != (3,) or not np.all(np.isfinite(value)):
+            raise ConfigError(f"start.{field_name} must be 3 finite numbers, got {value.tolist()}")
+    tic = time.perf_counter()
+    task = Task(name, cell, tg.check_location(cell, location), start, home)
+    qp = _problem(task, SAMPLES)
+    C, D = _guess_coeffs(qp.bez, np.linspace(0, 1, SAMPLES), start, task.guess_goal)
+    evals: dict = {}
+
+    def f(T: float) -> float:  # warm start: the best solution so far, a smaller region
+        best = min(evals.values(), key=lambda r: (r["objective"], r["merit"]), default=None)
+        if best is None:
+            evals[T] = scp_at_duration(task, T, C, D)
+        else:
+            evals[T] = scp_at_duration(task, T, best["C"], best["D"], TRUST_WARM)
+        return evals[T]["objective"]
+
+    f(hi)
+    if hi > lo:  # golden section on [lo, hi]; ties and infeasible pairs keep the longer part
+        g = (math.sqrt(5) - 1) / 2
+        a, b = lo, hi
+        c, d = b - g * (b - a), a + g * (b - a)
+        fc, fd = f(c), f(d)
+        for _ in range(GOLDEN_STEPS):
+            if fc < fd:
+                b, d, fd = d, c, fc
+                c = b - g * (b - a)
+                fc = f(c)
+            else:
+                a, c, fc = c, d, fd
+                d = a + g * (b - a)
+                fd = f(d)
+    T = min(evals, key=lambda k: (evals[k]["objective"], -k))
+    best = evals[T]
+    elapsed = time.perf_counter() - tic
+    if not math.isfinite(best["objective"]):
+        worst = min(r["violation"] for r in evals.values())
+        raise NoSolutionFound(name, "infeasible", "scp_violation", worst)
+    return _sampled(task, qp.bez, best, T, rate, elapsed, len(evals))
+
+
+def _sampled(task: Task, bez: Bezier, sol: dict, T: float, rate: float, elapsed: float,
+             n_durations: int) -> EETrajectory:
+    t = sample_times(T, rate)
+    s = t / T
+    Bk = [bez.basis(s, k) / T**k for k in range(3)]
+    p, v, a = (B @ sol["C"] for B in Bk)
+    o, od = Bk[0] @ sol["D"], Bk[1] @ sol["D"]
+    R = np.array([rpy_matrix(ok) for ok in o])
+    frac = task.cone_frac.get(task.name, 0.0)
+    cone = s <= frac + 1e-12 if frac else np.zeros(len(t), bool)
+    return EETrajectory(task.name, float(T), t, p, v, a, o, R, cone, sol["C"], elapsed,
+                        float(sol["objective"]), "optimal", od=od, o_coeffs=sol["D"],
+                        iterations=sol["iterations"], max_violation=sol["violation"],
+                        durations_tried=n_durations)
+
+
+__all__ = ["plan_segment_scp", "scp_at_duration", "violation", "Task", "DEGREE", "SAMPLES"]
