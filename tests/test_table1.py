@@ -6,6 +6,7 @@ import pytest
 
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.planning.planner import plan_flip
+from flipkit.behaviors import targets as tg
 from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.verify import verify_plan
 
@@ -24,3 +25,24 @@ def test_table1_location_plans_and_verifies(index):
     assert flip.cone_nodes == list(range(15))  # the paper's 0.6 N, extended to the release
     assert flip.landing["offset"] <= flip.landing["r_land"] + 1e-6
     assert all(s.solver.name in ("sqp", "ipopt") for s in plan.segments)
+    _scoop_brakes_within_friction_under_the_burger(plan)
+
+
+def _scoop_brakes_within_friction_under_the_burger(plan):
+    """The scoop carries the cone at every node where its tip has passed under the burger's
+    centre (the braking that drags a burger toward the tip), and the planned blade obeys it."""
+    from flipkit.model.contact import make_cone
+    from flipkit.model.robot import Robot
+
+    cell = plan.cell()
+    robot, cone = Robot(cell, with_burger=False), make_cone(plan.cone, cell.burger.mu, cell.gravity)
+    scoop = plan.segments[SUBBEHAVIORS.index("scoop")]
+    pb, half = np.asarray(plan.burger["location"]), cell.spatula.length / 2
+    assert scoop.cone_nodes == tg.scoop_cone_nodes(cell, len(scoop.t) - 1)
+    for i, q in enumerate(scoop.q):
+        M = robot.placement(q)
+        tip = M.translation + M.rotation @ np.array([half, 0.0, 0.0])
+        if tip[0] >= pb[0]:  # the scoop heads along world +x (targets.scoop_ready)
+            assert i in scoop.cone_nodes, i
+        if i in scoop.cone_nodes:
+            assert cone.margin(robot.state(scoop.q[i], scoop.qd[i], scoop.qdd[i])) >= -1e-6, i

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 from test_plan import models  # noqa: F401  (fixture)
-from test_plan import chain_plan, cubic_segment, translate_plan
+from test_plan import LOCATION, chain_plan, cubic_segment, translate_plan
 
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import T_BOUNDS
@@ -14,6 +14,7 @@ from flipkit.errors import ConfigError, VerificationError
 from flipkit.planning.plan_file import Plan
 from flipkit.behaviors.segments import SCOOP_PRESS
 from flipkit.planning.verify import GROUPS, verify_plan
+from flipkit.model.ik import solve_pose
 
 
 @pytest.fixture(scope="module")
@@ -112,6 +113,24 @@ def test_cone_with_little_friction(models):
     plan = translate_plan(models)
     plan.burger["mu"] = 0.01  # the gentle base turn now slides the burger
     assert _fails(plan, "cone").worst()[0] == "cone"
+
+
+def test_a_scoop_braking_hard_under_the_burger_fails_the_cone(models):
+    """A scoop that stops 14 cm of travel in 0.2 s (end deceleration 21 m/s² ≫ μ g) would
+    fling the burger toward the tip: verify checks the scoop's cone where the burger is over
+    the blade (targets.scoop_cone_nodes), whatever the plan file's own cone_nodes say."""
+    r, cell = models.bare, models.cell
+    ready, end = tg.scoop_ready(cell, LOCATION), tg.scoop_end(cell, LOCATION)
+    q0 = solve_pose(r, ready.p, ready.o, r.q_home, tol=1e-22)
+    q1 = solve_pose(r, end.p, end.o, q0, tol=1e-22)
+    seg = cubic_segment("scoop", q0, q1, 0.2, models.bare)
+    assert seg.cone_nodes == []
+    plan = Plan.from_segments("flip", cell, [seg], location=LOCATION)
+    report = _fails(plan, "cone")
+    assert report.groups["cone"].node in tg.scoop_cone_nodes(cell, 20)
+    still = Plan.from_segments("flip", cell, [cubic_segment("scoop", q1, q1, 0.2, models.bare)],
+                               location=LOCATION)
+    assert verify_plan(still).groups["cone"].ok  # at rest, blade flat: within the cone
 
 
 def test_paper_cone_form_is_used_when_recorded(models):

@@ -302,6 +302,8 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
                                          np.asarray(pb) - band, np.asarray(pb) + band))
             ang = np.array([SCOOP_ANGLE_BAND, np.inf, SCOOP_ANGLE_BAND])
             blocks.append(KinematicBlock("scoop_attitude", L, "rpy", range(1, L.N), -ang, ang))
+            # Brake within friction once the burger is over the blade (our addition).
+            cone_nodes = tg.scoop_cone_nodes(cell, L.N)
         elif name == "pickup":
             pose, cone_nodes = tg.pickup_end(cell, pb), list(all_nodes)
         elif name == "flip":

@@ -62,6 +62,26 @@ def scoop_ready(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
     return Pose((x, pb[1], z + l / 2 * math.sin(oy)), (0.0, oy, 0.0))
 
 
+def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
+    """Scoop nodes with the friction cone: where the burger's centre is over the blade.
+
+    The scoop ends at rest with the burger on the blade, so the blade brakes under it; braked
+    harder than friction allows, the burger slides on toward the tip (measured in MuJoCo at
+    (0.84, 0.12): 4.7 cm of a 7 cm drag happened in the last 0.15 s of the scoop, after the
+    blade was under it). The blade's tip passes under the burger's centre once the blade
+    centre is within l/2 of p^b; on the straight scoop path of length
+    d/2 + SCOOP_START_MARGIN + (l/2) cos o_y* that is the last (l/2)/length of the path,
+    which the smoothstep timing of the initial guess (and of the Bezier outputs near it)
+    covers from the first node where 3s² − 2s³ ≥ 1 − (l/2)/length. Before it the burger lies
+    on the grill, and the pitched blade (o_y* = 18°) would not hold it.
+    """
+    d, l = cell.burger.diameter, cell.spatula.length
+    length = d / 2 + SCOOP_START_MARGIN + l / 2 * math.cos(SCOOP_PITCH)
+    covered = 1.0 - (l / 2) / length
+    s = np.arange(N + 1) / N
+    return [int(i) for i in np.flatnonzero(s * s * (3 - 2 * s) >= covered - 1e-12)]
+
+
 def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
     """End of scoop (eq. 23): blade flat, centred under the burger, pressed ``press`` (m)
     into the grill."""

@@ -274,6 +274,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
     release = seg.release["node"] if seg.release else 0
     required = {"translate": range(N + 1), "pickup": range(N + 1),
+                "scoop": tg.scoop_cone_nodes(cell, N),
                 "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)],
                 "carry": sv.cone_nodes("carry", N), "place": sv.cone_nodes("place", N)}
     on_blade = (seg.landing or seg.placing or {}).get(
