@@ -115,3 +115,29 @@ def test_the_shipped_atlas_serves_the_default_options():
     atlas = Atlas.load(default_path(), CellConfig(), SegmentOptions())
     plan = plan_flip(TABLE1_LOCATIONS[0], atlas=atlas)  # guess() checks each structure key
     assert plan.status == "solved"
+
+
+def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch):
+    """The serve shares go to burger, scoop and pickup with the flip: the atlas seeds those
+    (at the entry itself, the stored solution exactly) and no other segment; the serve is
+    solved and verified like any plan."""
+    from flipkit.planning import chain
+    from flipkit.planning.serve import plan_serve
+
+    seeded, solve = {}, chain.solve_segment
+
+    def spy(nlp, solver, x0=None):
+        seeded.setdefault(nlp.name, None if x0 is None else np.array(x0))
+        return solve(nlp, solver, x0) if x0 is not None else solve(nlp, solver)
+
+    monkeypatch.setattr(chain, "solve_segment", spy)
+    atlas = _atlas(entry)
+    plan = plan_serve(LOC, (0.45, 0.70), atlas=atlas)
+    assert plan.status == "solved" and verify_plan(plan, space=CellConfig().space).ok
+    for name in ("go_to_burger", "scoop", "pickup"):
+        np.testing.assert_array_equal(seeded[name], atlas.solutions[name][0])
+    assert all(seeded[name] is None for name in ("carry", "place", "return_home"))
+    stale = Atlas(atlas.locations, atlas.solutions, atlas.structure,
+                  {**atlas.meta, "options_hash": "0" * 64})
+    with pytest.raises(AtlasError, match="stale atlas"):
+        plan_serve(LOC, (0.45, 0.70), atlas=stale)

@@ -73,10 +73,7 @@ def register(subparsers) -> None:
                    help="landing spot X Y (m) on the grill; default where the burger lies")
     f.add_argument("--r-land", default="0.02", metavar="M",
                    help="radius (m) of the landing disc about the spot (default 0.02)")
-    f.add_argument("--atlas", metavar="FILE",
-                   help="warm-start atlas (`flipkit atlas build`); default: the package's "
-                        "atlas when it serves these options, else cold starts")
-    f.add_argument("--no-atlas", action="store_true", help="cold starts (no atlas)")
+    atlas_arguments(f)
     common(f)
     f.set_defaults(run=run_flip)
 
@@ -90,6 +87,7 @@ def register(subparsers) -> None:
                    help="where the burger should rest on the table, X Y (m)")
     s.add_argument("--start-q", nargs="+", metavar="Q",
                    help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+    atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
     s.set_defaults(run=run_serve)
 
@@ -220,6 +218,14 @@ def run_flip(args: argparse.Namespace) -> int:
     return _report(plan, args.json)
 
 
+def atlas_arguments(parser: argparse.ArgumentParser, which: str = "") -> None:
+    """``--atlas FILE`` and ``--no-atlas`` on ``parser``."""
+    parser.add_argument("--atlas", metavar="FILE",
+                        help=f"warm-start atlas (`flipkit atlas build`){which}; default: the "
+                             "package's atlas when it serves these options, else cold starts")
+    parser.add_argument("--no-atlas", action="store_true", help="cold starts (no atlas)")
+
+
 def _atlas(args: argparse.Namespace, options):
     """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
     package's when it exists and serves ``options``, else ``None`` (cold starts)."""
@@ -241,8 +247,13 @@ def run_serve(args: argparse.Namespace) -> int:
     location = _numbers("--burger", args.burger, 3)
     spot = _numbers("--table-spot", args.table_spot, 2)
     q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
-    plan = plan_serve(location, spot, q_start, solver=args.solver)
+    from flipkit.behaviors.segments import SegmentOptions
+
+    atlas = _atlas(args, SegmentOptions())
+    plan = plan_serve(location, spot, q_start, solver=args.solver, atlas=atlas)
     plan.to_json(args.json)
+    if atlas is not None:
+        print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
     return _report(plan, args.json)
 
 

@@ -137,7 +137,8 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
     q_start=..., cell=..., solver=...)`` (``cell`` and ``solver`` passed where its signature
     takes them).
 
-    ``atlas`` is accepted for a uniform signature and not used (the atlas holds flips).
+    ``atlas`` (a pickup-and-flip atlas) warm-starts the serve's go to burger, scoop and
+    pickup, where ``plan_serve`` takes it.
 
     Raises:
         MissingPlannerError: ``plan_serve`` does not exist in :mod:`flipkit.planning.planner`.
@@ -154,8 +155,8 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
 
     params = inspect.signature(plan_serve).parameters
     takes_all = any(p.kind is p.VAR_KEYWORD for p in params.values())
-    extra = {k: v for k, v in (("cell", cell), ("solver", solver))
-             if takes_all or k in params}
+    extra = {k: v for k, v in (("cell", cell), ("solver", solver), ("atlas", atlas))
+             if (takes_all or k in params) and (k != "atlas" or v is not None)}
     if cell is not None and cell != CellConfig() and "cell" not in extra:
         raise MissingPlannerError(f"{SERVE_PLANNER} takes no cell; it cannot plan in a "
                                   "non-default cell")

@@ -142,9 +142,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     t0, cell = time.perf_counter(), cell or CellConfig()
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
-    if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
-        raise AtlasError("stale atlas: built for other planning options or another cell; "
-                         "rebuild it with `flipkit atlas build`")
+    check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
     on_blade = _on_blade(on_blade, cell)
@@ -156,6 +154,14 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
     guess = None if atlas is None else (lambda name, nlp: atlas.guess(name, pb, nlp))
     return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0, guess)
+
+
+def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
+    """Raise :class:`~flipkit.errors.AtlasError` if ``atlas`` (or ``None``) was built for
+    other planning options or another cell."""
+    if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
+        raise AtlasError("stale atlas: built for other planning options or another cell; "
+                         "rebuild it with `flipkit atlas build`")
 
 
 def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:

@@ -23,7 +23,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.inputs import check_joint_vector
-from flipkit.planning.planner import SOLVERS, _on_blade, chain_segments, models_for
+from flipkit.planning.planner import SOLVERS, _on_blade, chain_segments, check_atlas, models_for
 
 
 def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
@@ -37,7 +37,7 @@ def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
                solver: str = "auto", on_blade=(0.0, 0.0),
-               options: SegmentOptions = SegmentOptions()) -> Plan:
+               options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
     """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
     22–25), carry with the friction cone throughout, place by a tilt-off, return home.
 
@@ -54,6 +54,10 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             during the carry and place; default the blade centre (:func:`replan_serve`
             re-plans for a sensed one).
         options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
+        atlas: A pickup-and-flip :class:`~flipkit.planning.atlas.Atlas` built for ``cell``
+            and ``options``: go to burger, scoop and pickup (the flip's first three
+            segments, the same NLPs) start from its interpolated solutions, carry, place
+            and return home from their own guesses; ``None`` (default): cold starts.
 
     Returns:
         The :class:`~flipkit.planning.plan_file.Plan`, behaviour ``serve``: status
@@ -64,10 +68,12 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     Raises:
         UnreachableError: Burger off the grill, spot off the table, or the place pose out of
             reach. ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
+        AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
     t0, cell = time.perf_counter(), cell or CellConfig()
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
+    check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, burger)
     spot = sv.check_table_spot(cell, table_spot)
     on_blade = _on_blade(on_blade, cell)
@@ -84,10 +90,13 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
         except UnreachableError as exc:
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
-    return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0)
+    guess = None if atlas is None else (
+        lambda name, nlp: atlas.guess(name, pb, nlp) if name in atlas.structure else None)
+    return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0, guess)
 
 
-def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -> Plan:
+def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0,
+           guess=None) -> Plan:
     """The serve's subbehaviours after the segments ``done`` from (q, q̇); the carry and
     place segments record the ``placing``."""
     def build(name, q, qd, o):
@@ -99,7 +108,7 @@ def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0) -
             seg.placing = placing_record(cell, spot, on_blade)
 
     return chain_segments("serve", sv.SERVE_SUBBEHAVIORS, build, q, qd, done, cell, solver,
-                          options, t0, pb, decorate)
+                          options, t0, pb, decorate, guess)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
