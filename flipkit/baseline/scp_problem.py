@@ -149,7 +149,7 @@ class SCPProblem:
                   free_position: bool = False) -> None:
         """Set the linearisation about the iterate (C, D) and the trust region (rad; with
         ``free_position`` none on C)."""
-        B, n = self.B, self.n
+        B = self.B
         Ok, Ak = B[0] @ D, B[2] @ C / T**2
         R = np.array([rpy_matrix(o) for o in Ok])
         dR = np.array([rpy_matrix_derivatives(o) for o in Ok])  # (n, j, 3, 3)
