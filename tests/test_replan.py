@@ -67,3 +67,21 @@ def test_a_failed_replan_leaves_the_verified_plan_running(flip_plan):
 def test_replan_rejects_a_burger_off_the_blade(flip_plan):
     with pytest.raises(ConfigError, match="on the blade"):
         replan_flip(flip_plan, (0.5, 0.0))
+
+
+def test_no_replan_for_a_burger_the_scoop_missed(flip_plan):
+    """A burger lying 20 cm to the side of the scoop's line is not on the blade when the
+    scoop ends: the cell does not re-plan for a clipped, made-up position on the blade; the
+    verified plan runs on and the judges see the miss."""
+    calls = []
+
+    def record(plan, on_blade):
+        calls.append(on_blade)
+        return replan_flip(plan, on_blade)
+
+    draw = {"dx_m": 0.0, "dy_m": 0.2, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0}
+    ex = execute_plan(flip_plan, "feedforward", draw, replan=record)
+    assert calls == [] and ex.plan is flip_plan
+    assert ex.replan_failure.startswith("burger not on the blade after the scoop")
+    assert abs(ex.sensed_on_blade[1]) > flip_plan.spatula["width"] / 2
+    assert not judge_scoop(ex.run, ex.bounds["scoop"]).ok

@@ -60,7 +60,9 @@ class Execution:
         mode: The controller. scene: The compiled cell.
         plan: The plan executed (the replanned one when ``replan`` was given).
         sensed_on_blade: The burger's centre on the blade (x, y) (m) measured after the scoop
-            and handed to ``replan`` (clipped to the blade); ``None`` open loop.
+            (serve: the carry) and handed to ``replan``; ``None`` open loop. A burger whose
+            centre is not over the blade, or not resting on it, is not re-planned for
+            (``replan_failure`` says where it was).
         replan_failure: Why the replan failed (the original, verified plan then ran on), or
             ``None``.
     """
@@ -193,17 +195,26 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     f6 = np.zeros(6)
     sensed, replan_failure = None, None
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    thick = cell.spatula.thickness
     k = -1
     while k + 1 < len(t):
         k += 1
         if t[k] >= t_sense - 1e-9 and sensed is None:  # at rest: sense and replan
             mujoco.mj_kinematics(m, d)
             p_b, R_b = scene.blade_pose()
-            sensed = ((d.xpos[burger_body] - p_b) @ R_b)[:2]
-            try:  # a failed replan keeps the verified plan under way (and this step runs)
-                new = replan(plan, np.clip(sensed, -half, half))
-            except FlipkitError as exc:
-                new, replan_failure = None, str(exc)
+            rel = (d.xpos[burger_body] - p_b) @ R_b
+            sensed = rel[:2]
+            if np.any(np.abs(sensed) > half) or not 0.0 < rel[2] < bg.thickness + thick:
+                # not on the blade (the scoop missed or pushed it off): nothing to re-plan for;
+                # the verified plan runs on, and the judges see the miss
+                new, replan_failure = None, (
+                    f"burger not on the blade after the {SENSE_AFTER[plan.behavior]}: its centre "
+                    f"at ({rel[0]:+.3f}, {rel[1]:+.3f}, {rel[2]:+.3f}) m in the blade frame")
+            else:
+                try:  # a failed replan keeps the verified plan under way (and this step runs)
+                    new = replan(plan, sensed)
+                except FlipkitError as exc:
+                    new, replan_failure = None, str(exc)
             if new is not None and new.status != "solved":
                 new, replan_failure = None, new.failure or "replanned plan not solved"
             if new is not None:
