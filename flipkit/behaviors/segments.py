@@ -20,7 +20,7 @@ from flipkit.transcription.layout import Layout
 from flipkit.config import CellConfig
 from flipkit.transcription.constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
 from flipkit.transcription.constraints.braking import BrakingMargin
-from flipkit.transcription.constraints.clearance import ArmClearance
+from flipkit.transcription.constraints.clearance import ArmClearance, CoastingClearance
 from flipkit.behaviors.clearance import (AT_GRILL, AT_TABLE, FLIP_END_ALLOWANCE, FLIP_TOOL_FRACTION,
                                          TOOL_SHAPES, clearance_excluded)
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
@@ -256,6 +256,13 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     if options.arm_clearance:
         blocks.append(ArmClearance(L, models.shapes, moving,
                                    lambda i: clearance_excluded(name, i, L.N), margins))
+        if name == "flip":
+            # The turn back starts with the flip's end velocity; coasting for its first node
+            # interval (at its longest) the arm must still keep the margin (CoastingClearance).
+            blocks.append(CoastingClearance(L, models.shapes, last,
+                                            T_BOUNDS["turn_back"][1] / L.N,
+                                            clearance_excluded(name, last, L.N),
+                                            cell.space.margin))
     # Orientation limits (Constraint 1, eq. 4): the pitch; roll and yaw are free (TaskLimits).
     blocks.append(KinematicBlock("task_orientation", L, "pitch", moving, *lim.pitch_range))
     # the burger's contact acceleration is that of the blade point under its centre

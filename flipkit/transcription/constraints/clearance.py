@@ -68,3 +68,45 @@ class ArmClearance(Block):
             vals[r], grad, *self.nearest[r] = self.shapes.nearest(ev.node(i)[0], pairs, CAP)
             jac.append(grad)
         return vals, (np.concatenate(jac) if jac else np.zeros(0))
+
+
+class CoastingClearance(Block):
+    """margin ≤ min(CAP, min_{(s, b) ∈ P} d(shape s at q_i + τ q̇_i, box b)) at one node i.
+
+    The space limits at the configuration the arm would reach coasting for ``tau`` from node
+    i's state: a segment that ends in motion (the flip) leaves the next segment, which starts
+    from that state (29), room to keep the margin at its first node without braking, and to
+    brake after it. It is to the cell's boxes what
+    :class:`~flipkit.transcription.constraints.braking.BrakingMargin` is to the joint limits.
+    The row's Jacobian is exact: ∂/∂q_i = g, ∂/∂q̇_i = τ g, g the nearest pair's distance
+    gradient at q_i + τ q̇_i.
+
+    Args:
+        layout: Variable layout. shapes: The arm's shapes and the cell's boxes.
+        node: Node index. tau: Coasting time (s, > 0).
+        excluded: (shape name, box name) pairs not applied. margin: Least distance (m).
+    """
+
+    def __init__(self, layout, shapes: ArmShapes, node: int, tau: float, excluded=(),
+                 margin: float = 0.02):
+        super().__init__("coasting_clearance", layout)
+        if not (np.isfinite(tau) and tau > 0):
+            raise ConfigError(f"coasting time must be positive (s), got {tau!r}")
+        if not (np.isfinite(margin) and 0 <= margin < CAP):
+            raise ConfigError(f"arm clearance margin must be in [0, {CAP}) m, got {margin!r}")
+        self.shapes, self.node, self.tau = shapes, int(node), float(tau)
+        skip = set(excluded)
+        for shape, box in skip:
+            shapes.shape_index(shape), shapes.box_index(box)
+        self.pairs = np.array([(k, b) for k, s in enumerate(shapes.names)
+                               for b, box in enumerate(shapes.box_names) if (s, box) not in skip],
+                              dtype=int).reshape(-1, 2)
+        self._add(0, 1, np.concatenate([layout.iq(self.node), layout.iqd(self.node)]))
+        self.m = 1
+        self.nearest = np.full((1, 2), -1)
+        self._finish(margin, np.inf, 1.0)
+
+    def evaluate(self, ev):
+        q, qd = ev.node(self.node)[:2]
+        d, grad, *self.nearest[0] = self.shapes.nearest(q + self.tau * qd, self.pairs, CAP)
+        return np.array([d]), np.concatenate([grad, self.tau * grad])
