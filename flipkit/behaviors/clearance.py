@@ -18,7 +18,14 @@ from __future__ import annotations
 # FLIP_END_ALLOWANCE farther from the cell than the margin: the turn back starts with the
 # flip's end velocity and needs room to turn the arm away (measured at (0.75, 0.00): a flip
 # ending on the margin with the flange coming down at ~0.9 m/s, and no turn back from there
-# could keep it; 1.4 cm short at its first node).
+# could keep it; 1.4 cm short at its first node). The allowance is sized for ~0.9 m/s: flips
+# at the grill's far half (x ≥ 0.74 m, y ≤ 0.02 m) ended on it with the wrist housings coming
+# down at 1.2 m/s, and neither the SQP nor IPOPT found a turn back from there (measured at
+# (0.84, −0.22): node 1, 0.06 s in, 1–4 mm short with shoulder, elbow and wrist 1 braking at
+# the 20 rad/s² limit). So the flip also holds the configuration it would reach coasting for
+# the turn back's first node interval, q_N + (T_max/N) q̇_N, to the margin
+# (segments.build_segment, CoastingClearance): the turn back then keeps the margin at node 1
+# without braking, and brakes clear after it (needs ≥ v/(2τ) ≈ 10 m/s² at 1.2 m/s).
 # Serving: the place puts the blade's tip 5 mm above the table and tilts it tip down, and the
 # return home first withdraws the blade along its own plane: the tool end works on the table
 # there as it works on the grill above, so the same tool shapes are exempt from the table (the
