@@ -181,7 +181,8 @@ def test_segments_exempt_only_the_tool_at_the_grill(models):
     tool = {(s, "grill") for s in TOOL_SHAPES}
     for name in AT_GRILL:
         assert clearance_excluded(name, 20, 20) == tool
-    assert clearance_excluded("flip", 4, 20) == tool and clearance_excluded("flip", 5, 20) == set()
+    for name in ("flip", "carry"):  # both start where the pickup ends
+        assert clearance_excluded(name, 4, 20) == tool and clearance_excluded(name, 5, 20) == set()
     for name in ("translate", "turn_back"):
         assert clearance_excluded(name, 1, 20) == set()
     nlp = build_segment("translate", models, models.bare.q_home,
