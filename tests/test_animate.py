@@ -28,11 +28,13 @@ def test_tiny_gif_has_frames(flip_plan_file, tmp_path):
 def test_filmstrip_and_key_frames(flip_plan, tmp_path):
     ex = execute_plan(flip_plan, hold=0.3)
     keys = key_frames(ex)
-    assert set(keys) == {"release", "apex", "landing"}
-    r, a, land = keys.values()
-    if r is not None:  # release inside the flip, apex after it, landing after the apex
-        t0, t1 = ex.bounds["flip"]
-        assert t0 <= ex.run.t[r] <= t1 and a >= r and (land is None or land >= a)
+    assert list(keys) == ["release", "mid_flight", "landing"]
+    r, mid, land = keys.values()
+    assert r is not None and land is not None  # the plan's burger leaves the blade and lands
+    t0, t1 = ex.bounds["flip"]
+    assert t0 <= ex.run.t[r] <= t1 and r < mid < land  # release inside the flip, then flight
+    assert abs(ex.run.t[mid] - 0.5 * (ex.run.t[r] + ex.run.t[land])) <= 1e-3
+    assert not ex.run.touch_spatula[r + 1:land].any() and not ex.run.touch_grill[r + 1:land].any()
     out = write_filmstrip(ex, tmp_path / "strip.png", 80, 60)
     assert Image.open(out).size[0] > Image.open(out).size[1]
 

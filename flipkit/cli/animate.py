@@ -20,7 +20,7 @@ def register(subparsers) -> None:
         "animate", help="render the simulated execution of a flip plan (GIF or MP4)",
         description="Execute a solved flip plan closed-loop in the MuJoCo cell (nominal burger) "
                     "and render it offscreen in real time; optionally a filmstrip PNG of "
-                    "release, apex and landing.")
+                    "release, mid-flight and landing.")
     parser.add_argument("plan", metavar="PLAN.json", help="a solved flip plan file")
     parser.add_argument("--out", required=True, metavar="FILE.gif|FILE.mp4",
                         help="output animation (.gif with Pillow; .mp4 needs imageio-ffmpeg)")
@@ -30,7 +30,7 @@ def register(subparsers) -> None:
     parser.add_argument("--width", type=int, default=480, help="pixels (default 480)")
     parser.add_argument("--height", type=int, default=360, help="pixels (default 360)")
     parser.add_argument("--filmstrip", metavar="FILE.png",
-                        help="also write the key frames (release, apex, landing) as a PNG")
+                        help="also write the key frames (release, mid-flight, landing) as a PNG")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: re-plan the flip for where the scoop left the "
                              "burger on the blade (as flipkit validate --replan)")

@@ -147,18 +147,20 @@ def write_animation(execution, out, fps: float = 30.0, width: int = 480, height:
 def key_frames(execution) -> dict:
     """Sample indices of the flip's key moments (``None`` where one did not happen).
 
-    ``release``: last burger-blade contact during the flip segment; ``apex``: highest burger
-    centre after it; ``landing``: first burger-grill contact after the apex.
+    ``release``: last burger-blade contact during the flip segment; ``landing``: first
+    burger-grill contact after it; ``mid_flight``: the sample halfway in time between them
+    (a flipped burger often falls from the release on, so its highest point is the release).
     """
     run, (t0, t1) = execution.run, execution.bounds["flip"]
     in_flip = np.flatnonzero((run.t >= t0) & (run.t <= t1) & run.touch_spatula)
-    out = {"release": None, "apex": None, "landing": None}
+    out = {"release": None, "mid_flight": None, "landing": None}
     if in_flip.size == 0:
         return out
     out["release"] = r = int(in_flip[-1])
-    out["apex"] = a = r + int(np.argmax(run.burger_pos[r:, 2]))
-    hit = np.flatnonzero(run.touch_grill[a:])
-    out["landing"] = a + int(hit[0]) if hit.size else None
+    hit = np.flatnonzero(run.touch_grill[r + 1:])
+    if hit.size:
+        out["landing"] = land = r + 1 + int(hit[0])
+        out["mid_flight"] = int(np.searchsorted(run.t, 0.5 * (run.t[r] + run.t[land])))
     return out
 
 
@@ -187,7 +189,7 @@ def filmstrip_figure(execution, width: int = 320, height: int = 240, panel_width
     for ax, (name, k), f, i in zip(axes, keys.items(), frames, idx):
         ax.imshow(f)
         ax.set_axis_off()
-        what = "not reached: end" if k is None else name
+        what = "not reached: end" if k is None else name.replace("_", "-")
         ax.set_title(f"{what}, t = {execution.run.t[i]:.2f} s", fontsize=fontsize)
     fig.tight_layout()
     times = {name: None if k is None else float(execution.run.t[k]) for name, k in keys.items()}
