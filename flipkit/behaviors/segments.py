@@ -42,7 +42,10 @@ BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS + sv.SERVE_ONLY
 # and 20 rad/s²: ≥ 0.97 s from rest). Their worst cases add up to 3.0 s, and a uniform
 # 0.7/0.55/0.25/0.6/0.9 s failed 10 of 10 turn backs and 2 scoops; 0.75/0.6/0.25/0.6/1.1 s
 # solved the ten Table I locations with the SQP, but IPOPT's flip at (0.76, 0.09) ends where
-# a 1.1 s turn back is infeasible and a 1.2 s one is not.
+# a 1.1 s turn back is infeasible and a 1.2 s one is not. Session 7 (scoop cone, coasting
+# clearance), SQP, the ten Table I locations: 0.7/0.5/0.25/0.55/1.0 s (3.0 s in all) fit 3 of
+# the 10 chains; 5 turn backs needed more than 1.0 s, 3 scoops more than 0.5 s, 1 flip more
+# than 0.55 s (each then took T_STRETCH × its bound: 3.25–3.75 s).
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.75), "scoop": (0.2, 0.6),
             "pickup": (0.2, 0.25), "flip": (0.2, 0.6), "turn_back": (0.4, 1.2), **sv.T_BOUNDS}
 # A segment infeasible within its duration bound is planned once more with the upper bound
