@@ -84,7 +84,8 @@ def test_round_trip_is_exact_and_keys_follow_the_format(models, tmp_path):
     path = plan.to_json(tmp_path / "p.json")
     doc = json.loads(path.read_text())
     assert list(doc) == ["format", "behavior", "status", "created_by", "robot", "gravity",
-                         "grill_height", "spatula", "burger", "cone", "segments"]
+                         "grill_height", "spatula", "burger", "cone", "segments",
+                         "cell_geometry"]
     assert doc["format"] == FORMAT and doc["status"] == "solved"
     assert list(doc["robot"]) == ["urdf", "urdf_sha256", "base_in_world", "tool_parent_frame",
                                   "spatula_in_parent", "payload", "q_home"]
@@ -208,3 +209,44 @@ def test_flip_segments_must_come_in_order(models, tmp_path):
     (tmp_path / "p.json").write_text(json.dumps(doc))
     with pytest.raises(PlanFileError, match="in this order"):
         Plan.load(tmp_path / "p.json")
+
+
+def test_the_plan_records_the_cell_it_was_made_in(models, tmp_path):
+    """Grill and table areas, limits, margin, walls and the acceleration bound survive the
+    file: ``Plan.cell()`` (and so ``flipkit verify``) rebuilds that cell, not the defaults."""
+    from dataclasses import replace
+
+    from flipkit.config.cell import TableConfig
+    from flipkit.config.space import BACK_WALL, CellBox, SpaceConfig
+
+    hood = CellBox("hood", (0.5, -0.6, 0.9), (1.0, 0.3, 1.0))
+    cell = replace(models.cell, table=TableConfig(0.12, (0.25, 0.5), (0.5, 0.75)),
+                   space=SpaceConfig(margin=0.03, walls=(BACK_WALL, hood)),
+                   robot=replace(models.cell.robot, accel_limit=15.0))
+    plan = translate_plan(models)
+    plan = Plan.from_segments("translate", cell, plan.segments)
+    back = Plan.load(plan.to_json(tmp_path / "p.json")).cell()
+    assert back.table == cell.table and back.space == cell.space
+    assert back.robot.accel_limit == 15.0 and back.grill == cell.grill and back.limits == cell.limits
+    doc = json.loads((tmp_path / "p.json").read_text())
+    del doc["cell_geometry"]  # a file written before the record: today's defaults
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    old = Plan.load(tmp_path / "old.json").cell()
+    assert old.space == CellConfig().space and old.table == CellConfig().table
+
+
+@pytest.mark.parametrize("edit, key", [
+    (lambda g: g["space"].update(margin=-1.0), "cell_geometry.space"),
+    (lambda g: g["table"].pop("x_range"), "cell_geometry.table"),
+    (lambda g: g["space"]["walls"][0].update(lower=[0, 0]), "cell_geometry.space"),
+    (lambda g: g.update(accel_limit="fast"), "cell_geometry.accel_limit"),
+    (lambda g: g["grill"].update(height=0.08), "cell_geometry.grill.height"),
+    (lambda g: g.pop("limits"), "cell_geometry: expected the keys"),
+])
+def test_a_malformed_cell_record_is_refused_in_one_line(models, tmp_path, edit, key):
+    doc = json.loads(translate_plan(models).to_json(tmp_path / "p.json").read_text())
+    edit(doc["cell_geometry"])
+    (tmp_path / "bad.json").write_text(json.dumps(doc))
+    with pytest.raises(PlanFileError, match=key) as info:
+        Plan.load(tmp_path / "bad.json")
+    assert "\n" not in str(info.value)

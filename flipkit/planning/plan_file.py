@@ -36,6 +36,7 @@ from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text, dumps)
 from flipkit.planning.segment import SEGMENT_KEYS, Segment, default_payload
+from flipkit.planning.cell_record import cell_geometry, geometry_configs
 from flipkit.provenance import git_commit
 from flipkit.config.urdf import portable_urdf, resolve_urdf, urdf_sha256
 
@@ -110,9 +111,15 @@ class Plan:
     segments: list
     created_by: dict = field(default_factory=_created_by)
     format: str = FORMAT
+    cell_geometry: dict | None = None
 
     def __post_init__(self):
         check_choice("format", self.format, FORMATS)
+        if self.cell_geometry is not None:
+            grill = geometry_configs(self.cell_geometry)["grill"]
+            if abs(grill.height - float(self.grill_height)) > 1e-12:
+                raise ConfigError(f"cell_geometry.grill.height: {grill.height} differs from "
+                                  f"grill_height {self.grill_height}")
         check_choice("behavior", self.behavior, PLAN_BEHAVIORS)
         check_choice("status", self.status, PLAN_STATUSES)
         check_choice("cone", self.cone, CONE_FORMS)
@@ -212,11 +219,13 @@ class Plan:
             np.asarray(cell.gravity, float), cell.grill.height,
             {"length": cell.spatula.length, "width": cell.spatula.width},
             {"location": None if location is None else list(location),
-             **{k: getattr(cell.burger, k) for k in _BURGER_KEYS[1:]}}, cone, list(segments))
+             **{k: getattr(cell.burger, k) for k in _BURGER_KEYS[1:]}}, cone, list(segments),
+            cell_geometry=cell_geometry(cell))
 
     def cell(self) -> CellConfig:
-        """The cell the plan was made in, rebuilt from the file (task-space limits, grill and
-        table areas and the acceleration limit are not recorded: defaults are used).
+        """The cell the plan was made in, rebuilt from the file: its grill and table, task-space
+        limits, space limits and acceleration bound from ``cell_geometry`` (a file written
+        without it gets today's defaults for them, :mod:`flipkit.planning.cell_record`).
 
         Raises:
             PlanFileError: The URDF is missing here, differs from the one the plan recorded
@@ -237,14 +246,20 @@ class Plan:
         m, Ixx = float(spatula["mass"]), float(np.asarray(spatula["inertia"])[0][0])
         thickness2 = 12 * Ixx / m - w**2  # thin box: I_xx = m (w² + t²) / 12
         try:
+            geo = {} if self.cell_geometry is None else geometry_configs(self.cell_geometry)
+            accel = {} if not geo else {"accel_limit": geo.pop("accel_limit")}
+            if geo:  # grill_height is the plan's h_g (the record agreed with it when read)
+                geo["grill"] = GrillConfig(self.grill_height, geo["grill"].x_range,
+                                           geo["grill"].y_range)
             return CellConfig(
                 robot=RobotConfig(urdf=r["urdf"], tool_frame=r["tool_parent_frame"],
                                   base_in_world=tuple(map(tuple, r["base_in_world"])),
-                                  q_home=tuple(r["q_home"])),
+                                  q_home=tuple(r["q_home"]), **accel),
                 spatula=SpatulaConfig(self.spatula["length"], w, np.sqrt(max(thickness2, 0.0)),
                                       float(r["spatula_in_parent"][2, 3]), m),
                 burger=BurgerConfig(**{k: self.burger[k] for k in _BURGER_KEYS[1:]}),
-                grill=GrillConfig(height=self.grill_height), gravity=tuple(self.gravity))
+                gravity=tuple(self.gravity), **{"grill": GrillConfig(height=self.grill_height),
+                                                **geo})
         except ConfigError as exc:
             raise PlanFileError(f"cannot rebuild the cell from the plan: {exc}") from None
 
@@ -314,6 +329,8 @@ class Plan:
                "burger": {"location": None if loc is None else loc.tolist(),
                           **{k: self.burger[k] for k in _BURGER_KEYS[1:]}},
                "cone": self.cone, "segments": [s.to_json() for s in self.segments]}
+        if self.cell_geometry is not None:
+            doc["cell_geometry"] = self.cell_geometry
         path = Path(path)
         tmp = path.with_name(path.name + ".tmp")
         try:
@@ -353,7 +370,8 @@ class Plan:
                 schema_error = None
             except ConfigError as exc:
                 schema_error = exc
-            plan = cls(**check_keys(doc, "", keys), format=doc["format"])
+            plan = cls(**check_keys(doc, "", keys), format=doc["format"],
+                       cell_geometry=doc.get("cell_geometry"))
             if schema_error is not None:
                 raise schema_error
             return plan

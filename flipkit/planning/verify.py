@@ -49,10 +49,12 @@ orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     t
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
 and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
 duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
-Task-space position, velocity and acceleration bounds (cell.limits) are not recorded in the
-plan file and not checked; the pitch range, the cell's boxes and margin and the side table are
-not recorded either: ``arm_clearance``, ``orientation`` and ``placing`` check against today's
-defaults of :class:`~flipkit.config.CellConfig` (as ``time_grid`` does against today's T_BOUNDS).
+Task-space position, velocity and acceleration bounds (cell.limits) are not checked. The
+pitch range, the cell's boxes and margin and the side table come from the plan's
+``cell_geometry`` record (:mod:`flipkit.planning.cell_record`): ``arm_clearance``,
+``orientation`` and ``placing`` check against the cell the plan was made in (a file without
+the record, written before session 7, against today's defaults of
+:class:`~flipkit.config.CellConfig`, as ``time_grid`` checks against today's T_BOUNDS).
 """
 
 from __future__ import annotations
@@ -203,8 +205,8 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
         plan: The plan (e.g. :meth:`Plan.load`).
         tol: Tolerance in the solver's scaled units (see the module docstring).
         space: The cell's walls and margin (:class:`~flipkit.config.space.SpaceConfig`) to
-            check ``arm_clearance`` against; the plan file does not record them, default
-            today's :class:`~flipkit.config.CellConfig` defaults.
+            check ``arm_clearance`` against; default the plan's own (``cell_geometry``, or
+            today's defaults for a file without it).
 
     Raises:
         PlanFileError: The plan's model cannot be rebuilt (URDF missing, payload mismatch).
