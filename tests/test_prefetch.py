@@ -1,11 +1,10 @@
 """Planning a cook or a batch in worker processes: the same motions, solved and verified, on the
 same schedule as the serial run.
 
-Not the same plans to the bit: the SQP's path depends on the last bits of its arithmetic, and a
-solve in a process that has solved other problems before (the serial run, a pytest worker)
-can end at another point of the solution set than the same solve in a fresh worker —
-measured in CI: flip events 2 ms apart, one batch plan's joint path 0.05 rad apart. Both are
-verified plans; which one comes out depends on the process's history (an open defect).
+The plans used to depend on the process's history (CI: a batch plan's joint path 0.05 rad from
+its worker twin): coal's Box support keeps a static set by the process's first box query
+(:func:`flipkit.model.collision.pin_box_support`, tests/test_determinism.py). With it pinned,
+the batch below is compared bit for bit.
 """
 
 import numpy as np
@@ -66,3 +65,5 @@ def test_parallel_batch_equals_the_serial_one():
         assert [s.name for s in a.segments] == [s.name for s in b.segments]
         assert verify_plan(b, space=CELL.space).ok
         np.testing.assert_array_equal(a.segments[0].q[0], b.segments[0].q[0])  # same start
+        for sa, sb in zip(a.segments, b.segments):  # the same plan, bit for bit
+            np.testing.assert_array_equal(sa.q, sb.q)

@@ -39,13 +39,73 @@ BLADE, HANDLE = "blade", "handle"
 GJK_TOLERANCE = 1e-9
 
 
-def distance_request():
-    """A coal DistanceRequest with :data:`GJK_TOLERANCE`."""
+# coal (3.0.x) keeps in its Box support function a function-local
+#     static const CoalScalar inflate = (dir.array() == 0).any() ? 1 + 1e-10 : 1.;
+# (coal/narrowphase/support_functions.h): the first Box support query of the *process* decides,
+# for every later one, whether a box's negative half-sides are inflated by 1e-10 relative.
+# Which query comes first depended on the process's history — a box–box pair (the blade or
+# the ee box against a cell box, or the blade against the burger in verify_flight) puts GJK's
+# default guess (1, 0, 0) in the box's frame and inflates; a link's hull against the grill
+# does not — and distances then differ by ~1e-11 m (measured: the wrist_1 hull to the grill),
+# enough for the SQP to end at another point of the solution set (a flip segment 20 instead
+# of 25 iterations, the joint path 1.1 rad apart). :func:`pin_box_support` makes the first
+# Box query of the process one with a generic direction (no inflation, the exact box), so
+# every flipkit process computes the same distances.
+_BOX_SUPPORT_PINNED: bool | None = None
+_GENERIC_ROTATION = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
+
+
+def _box_probe() -> float:
+    """A box–box distance that reads 0.3 with coal's exact box support and
+    0.3 − 1.7e-11 with the inflated one."""
     import coal
 
     req = coal.DistanceRequest()
     req.gjk_tolerance = GJK_TOLERANCE
+    return float(coal.distance(
+        coal.Box(0.2, 0.1, 0.3), coal.Transform3s(_GENERIC_ROTATION, np.array([0.31, -0.27, 0.52])),
+        coal.Box(1.0, 1.0, 0.1), coal.Transform3s(np.eye(3), np.zeros(3)), req,
+        coal.DistanceResult()))
+
+
+def pin_box_support() -> bool:
+    """Make coal's first Box support query of the process one with no zero direction component
+    (see the note above), once; returns True if coal's boxes are exact in this process, False
+    (with a RuntimeWarning) if a Box query made before flipkit's (outside flipkit) left them
+    inflated — distances then differ from other processes' by ~1e-11 m."""
+    global _BOX_SUPPORT_PINNED
+    if _BOX_SUPPORT_PINNED is None:
+        import coal
+
+        # An ellipsoid first (GJK's first direction (−1, 0, 0) is its own), the box second,
+        # turned so that the direction in its frame, the rotation's first row, has no zero.
+        coal.distance(coal.Ellipsoid(0.1, 0.12, 0.14), coal.Transform3s(np.eye(3), np.zeros(3)),
+                      coal.Box(1.0, 1.0, 1.0),
+                      coal.Transform3s(_GENERIC_ROTATION, np.array([2.0, 0.3, 0.2])),
+                      coal.DistanceRequest(), coal.DistanceResult())
+        _BOX_SUPPORT_PINNED = abs(_box_probe() - 0.3) <= 1e-13
+        if not _BOX_SUPPORT_PINNED:
+            import warnings
+
+            warnings.warn("coal's Box support was first used before flipkit in this process and "
+                          "inflates boxes by 1e-10: collision distances (and so plans) may differ "
+                          "from other processes' in their last digits", RuntimeWarning,
+                          stacklevel=2)
+    return _BOX_SUPPORT_PINNED
+
+
+def distance_request():
+    """A coal DistanceRequest with :data:`GJK_TOLERANCE` (coal's box support pinned first,
+    :func:`pin_box_support`)."""
+    import coal
+
+    pin_box_support()
+    req = coal.DistanceRequest()
+    req.gjk_tolerance = GJK_TOLERANCE
     return req
+
+
+pin_box_support()  # before any other flipkit query: loading this module pins it
 
 
 @dataclass

@@ -67,6 +67,9 @@ def blade_burger_distance(blade_pose, burger_pose, cell) -> float:
     depth as coal reports it). Poses are (p, R) in the world."""
     import coal
 
+    from flipkit.model.collision import pin_box_support
+
+    pin_box_support()  # coal's box support state, the same in every process
     sp, bg = cell.spatula, cell.burger
     blade = coal.Box(sp.length, sp.width, sp.thickness)
     burger = coal.Cylinder(bg.diameter / 2, bg.thickness)
