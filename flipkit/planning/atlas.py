@@ -33,6 +33,12 @@ from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 
 FORMAT = "flipkit-atlas/1"
+# Segments the planners seed from the atlas. Not the flip: from the interpolated guess the SQP
+# declared the flip infeasible after 8–12 iterations (2–3 s) at Table I locations 2 and 6
+# (session 7, after the scoop's cone and the flip's coasting clearance), and then solved it
+# cold in 19–21 iterations; its landing, cone and coasting rows are strongly curved, and a
+# weighted mean of neighbours' flips satisfies none of them.
+SEEDED = ("go_to_burger", "scoop", "pickup", "turn_back")
 K_NEAREST = 4
 BRANCH_TOL = 0.5  # rad: entries whose joint path departs more from the nearest one's are left out
 DEFAULT_NAME = "atlas.npz"
@@ -151,4 +157,4 @@ class Atlas:
         return (w[:, None] * X[keep]).sum(0) / w.sum()
 
 
-__all__ = ["Atlas", "FORMAT", "default_atlas", "default_path", "options_hash"]
+__all__ = ["Atlas", "FORMAT", "SEEDED", "default_atlas", "default_path", "options_hash"]

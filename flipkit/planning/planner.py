@@ -31,7 +31,7 @@ from flipkit.planning.inputs import check_joint_vector, check_position
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
 from flipkit.planning import chain
-from flipkit.planning.atlas import options_hash
+from flipkit.planning.atlas import SEEDED, options_hash
 from flipkit.planning.chain import (SOLVERS, chain_segments, finish_plan, solve_segment,  # noqa: F401
                                     solver_failure)
 
@@ -152,7 +152,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         "start configuration", q_start, robot.q_min, robot.q_max, "rad")
     qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
-    guess = None if atlas is None else (lambda name, nlp: atlas.guess(name, pb, nlp))
+    guess = None if atlas is None else (
+        lambda name, nlp: atlas.guess(name, pb, nlp) if name in SEEDED else None)
     return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0, guess)
 
 

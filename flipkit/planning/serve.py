@@ -23,6 +23,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.inputs import check_joint_vector
+from flipkit.planning.atlas import SEEDED
 from flipkit.planning.planner import SOLVERS, _on_blade, chain_segments, check_atlas, models_for
 
 
@@ -91,7 +92,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
     guess = None if atlas is None else (
-        lambda name, nlp: atlas.guess(name, pb, nlp) if name in atlas.structure else None)
+        lambda name, nlp: atlas.guess(name, pb, nlp) if name in SEEDED[:3] else None)
     return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0, guess)
 
 
