@@ -115,11 +115,6 @@ class Plan:
 
     def __post_init__(self):
         check_choice("format", self.format, FORMATS)
-        if self.cell_geometry is not None:
-            grill = geometry_configs(self.cell_geometry)["grill"]
-            if abs(grill.height - float(self.grill_height)) > 1e-12:
-                raise ConfigError(f"cell_geometry.grill.height: {grill.height} differs from "
-                                  f"grill_height {self.grill_height}")
         check_choice("behavior", self.behavior, PLAN_BEHAVIORS)
         check_choice("status", self.status, PLAN_STATUSES)
         check_choice("cone", self.cone, CONE_FORMS)
@@ -146,6 +141,11 @@ class Plan:
         self.robot = {**self.robot, **r}
         self.gravity = check_array("gravity", self.gravity, (3,))
         self.grill_height = check_number("grill_height", self.grill_height)
+        if self.cell_geometry is not None:
+            grill = geometry_configs(self.cell_geometry)["grill"]
+            if abs(grill.height - float(self.grill_height)) > 1e-12:
+                raise ConfigError(f"cell_geometry.grill.height: {grill.height} differs from "
+                                  f"grill_height {self.grill_height}")
         self.spatula = {k: check_number(f"spatula.{k}", v, positive=True)
                         for k, v in check_keys(self.spatula, "spatula", ("length", "width")).items()}
         b = check_keys(self.burger, "burger", _BURGER_KEYS)
