@@ -141,3 +141,35 @@ def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch)
                   {**atlas.meta, "options_hash": "0" * 64})
     with pytest.raises(AtlasError, match="stale atlas"):
         plan_serve(LOC, (0.45, 0.70), atlas=stale)
+
+
+def test_anchored_guess_starts_at_the_segment_start_and_keeps_the_turn_back_end(entry):
+    """The flip and turn back are seeded by a neighbour's joint path anchored at their own
+    start state: node 0 is (q_start, q̇_start) exactly, u = RNEA at every node, the flip's
+    path is shifted whole, the turn back's offset fades out so it still ends at rest where the
+    neighbour ended; a start that is the neighbour's own returns its solution unchanged."""
+    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.planning.atlas import anchored_guess
+
+    models = Models(CellConfig())
+    rng = np.random.default_rng(0)
+    for name, how in (("flip", "shift"), ("turn_back", "blend")):
+        x = np.array(entry["x"][name])
+        q0 = x[: 21 * 4 * 6].reshape(21, 4, 6)[0]
+        nlp = build_segment(name, models, q0[0], q0[1], location=LOC)
+        L, robot = nlp.layout, nlp.robot
+        nodes0 = L.nodes(x)
+        np.testing.assert_array_equal(anchored_guess(nlp, x, q0[0], q0[1], how), x)
+        q_start = q0[0] + rng.uniform(-0.05, 0.05, 6)
+        qd_start = q0[1] + rng.uniform(-0.1, 0.1, 6)
+        g = L.nodes(anchored_guess(nlp, x, q_start, qd_start, how))
+        np.testing.assert_allclose(g[0, 0], q_start, atol=1e-12)
+        np.testing.assert_allclose(g[0, 1], qd_start, atol=1e-9)
+        for k in range(21):
+            np.testing.assert_allclose(g[k, 3], robot.inverse_dynamics(*g[k, :3]), atol=1e-8)
+        offset = q_start - nodes0[0, 0]
+        if how == "shift":  # the whole path moves with the start (least-squares refit)
+            assert np.abs(g[-1, 0] - (nodes0[-1, 0] + offset)).max() < 0.05
+        else:  # the end is the neighbour's, at rest
+            assert np.abs(g[-1, 0] - nodes0[-1, 0]).max() < 0.02
+            np.testing.assert_allclose(g[-1, 1], 0.0, atol=1e-9)

@@ -124,3 +124,56 @@ def test_no_restoration_from_a_feasible_point():
     feasible_before = [True] + [row["violation"] <= 1e-6 for row in res.log[:-1]]
     assert not any(row["elastic"] for row, ok in zip(res.log, feasible_before) if ok)
     assert res.objective == pytest.approx(solve_ipopt(nlp).objective, rel=1e-3)
+
+
+def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference):
+    """Where the linearised rows cannot be met within a shrunken trust box, the SQP takes the
+    hard QP's step in the largest box (Δ_max ∩ bounds) and lets the line search shorten it;
+    only without that box does it fall back to the elastic restoration QP."""
+    from flipkit.solvers import sqp as S
+    from flipkit.solvers.iterate import Iterate
+
+    nlp, _ = reference
+    o, D = SQPOptions(), nlp.x_scale
+    jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
+    x = nlp.project(nlp.x0 + 0.02 * D * np.random.default_rng(0).standard_normal(nlp.n))
+    p = Iterate(nlp, x, jscale)
+    assert p.v_max > 1e-3  # far enough that a 1e-5 box cannot reach the rows
+    grad = nlp.gradient(p.x) * nlp.obj_scale * D
+    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
+    lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
+    tiny = (np.maximum(lo, -1e-5), np.minimum(hi, 1e-5))
+    wide = (np.maximum(lo, -o.trust_max), np.minimum(hi, o.trust_max))
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, *tiny, 1e-6)
+    assert qp.elastic  # no wide box: restoration
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, *tiny, 1e-6, wide)
+    assert not qp.elastic and sol.status == "optimal"
+    assert np.abs(sol.d).max() <= o.trust_max + 1e-6 and np.abs(sol.d).max() > 1e-5
+    assert S._linearised_violation(nlp, p, sol.d) < 1e-3 * float(p.v.sum())
+
+
+def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
+    """The elastic step trades Σu² for feasibility: its line search runs on ½‖v‖², and the
+    step is taken even when the ℓ1 merit's model predicts no decrease of φ."""
+    from flipkit.solvers import sqp as S
+    from flipkit.solvers.iterate import Iterate, newton_correction
+
+    nlp, _ = reference
+    o, D = SQPOptions(), nlp.x_scale
+    jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
+    x = nlp.project(nlp.x0 + 0.02 * D * np.random.default_rng(0).standard_normal(nlp.n))
+    p = Iterate(nlp, x, jscale)
+    grad = nlp.gradient(p.x) * nlp.obj_scale * D
+    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
+    lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, np.maximum(lo, -1e-2),
+                                np.minimum(hi, 1e-2), 1e-6)
+    assert qp.elastic
+    lin = S._linearised_violation(nlp, p, sol.d, total=False)
+    decrease = S._square_violation(p) - 0.5 * float(lin @ lin)
+    assert decrease > 0
+    point = lambda z: Iterate(nlp, nlp.project(z), jscale)  # noqa: E731
+    trial, step, _, accepted = S._line_search(
+        o, p, D * sol.d, decrease, S._square_violation, point,
+        lambda q: point(q.x + D * newton_correction(nlp, q)))
+    assert accepted and S._square_violation(trial) < S._square_violation(p)

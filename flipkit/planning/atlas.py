@@ -33,12 +33,19 @@ from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 
 FORMAT = "flipkit-atlas/1"
-# Segments the planners seed from the atlas. Not the flip: from the interpolated guess the SQP
-# declared the flip infeasible after 8–12 iterations (2–3 s) at Table I locations 2 and 6
-# (session 7, after the scoop's cone and the flip's coasting clearance), and then solved it
-# cold in 19–21 iterations; its landing, cone and coasting rows are strongly curved, and a
-# weighted mean of neighbours' flips satisfies none of them.
-SEEDED = ("go_to_burger", "scoop", "pickup", "turn_back")
+# Segments the planners seed from the atlas.
+SEEDED = ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
+# Segments seeded by their neighbours' joint paths *anchored* at the segment's actual start
+# state, then refitted (:func:`anchored_guess`), rather than by the interpolated vector itself.
+# The flip and the turn back start where the previous segment of *this* chain ended, which an
+# interpolated solution misses. Measured (session 7): from the interpolated vector the SQP
+# declared the flip infeasible after 8–12 iterations (2–3 s) at Table I locations 2 and 6; its
+# landing, cone and coasting rows are strongly curved, and a weighted mean of neighbours' flips
+# satisfies none of them. Anchored (session 8, nearest entry, Table I): every flip solved, in
+# 11–25 iterations and 0.6–1.7 s, against 16–45 iterations and 1.6–4.8 s cold.
+# "shift": q(t) = q_atlas(t) + (q_start − q_atlas(0)) (the flip's free end moves with its
+# start); "blend": the offset fades out by a smoothstep (the turn back ends at q_home).
+ANCHORED = {"flip": "shift", "turn_back": "blend"}
 K_NEAREST = 4
 BRANCH_TOL = 0.5  # rad: entries whose joint path departs more from the nearest one's are left out
 DEFAULT_NAME = "atlas.npz"
@@ -135,8 +142,13 @@ class Atlas:
         return atlas
 
     # ----------------------------------------------------------------- lookup
-    def guess(self, name: str, location, nlp) -> np.ndarray:
+    def guess(self, name: str, location, nlp, start=None) -> np.ndarray:
         """Initial guess of segment ``name`` of the chain at ``location`` for ``nlp``.
+
+        Args:
+            name, location, nlp: The segment, the burger's location p^b (m) and its NLP.
+            start: Optional (q, q̇) the segment starts from (rad, rad/s); for the segments of
+                :data:`ANCHORED`, the guess is then anchored there (:func:`anchored_guess`).
 
         Raises:
             AtlasError: The atlas's ``name`` segment has another structure than ``nlp``
@@ -149,12 +161,36 @@ class Atlas:
         d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
         near = np.argsort(d, kind="stable")[:K_NEAREST]
         if d[near[0]] < 1e-9:
-            return X[near[0]].copy()
-        q = nlp.layout.nodes(X[near[0]])[:, 0]
-        keep = [k for k in near
-                if np.abs(nlp.layout.nodes(X[k])[:, 0] - q).max() <= BRANCH_TOL]
-        w = 1.0 / d[keep] ** 2
-        return (w[:, None] * X[keep]).sum(0) / w.sum()
+            x = X[near[0]].copy()
+        else:
+            q = nlp.layout.nodes(X[near[0]])[:, 0]
+            keep = [k for k in near
+                    if np.abs(nlp.layout.nodes(X[k])[:, 0] - q).max() <= BRANCH_TOL]
+            w = 1.0 / d[keep] ** 2
+            x = (w[:, None] * X[keep]).sum(0) / w.sum()
+        if start is None or name not in ANCHORED:
+            return x
+        return anchored_guess(nlp, x, start[0], start[1], ANCHORED[name])
 
 
-__all__ = ["Atlas", "FORMAT", "SEEDED", "default_atlas", "default_path", "options_hash"]
+def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
+    """A guess for ``nlp`` from another solution ``x`` of its structure, anchored at the
+    segment's start state: the joint path of ``x`` offset by q_start − q_x(0) ("shift": the
+    whole path; "blend": fading out by a smoothstep, so the end is kept), then refitted by the
+    Bezier polynomial from (q_start, q̇_start) with u = RNEA (:func:`~flipkit.transcription.guess.fit_guess`),
+    at the duration of ``x``. A start that is ``x``'s own (to 1e-9) returns ``x``."""
+    from flipkit.transcription.guess import fit_guess
+
+    L, robot = nlp.layout, nlp.robot
+    nodes = L.nodes(x)
+    offset = np.asarray(q_start, float) - nodes[0, 0]
+    if np.abs(offset).max() < 1e-9 and np.abs(nodes[0, 1] - qd_start).max() < 1e-9:
+        return np.asarray(x, float).copy()
+    s = L.s
+    fade = np.ones_like(s) if how == "shift" else 1.0 - s * s * (3 - 2 * s)
+    waypoints = np.clip(nodes[:, 0] + np.outer(fade, offset), robot.q_min, robot.q_max)
+    T = float(np.clip(x[L.T_index], nlp.x_lb[L.T_index], nlp.x_ub[L.T_index]))
+    return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end=how == "blend")
+
+
+__all__ = ["ANCHORED", "Atlas", "FORMAT", "SEEDED", "anchored_guess", "default_atlas", "default_path", "options_hash"]

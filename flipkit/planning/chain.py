@@ -129,8 +129,8 @@ def chain_segments(behavior: str, names, build, q, qd, done: list, cell: CellCon
         t0: ``time.perf_counter()`` when planning began (the plan's wall time counts from it).
         location: The burger's location p^b (m), recorded in the plan.
         decorate: Optional ``decorate(name, segment)`` adding records to a solved segment.
-        guess: Optional ``guess(name, nlp) -> x0`` warm-starting each segment's solve
-            (:func:`solve_stretched`).
+        guess: Optional ``guess(name, nlp, q, qd) -> x0`` warm-starting each segment's solve
+            from its start state (q, qd) (:func:`solve_stretched`).
 
     Returns:
         The verified plan; on a segment failure the chain stops there and ``plan.failure``
@@ -145,7 +145,8 @@ def chain_segments(behavior: str, names, build, q, qd, done: list, cell: CellCon
         try:
             nlp, result = solve_stretched(lambda o: build(name, q, qd, o), options, solver,
                                           None if guess is None else
-                                          (lambda nlp, name=name: guess(name, nlp)))
+                                          (lambda nlp, name=name, q=q, qd=qd:
+                                           guess(name, nlp, q, qd)))
         except AtlasError:
             raise
         except FlipkitError as exc:

@@ -153,7 +153,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
     guess = None if atlas is None else (
-        lambda name, nlp: atlas.guess(name, pb, nlp) if name in SEEDED else None)
+        lambda name, nlp, q, qd: atlas.guess(name, pb, nlp, (q, qd)) if name in SEEDED
+        else None)
     return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0, guess)
 
 

@@ -92,7 +92,8 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
     guess = None if atlas is None else (
-        lambda name, nlp: atlas.guess(name, pb, nlp) if name in SEEDED else None)
+        lambda name, nlp, q, qd: atlas.guess(name, pb, nlp, (q, qd)) if name in SEEDED
+        else None)
     return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0, guess)
 
 

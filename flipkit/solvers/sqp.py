@@ -25,7 +25,12 @@ predicted step that used at least half of it and shrinks to the accepted length 
 Subproblem failures. If OSQP runs out of iterations on the hard QP, μ is raised tenfold and
 the QP re-solved (up to three tries); if the linearisation is infeasible, a restoration
 step minimises ½σ‖s‖² + ½μ_r‖d‖² over the elastic rows (:class:`~flipkit.solvers.full_qp.QPSubproblem`
-with ``elastic=True``); when ``stall_iterations`` restoration steps in a row barely reduce
+with ``elastic=True``). A restoration step is judged by the violation alone: its trial points
+must lower ½‖v‖₂² (which that QP models, σ = 1) by η·a times the linearised reduction, whatever
+Σu² does (not ‖v‖₁: the ℓ2 step may spread one row's violation over many; judged on φ, a step
+that removes violation by raising Σu² has a negative predicted decrease and was never tried:
+measured at Table I location 2 from a warm start, the trust box then shrank tenfold per
+iteration at a landing violation of 0.0098 until the solve was declared infeasible); when ``stall_iterations`` restoration steps in a row barely reduce
 the violation, Z is a stationary point of the violation and the solve stops as
 ``infeasible``. The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
 violation (or, at a feasible iterate, the last predicted decrease), within ``qp_eps`` — loose
@@ -138,10 +143,12 @@ class SQPOptions:
 
 
 def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
-                eps: float):
+                eps: float, wide=None):
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
-    raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again),
-    else the restoration QP. Returns (solution, QP object, μ, tries, ADMM iterations)."""
+    raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
+    if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
+    trust region), if given; else the restoration QP. Returns (solution, QP object, μ, tries,
+    ADMM iterations)."""
     admm = 0
     for attempt in range(3):
         qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
@@ -157,28 +164,42 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         mu = min(10.0 * mu, o.prox_range[1])
     if sol.status == "optimal":
         return sol, qp, mu, attempt + 1, admm
+    if wide is not None and "infeasible" in sol.status:
+        # Infeasible within a shrunken trust box: the hard QP in the largest box Δ_max ∩ the
+        # variable bounds (the line search then shortens the step). Measured on Table I flips
+        # from the atlas: each of the four such QPs was feasible there and solved in 60–110
+        # ADMM iterations, where the elastic QP took 0.2–0.7 s. (In the variable bounds alone,
+        # without Δ_max, cold flips took steps into regions where they were declared
+        # infeasible: measured at Table I location 2.)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide)
+        qp.cold()
+        sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[-1])
+        admm += sol.iterations
+        if sol.status == "optimal":
+            return sol, qp, mu, attempt + 2, admm
     # Restoration: a least-squares (Levenberg–Marquardt) step on the rows.
     qp = SUBPROBLEMS.get(nlp, "elastic")
     qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), d_lo, d_hi,
               o.slack_reg)
     sol = qp.solve(eps=eps)
-    return sol, qp, mu, attempt + 2, admm + sol.iterations
+    return sol, qp, mu, attempt + 3, admm + sol.iterations
 
 
-def _line_search(o: SQPOptions, p: Iterate, d, pred: float, rho: float, point, correct):
-    """Backtracking on φ from p along d, with a second-order correction of a poorly
-    predicted, infeasible full step. Returns (trial, step, ratio, accepted)."""
+def _line_search(o: SQPOptions, p: Iterate, d, pred: float, merit, point, correct):
+    """Backtracking on ``merit`` (a function of an iterate: φ for a hard step, ‖v‖₁ for a
+    restoration step) from p along d, with a second-order correction of a poorly predicted,
+    infeasible full step. Returns (trial, step, ratio, accepted)."""
     step, ratio, trial = 1.0, 0.0, None
     for _ in range(o.backtracks + 1):
         trial = point(p.x + step * d)
-        if step == 1.0 and trial.v.sum() > p.v.sum() and p.merit(rho) - trial.merit(rho) < 0.75 * pred:
+        if step == 1.0 and trial.v.sum() > p.v.sum() and merit(p) - merit(trial) < 0.75 * pred:
             # Second-order correction: the full step's curvature error on the rows (cone,
             # blade heights, landing) removed by a minimum-norm Newton step at Z + d that
             # holds the subproblem's active rows at their bounds.
             soc = correct(trial)
-            if soc.merit(rho) < trial.merit(rho):
+            if merit(soc) < merit(trial):
                 trial = soc
-        actual = p.merit(rho) - trial.merit(rho)
+        actual = merit(p) - merit(trial)
         ratio = actual / (step * pred)
         if actual >= o.eta * step * pred:
             return trial, step, ratio, True
@@ -206,14 +227,25 @@ def _adapt(o: SQPOptions, accepted: bool, step: float, ratio: float, d_len: floa
     return trust, mu
 
 
+def _linearised_violation(nlp: NLP, p: Iterate, d, total: bool = True):
+    """‖v‖₁ of the rows linearised at p after the (scaled) step d, or (``total=False``) the
+    rows' violations."""
+    c_lin = p.cs + p.J @ d
+    v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin, c_lin - nlp.c_scale * nlp.c_hi), 0.0)
+    return float(v.sum()) if total else v
+
+
+def _square_violation(p: Iterate) -> float:
+    """½‖v‖₂², the restoration's merit (the elastic QP is its Levenberg–Marquardt model)."""
+    return 0.5 * float(p.v @ p.v)
+
+
 def _descent_model(nlp: NLP, p: Iterate, sol: QPSolution, grad, hess, rho: float):
     """(ρ, pred): ρ ≥ twice the largest multiplier and large enough for d to descend on φ
     (elastic steps have no informative multipliers); pred = φ(p) − model(d)."""
     d = sol.d
     rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
-    c_lin = p.cs + p.J @ d
-    lin_v = np.maximum(np.maximum(nlp.c_scale * nlp.c_lo - c_lin, c_lin - nlp.c_scale * nlp.c_hi),
-                       0.0).sum()
+    lin_v = _linearised_violation(nlp, p, d)
     model_f = grad @ d + 0.5 * d @ (hess * d)
     reduction = float(p.v.sum()) - lin_v
     if model_f > 0 and reduction > 0:
@@ -257,7 +289,9 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
         theta = p.v_max if p.v_max > o.tol else pred  # resolve the violation, else the decrease
         eps = float(np.clip(o.qp_eps_factor * theta * tighten, *o.qp_eps))
-        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps)
+        wide = (np.maximum((nlp.x_lb - p.x) / D, -o.trust_max),
+                np.minimum((nlp.x_ub - p.x) / D, o.trust_max)) if trust < o.trust_max else None
+        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide)
         qp_iters += admm
         hard = not qp.elastic
         rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)
@@ -287,17 +321,23 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
                     break
         if stationary and p.v_max <= o.tol:
             status = Status.SOLVED
-        elif sol.status in ("optimal", "optimal_inaccurate") and pred > 0:
+        elif sol.status in ("optimal", "optimal_inaccurate") and (pred > 0 or not hard):
             side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi) if hard else None
-            trial, step, ratio, accepted = _line_search(
-                o, p, D * sol.d, pred, rho, point,
-                lambda q: point(q.x + D * newton_correction(nlp, q, side)))
+            if hard:
+                merit, decrease = (lambda q: q.merit(rho)), pred
+            else:  # restoration: judged by the violation it removes, whatever Σu² does
+                merit, decrease = _square_violation, _square_violation(p) - 0.5 * float(
+                    np.sum(_linearised_violation(nlp, p, sol.d, total=False) ** 2))
+            if decrease > 0:
+                trial, step, ratio, accepted = _line_search(
+                    o, p, D * sol.d, decrease, merit, point,
+                    lambda q: point(q.x + D * newton_correction(nlp, q, side)))
         d_len = float(np.abs(sol.d).max(initial=0.0))
         if status != Status.SOLVED and not inexact:
             trust, mu = _adapt(o, accepted, step, ratio, d_len, trust, mu)
         if not hard:  # restoration: count the steps that barely reduce the violation
-            gain = float(p.v.sum()) - float(trial.v.sum()) if accepted else 0.0
-            stalls = stalls + 1 if gain < o.stall_progress * float(p.v.sum()) else 0
+            gain = _square_violation(p) - _square_violation(trial) if accepted else 0.0
+            stalls = stalls + 1 if gain < o.stall_progress * _square_violation(p) else 0
         if accepted:
             p = trial
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": p.v_max,
