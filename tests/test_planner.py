@@ -179,3 +179,47 @@ def test_a_duration_beyond_the_stretched_bound_fails_verify(models):
     bad = translate_plan(models, durations=(T_STRETCH * T_BOUNDS["translate"][1] + 0.01,))
     assert verify_plan(ok).groups["time_grid"].ok
     assert not verify_plan(bad).groups["time_grid"].ok
+
+
+def test_a_warm_start_found_infeasible_tries_the_stretched_bound_before_the_cold_solve(
+        monkeypatch):
+    """solve_stretched: when the SQP from the warm start ends ``infeasible`` within the bound,
+    the stretched bound is solved next; the cold solve within the bound comes only if that
+    fails too. Any other warm failure gets the cold solve first, as before."""
+    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.solvers.result import Status
+
+    def run(warm_status, stretched_ok):
+        calls = []
+
+        class _NLP:
+            def __init__(self, stretch):
+                self.stretch = stretch
+
+        def fake(nlp, solver="sqp", x0=None):
+            calls.append(("stretched" if nlp.stretch else "bound", solver,
+                          "warm" if x0 is not None else "cold"))
+            if x0 is not None:
+                status = warm_status
+            elif nlp.stretch:
+                status = Status.SOLVED if stretched_ok else Status.INFEASIBLE
+            else:
+                status = Status.INFEASIBLE
+            return SolveResult(x=np.zeros(1), status=status, iterations=1, wall_time_s=0.5,
+                               objective=0.0, max_violation=0.0)
+
+        monkeypatch.setattr(chain, "solve_segment", fake)
+        nlp, res = chain.solve_stretched(lambda o: _NLP(o.stretch), SegmentOptions(), "auto",
+                                         lambda nlp: np.zeros(1))
+        return calls, nlp, res
+
+    calls, nlp, res = run(Status.INFEASIBLE, True)
+    assert calls == [("bound", "sqp", "warm"), ("stretched", "auto", "cold")]
+    assert nlp.stretch and res.success and res.wall_time_s == pytest.approx(1.0)
+    calls, nlp, res = run(Status.INFEASIBLE, False)
+    assert calls == [("bound", "sqp", "warm"), ("stretched", "auto", "cold"),
+                     ("bound", "auto", "cold")]
+    assert not nlp.stretch and not res.success and res.wall_time_s == pytest.approx(1.0)
+    calls, _, _ = run(Status.MAX_ITER, True)
+    assert calls == [("bound", "sqp", "warm"), ("bound", "auto", "cold"),
+                     ("stretched", "auto", "cold")]

@@ -253,3 +253,26 @@ def test_cli_validate_judges_a_serve_plan_on_the_table(plan_file, tmp_path, caps
     assert entry["spot"] == list(SPOT) and len(entry["rests"]) == 1
     rest = entry["rests"][0]
     assert entry["success"]["serve"] == int(rest["distance"] <= SERVE_TOL and rest["up_z"] > 0.9)
+
+
+def test_return_home_guess_makes_the_withdrawal():
+    """Return home's initial guess slides the blade back in its own plane before heading
+    home: the withdrawal rows are met to a few millimetres (a joint path straight home
+    missed them by 0.4, scaled), and it ends at q_home at rest."""
+    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.config import CellConfig
+    from flipkit.model.ik import solve_pose
+
+    cell = CellConfig()
+    models = Models(cell)
+    from flipkit.planning.cook import table_spots
+
+    spot = table_spots(cell)[0]
+    end = sv.place_end(cell, spot, (0.0, 0.0))
+    q0 = solve_pose(models.bare, end.p, end.o, models.bare.q_home)
+    nlp = build_segment("return_home", models, q0, np.zeros(6), spot=spot)
+    groups = nlp.violation_by_group(nlp.x0)
+    assert groups["withdraw"] < 0.02 and groups["withdraw_attitude"] < 0.02
+    nodes = nlp.layout.nodes(nlp.x0)
+    assert np.abs(nodes[-1, 0] - models.bare.q_home).max() < 0.02
+    np.testing.assert_allclose(nodes[-1, 1], 0.0, atol=1e-9)

@@ -177,3 +177,30 @@ def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
         o, p, D * sol.d, decrease, S._square_violation, point,
         lambda q: point(q.x + D * newton_correction(nlp, q)))
     assert accepted and S._square_violation(trial) < S._square_violation(p)
+
+
+def test_newton_correction_leaves_fixed_and_bounded_variables_alone(reference):
+    """The minimum-norm correction moves only variables strictly inside their bounds: the
+    start state (fixed by its bounds) and variables at a bound stay where they are, so the
+    projection cannot clip the correction away; the violated rows still shrink."""
+    from flipkit.solvers.iterate import Iterate, newton_correction
+
+    import copy
+
+    base, res = reference
+    nlp = copy.copy(base)
+    nlp.x_lb, nlp.x_ub = base.x_lb.copy(), base.x_ub.copy()
+    D = nlp.x_scale
+    jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
+    rng = np.random.default_rng(1)
+    x = np.clip(res.x + 1e-5 * D * rng.standard_normal(nlp.n), nlp.x_lb, nlp.x_ub)
+    fixed = nlp.u_index[:6]  # u_0 fixed by its bounds
+    nlp.x_lb[fixed] = nlp.x_ub[fixed] = x[fixed]
+    at_bound = nlp.layout.iqd(10)  # q̇ at node 10, at its upper bound
+    nlp.x_ub[at_bound] = x[at_bound]
+    p = Iterate(nlp, x, jscale)
+    assert np.abs(newton_correction(base, p)[np.r_[fixed, at_bound]]).max() > 0
+    delta = newton_correction(nlp, p)
+    assert np.all(delta[fixed] == 0) and np.all(delta[at_bound] == 0)
+    q = Iterate(nlp, x + D * delta, jscale)
+    assert q.v.sum() < 0.5 * p.v.sum()

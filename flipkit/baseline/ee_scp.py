@@ -51,8 +51,9 @@ import numpy as np
 from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
 from flipkit.baseline.scp_problem import ORIENTATION_WEIGHT, REST, SCPProblem
 from flipkit.behaviors import targets as tg
+from flipkit.behaviors.guesses import flip_guess_pose
 from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, RELEASE_FRACTION, SCOOP_PRESS,
-                                        SCOOP_TIP_BAND, T_BOUNDS, grill_floor, _flip_guess_pose)
+                                        SCOOP_TIP_BAND, T_BOUNDS, grill_floor)
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
 from flipkit.model.bezier import Bezier
@@ -93,7 +94,7 @@ class Task:
         self.edges = (EDGES * np.array([sp.length, sp.width, 0.0])).T  # (3, 4) blade frame
         self.goal = {"go_to_burger": tg.scoop_ready(cell, pb), "scoop": tg.scoop_end(cell, pb),
                      "pickup": tg.pickup_end(cell, pb), "turn_back": home}.get(name)
-        self.guess_goal = self.goal or _flip_guess_pose(cell, pb)
+        self.guess_goal = self.goal or flip_guess_pose(cell, pb)
         n = SAMPLES
         self.floor = grill_floor(name, cell, n - 1)
         self.p_lo = np.array(cell.limits.p_min, float)

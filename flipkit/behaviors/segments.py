@@ -15,7 +15,7 @@ import numpy as np
 
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.transcription.guess import bezier_guess, fit_guess
+from flipkit.behaviors.guesses import initial_guess
 from flipkit.transcription.layout import Layout
 from flipkit.config import CellConfig
 from flipkit.transcription.constraints import BezierOutput, Dynamics, FixedValues, HermiteSimpson, KinematicBlock
@@ -26,11 +26,9 @@ from flipkit.behaviors.clearance import (AT_GRILL, AT_TABLE, FLIP_END_ALLOWANCE,
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.model.contact import make_cone
-from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
+from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.collision import ArmShapes
-from flipkit.model.ik import solve_pose
 from flipkit.transcription.nlp import NLP
-from flipkit.model.orientation import rpy
 from flipkit.model.robot import Robot
 
 BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS + sv.SERVE_ONLY
@@ -156,56 +154,6 @@ def grill_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
     if name == "go_to_burger":
         floor[-1] = pressed
     return floor
-
-
-def _flip_guess_pose(cell: CellConfig, pb) -> tg.Pose:
-    """A pose inside the flip end set, used only to seed the initial guess."""
-    p = tg.pickup_end(cell, pb).p
-    return tg.Pose((p[0] + 0.02, p[1], cell.grill.height + 0.22), (-2.6, 0.0, 0.0))
-
-
-def _initial_guess(name, L, robot, q_start, qd_start, T, pose, pb, cell, rest_at_end):
-    """Initial guess at T = T_max.
-
-    Where the segment has a task-space path (go to burger, scoop, pickup) the spatula pose
-    is interpolated from start to end (smoothstep in time, the tip kept on the grill for
-    the scoop), solved by IK node by node and fitted by the Bezier polynomial; otherwise a
-    joint-space Bezier path to an IK solution of the end pose (flip: a pose in its end set;
-    turn back: q_home).
-    """
-    if name in ("turn_back", "return_home"):
-        # Critically damped return to q_home from the (moving) start state: it brakes first
-        # instead of extrapolating the start velocity past the joint limits.
-        w, t = 4.0 / T, L.s * T  # peak |q̈| ≈ w²|q_0 − q_home| stays near the limit
-        e0 = q_start - robot.q_home
-        waypoints = robot.q_home + (e0 + np.outer(t, qd_start + w * e0)) * np.exp(-w * t)[:, None]
-        return fit_guess(L, robot, np.clip(waypoints, robot.q_min, robot.q_max), T, qd_start, True)
-    if name in ("go_to_burger", "scoop", "pickup", "carry", "place"):
-        p0, R0 = robot.position(q_start), robot.rotation(q_start)
-        o0, o1 = rpy(R0), np.asarray(pose.o)
-        waypoints, q = [], q_start
-        for s in L.s:
-            w = s * s * (3 - 2 * s)
-            o = (1 - w) * o0 + w * o1
-            p = (1 - w) * p0 + w * np.asarray(pose.p)
-            if name == "scoop":  # keep the tip pressed: p_z = h_g − press + (l/2) sin o_y
-                p[2] = cell.grill.height - SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
-            try:
-                q = solve_pose(robot, p, o, q)
-            except UnreachableError:
-                if name not in sv.SERVE_ONLY:
-                    raise
-                # the straight carry to the table passes near the base: a joint-space path
-                return bezier_guess(L, robot, q_start, sv.reach(robot, pose, (q_start, q)),
-                                    T, qd_start)
-            waypoints.append(q)
-        return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end)
-    seed_pose = pose if pose is not None else _flip_guess_pose(cell, pb)
-    guess = q_start.copy()
-    if name == "flip":
-        guess[-1] -= 2.6  # roll the blade over about its own axis (wrist 3)
-    q_end = solve_pose(robot, seed_pose.p, seed_pose.o, guess)
-    return bezier_guess(L, robot, q_start, q_end, T, qd_start)
 
 
 def build_segment(name: str, models: Models, q_start, qd_start=None, *, location=None,
@@ -361,7 +309,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     T_lo, T_hi = T_BOUNDS[name]
     if options.stretch:
         T_hi *= T_STRETCH
-    x0 = _initial_guess(name, L, robot, q_start, qd_start, T_hi, pose, pb, cell, rest_at_end)
+    x0 = initial_guess(name, L, robot, q_start, qd_start, T_hi, pose, pb, cell, rest_at_end)
 
     lb, ub, scale = (np.empty(L.n) for _ in range(3))
     per_node = [(robot.q_min, robot.q_max, 1.0), (-robot.qd_max, robot.qd_max, 1.0),

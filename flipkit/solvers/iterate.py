@@ -43,7 +43,8 @@ class Iterate:
 
 def newton_correction(nlp: NLP, p: Iterate, active: np.ndarray | None = None) -> np.ndarray:
     """Minimum-norm Newton step (scaled) onto the equalities and violated inequalities:
-    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound.
+    Δ = −J_Rᵀ(J_R J_Rᵀ)⁻¹ r_R, r the scaled residual to the nearest bound, over the variables
+    strictly inside their bounds (J_R's other columns dropped; those variables stay put).
 
     Args:
         nlp: The NLP. p: The point to correct.
@@ -64,7 +65,14 @@ def newton_correction(nlp: NLP, p: Iterate, active: np.ndarray | None = None) ->
         r = np.where(held & np.isfinite(bound), p.cs - bound, r)
         rows |= held & np.isfinite(bound)
     rows = np.flatnonzero(rows)
-    JR = p.J[rows]
+    # Variables fixed or at a bound do not move: a correction through them is clipped away
+    # by the projection and breaks the rows it fixed (measured on a serve's carry: the
+    # start node's fixed q̈ moved, and the dynamics rows came out at 0.07 after clipping).
+    span = np.maximum(nlp.x_ub - nlp.x_lb, 0.0)
+    tight = 1e-9 * np.maximum(np.abs(p.x), 1.0)
+    free = np.flatnonzero((span > tight) & (p.x - nlp.x_lb > tight) & (nlp.x_ub - p.x > tight))
+    JR = p.J[rows][:, free]
     K = (JR @ JR.T + 1e-12 * sp.identity(len(rows))).tocsc()
-    delta = -(JR.T @ spla.spsolve(K, r[rows]))
+    delta = np.zeros(nlp.n)
+    delta[free] = -(JR.T @ spla.spsolve(K, r[rows]))
     return np.where(np.isfinite(delta), delta, 0.0)

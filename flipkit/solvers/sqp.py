@@ -311,9 +311,14 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
             < o.plateau_ftol * recent[0]["objective"])
         if stationary and p.v_max > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
-            # curved active rows): Newton corrections onto the violated rows.
+            # curved active rows): Newton corrections onto the violated rows, holding the
+            # subproblem's active rows at their bounds (else the correction pushes them out
+            # by as much: measured on a serve's carry, 30 iterations cycling at 2–4e-6).
+            side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi)
             for _ in range(3):
-                q = correct(p)
+                q = point(p.x + D * newton_correction(nlp, p, side))
+                if q.v.sum() >= p.v.sum():
+                    q = correct(p)
                 if q.v.sum() >= p.v.sum():
                     break
                 p = q
