@@ -264,7 +264,8 @@ def trial_key(job: dict) -> dict:
 
 
 def plan_location(job: dict) -> dict:
-    """Plan pickup-and-flip at one location and write the plan file (a sweep worker).
+    """Plan pickup-and-flip at one location and write the plan file (a sweep worker), warm-
+    started from the package's atlas when it serves the default options, as `flipkit plan flip`.
 
     Args:
         job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``.
@@ -273,10 +274,11 @@ def plan_location(job: dict) -> dict:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
     """
     from flipkit.experiments.compare_ik import plan_filename
+    from flipkit.planning.atlas import default_atlas
     from flipkit.planning.planner import plan_flip
 
     try:
-        plan = plan_flip(job["location"], solver=job["solver"])
+        plan = plan_flip(job["location"], solver=job["solver"], atlas=default_atlas())
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
     path = Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"])
