@@ -264,8 +264,8 @@ def trial_key(job: dict) -> dict:
 
 
 def plan_location(job: dict) -> dict:
-    """Plan pickup-and-flip at one location and write the plan file (a sweep worker), warm-
-    started from the package's atlas when it serves the default options, as `flipkit plan flip`.
+    """Plan pickup-and-flip at one location as `flipkit plan flip` does (from the package's
+    atlas when it serves) and write the plan file (a sweep worker).
 
     Args:
         job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``.
@@ -281,8 +281,7 @@ def plan_location(job: dict) -> dict:
         plan = plan_flip(job["location"], solver=job["solver"], atlas=default_atlas())
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
-    path = Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"])
-    plan.to_json(path)
+    path = plan.to_json(Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"]))
     return {"status": plan.status, "reason": plan.failure, "time_s": float(plan.wall_time_s),
             "path": str(path)}
 
@@ -396,6 +395,6 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
                     progress=progress, **kwargs)
 
 
-__all__ = ["Perturbations", "TRACK_RATE_HZ", "HOLD_S", "STAGES", "plan_from_text", "track_plan",
-           "landing_target", "run_trial", "merge_tracking", "location_entry", "trial_jobs", "trial_key",
-           "plan_location", "validate", "validate_plan_file", "validate_locations"]
+__all__ = ["HOLD_S", "Perturbations", "STAGES", "TRACK_RATE_HZ", "landing_target", "location_entry",
+           "merge_tracking", "plan_from_text", "plan_location", "run_trial", "track_plan",
+           "trial_jobs", "trial_key", "validate", "validate_locations", "validate_plan_file"]
