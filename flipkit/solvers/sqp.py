@@ -186,7 +186,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
 
 
 def _line_search(o: SQPOptions, p: Iterate, d, pred: float, merit, point, correct):
-    """Backtracking on ``merit`` (a function of an iterate: φ for a hard step, ‖v‖₁ for a
+    """Backtracking on ``merit`` (a function of an iterate: φ for a hard step, ½‖v‖₂² for a
     restoration step) from p along d, with a second-order correction of a poorly predicted,
     infeasible full step. Returns (trial, step, ratio, accepted)."""
     step, ratio, trial = 1.0, 0.0, None
@@ -311,14 +311,9 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
             < o.plateau_ftol * recent[0]["objective"])
         if stationary and p.v_max > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
-            # curved active rows): Newton corrections onto the violated rows, holding the
-            # subproblem's active rows at their bounds (else the correction pushes them out
-            # by as much: measured on a serve's carry, 30 iterations cycling at 2–4e-6).
-            side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi)
+            # curved active rows): Newton corrections onto the violated rows.
             for _ in range(3):
-                q = point(p.x + D * newton_correction(nlp, p, side))
-                if q.v.sum() >= p.v.sum():
-                    q = correct(p)
+                q = correct(p)
                 if q.v.sum() >= p.v.sum():
                     break
                 p = q
