@@ -136,3 +136,28 @@ def test_batch_writes_plans_and_summary(tmp_path, capsys):
         rows = list(csv.DictReader(fh))
     assert [r["status"] for r in rows] == ["solved"] and float(rows[0]["y"]) == 0.09
     assert "batch of 1: 1 solved" in out
+
+
+def test_batch_warm_starts_from_the_package_atlas_unless_told_not_to(tmp_path, capsys,
+                                                                      monkeypatch):
+    """``plan batch`` plans each burger as ``plan flip`` does: from the package's atlas when
+    it serves the default options, cold with ``--no-atlas``."""
+    import flipkit.planning.planner as planner
+    from flipkit.planning.atlas import default_atlas
+
+    if default_atlas() is None:
+        pytest.skip("no atlas shipped")
+    seen = []
+
+    def spy(pb, q=None, qd=None, **kw):
+        seen.append(kw.get("atlas"))
+        raise ConfigError("stopped by the test")
+
+    monkeypatch.setattr(planner, "plan_flip", spy)
+    src = tmp_path / "b.csv"
+    src.write_text("x,y,z\n0.76,0.09,0.072\n")
+    for extra in ((), ("--no-atlas",)):
+        rc, _, err = _run(capsys, "plan", "batch", "--burgers", src, "--out", tmp_path / "o",
+                          "--workers", "1", "--no-progress", *extra)
+        assert rc == 2 and "stopped by the test" in err
+    assert seen[0] is not None and len(seen[0]) > 0 and seen[1] is None

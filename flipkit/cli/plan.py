@@ -102,6 +102,7 @@ def register(subparsers) -> None:
                    help="plan the burgers in K worker processes (default: the CPU count; 1: "
                         "one after another in this process)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
+    atlas_arguments(b)
     common(b, json_out=False)
     b.set_defaults(run=run_batch)
 
@@ -259,10 +260,12 @@ def run_serve(args: argparse.Namespace) -> int:
 
 def run_batch(args: argparse.Namespace) -> int:
     """Plan the batch, write every plan and summary.csv, print the table."""
+    from flipkit.behaviors.segments import SegmentOptions
     from flipkit.planning.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
 
     _quiet()
     locations = read_locations(args.burgers)
+    atlas = _atlas(args, SegmentOptions())
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     if workers < 1:
         raise ConfigError(f"--workers must be a positive integer, got {workers}")
@@ -273,7 +276,7 @@ def run_batch(args: argparse.Namespace) -> int:
         executor = make_executor(workers=workers)
     try:
         plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
-                           executor=executor)
+                           executor=executor, atlas=atlas)
     finally:
         if executor is not None:
             executor.shutdown(cancel_futures=True)

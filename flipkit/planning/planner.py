@@ -226,7 +226,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
                progress: bool = True, options: SegmentOptions = SegmentOptions(),
-               executor=None) -> list[Plan]:
+               executor=None, atlas=None) -> list[Plan]:
     """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
 
     Burger k starts where the last *solved* plan ended (a solved flip ends at q_home at
@@ -241,7 +241,8 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
         locations: Burger locations p^b (m), in order.
         q_start: Start configuration of the first burger (rad), default q_home.
         progress: Show a tqdm progress bar (stderr).
-        cell, solver, options: As :func:`plan_flip`.
+        cell, solver, options, atlas: As :func:`plan_flip` (``atlas`` warm-starts every
+            burger's chain; default cold starts).
         executor: Optional :class:`concurrent.futures.Executor` to plan in parallel.
 
     Raises:
@@ -265,7 +266,8 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
         except UnreachableError as exc:
             raise UnreachableError(f"burger {k}: {exc}") from None
     home = models_for(cell).bare.q_home
-    kw = {"cell": cell, "solver": solver, "options": options}
+    check_atlas(atlas, cell, options)
+    kw = {"cell": cell, "solver": solver, "options": options, "atlas": atlas}
     ahead = None if executor is None else [
         executor.submit(plan_flip, pb, q_start if k == 0 else home, None, **kw)
         for k, pb in enumerate(checked)]
