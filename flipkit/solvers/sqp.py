@@ -311,9 +311,16 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
             < o.plateau_ftol * recent[0]["objective"])
         if stationary and p.v_max > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
-            # curved active rows): Newton corrections onto the violated rows.
+            # curved active rows): Newton corrections onto the violated rows, first holding
+            # the subproblem's active rows at their bounds, as the line search's correction
+            # does (see newton_correction), else not. Measured (session 8, from the atlas):
+            # Table I location 10 in 39 SQP iterations instead of 42, and the five-burger
+            # schedule planned in 13.8–14.0 s instead of 14.5–16.3 s.
+            side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi)
             for _ in range(3):
-                q = correct(p)
+                q = point(p.x + D * newton_correction(nlp, p, side))
+                if q.v.sum() >= p.v.sum():
+                    q = correct(p)
                 if q.v.sum() >= p.v.sum():
                     break
                 p = q
