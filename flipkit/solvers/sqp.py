@@ -309,6 +309,8 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
             and all(r["violation"] <= 100 * o.tol for r in recent)
             and recent[0]["objective"] - nlp.objective(p.x)
             < o.plateau_ftol * recent[0]["objective"])
+        side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi) if hard else None  # active rows
+        held = lambda q: point(q.x + D * newton_correction(nlp, q, side))  # noqa: E731
         if stationary and p.v_max > o.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows, first holding
@@ -316,9 +318,8 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
             # does (see newton_correction), else not. Measured (session 8, from the atlas):
             # Table I location 10 in 39 SQP iterations instead of 42, and the five-burger
             # schedule planned in 13.8–14.0 s instead of 14.5–16.3 s.
-            side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi)
             for _ in range(3):
-                q = point(p.x + D * newton_correction(nlp, p, side))
+                q = held(p)
                 if q.v.sum() >= p.v.sum():
                     q = correct(p)
                 if q.v.sum() >= p.v.sum():
@@ -329,16 +330,14 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         if stationary and p.v_max <= o.tol:
             status = Status.SOLVED
         elif sol.status in ("optimal", "optimal_inaccurate") and (pred > 0 or not hard):
-            side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi) if hard else None
             if hard:
                 merit, decrease = (lambda q: q.merit(rho)), pred
             else:  # restoration: judged by the violation it removes, whatever Σu² does
                 merit, decrease = _square_violation, _square_violation(p) - 0.5 * float(
                     np.sum(_linearised_violation(nlp, p, sol.d, total=False) ** 2))
             if decrease > 0:
-                trial, step, ratio, accepted = _line_search(
-                    o, p, D * sol.d, decrease, merit, point,
-                    lambda q: point(q.x + D * newton_correction(nlp, q, side)))
+                trial, step, ratio, accepted = _line_search(o, p, D * sol.d, decrease, merit,
+                                                            point, held)
         d_len = float(np.abs(sol.d).max(initial=0.0))
         if status != Status.SOLVED and not inexact:
             trust, mu = _adapt(o, accepted, step, ratio, d_len, trust, mu)
