@@ -93,3 +93,52 @@ def test_segment_validation(models):
         build_segment("jump", models, models.bare.q_home)
     with pytest.raises(ConfigError, match="burger location"):
         build_segment("scoop", models, models.bare.q_home)
+
+
+def test_interpolant_rows_are_the_executed_cubic(models):
+    """a_0, a_1 are the Hermite cubic's q̈ at each interval's ends (scipy's spline, the
+    controller's interpolant) and bound it in between; c bounds its q̇ on the interval."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    from flipkit.transcription.constraints.interpolant import InterpolantLimits
+
+    L, rng, T = Layout(), np.random.default_rng(3), 0.9
+    q, qd = rng.normal(size=(21, 6)), rng.normal(size=(21, 6))
+    x = L.pack(q, qd, np.zeros((21, 6)), np.zeros((21, 6)), np.zeros((6, 7)), T)
+    block = InterpolantLimits(L, models.bare.qd_max, models.bare.qdd_max)
+    vals = block.evaluate(Evaluation(L, models.bare, x))[0].reshape(20, 3, 6)
+    t = L.s * T
+    spl = CubicHermiteSpline(t, q, qd, axis=0)
+    eps = 1e-9
+    np.testing.assert_allclose(vals[:, 0], spl(t[:-1] + eps, 2), rtol=1e-6)
+    np.testing.assert_allclose(vals[:, 1], spl(t[1:] - eps, 2), rtol=1e-6)
+    for i in range(20):
+        tt = np.linspace(t[i] + eps, t[i + 1] - eps, 201)  # inside: q̈ jumps at the knots
+        acc, vel = np.abs(spl(tt, 2)), np.abs(spl(tt, 1))
+        assert np.all(acc <= np.maximum(abs(vals[i, 0]), abs(vals[i, 1])) * (1 + 1e-9))
+        hull = np.maximum.reduce([abs(qd[i]), abs(qd[i + 1]), abs(vals[i, 2])])
+        assert np.all(vel <= hull * (1 + 1e-9))
+    assert block.m == 360 and np.all(block.hi[:12] == 20.0)
+    np.testing.assert_array_equal(block.hi[12:18], models.bare.qd_max)
+
+
+def test_branch_bounds_keep_the_elbow_and_wrist_on_the_home_side():
+    from flipkit.model.singular import branch_bounds
+
+    q_min, q_max = np.full(6, -np.pi), np.full(6, np.pi)
+    home = np.array([-0.99, -1.79, 2.36, -0.57, 0.58, 1.57])
+    lo, hi = branch_bounds(q_min, q_max, home, home, 0.2)
+    assert (lo[2], hi[2]) == pytest.approx((0.2, np.pi - 0.2))
+    assert (lo[4], hi[4]) == pytest.approx((0.2, np.pi - 0.2))
+    np.testing.assert_array_equal(np.delete(lo, [2, 4]), -np.pi)  # the other joints untouched
+    start = home.copy()
+    start[4] = 0.05  # a start inside the margin widens the bound to it, no further
+    lo, hi = branch_bounds(q_min, q_max, home, start, 0.2)
+    assert lo[4] == 0.05 and hi[4] == pytest.approx(np.pi - 0.2)
+    flipped = home.copy()
+    flipped[4] = -0.58  # the other wrist branch: the interval below zero
+    lo, hi = branch_bounds(q_min, q_max, flipped, flipped, 0.2)
+    assert (lo[4], hi[4]) == pytest.approx((-np.pi + 0.2, -0.2))
+    np.testing.assert_array_equal(branch_bounds(q_min, q_max, home, home, 0.0)[0], q_min)
+    with pytest.raises(ConfigError, match="singularity margin"):
+        branch_bounds(q_min, q_max, home, home, 2.0)

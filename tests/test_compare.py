@@ -5,6 +5,7 @@ and the Dask executor gives the same outcome as local processes."""
 
 import json
 
+import numpy as np
 import pytest
 
 from flipkit.baseline import REASONS
@@ -73,6 +74,29 @@ def test_collocation_plan_passes_verify(run):
     plan = Plan.load(plans / plan_filename(LOCATION, "auto"))
     assert plan.status == "solved" and verify_plan(plan).ok
     assert doc["summary"]["success_fraction"]["collocation"] == 1.0
+
+
+def test_the_judge_passes_the_collocation_plan_and_catches_a_jump(run):
+    """The baseline's judge on the collocation plan at 500 Hz: every segment passes (limits
+    between the nodes, clear of the singularities); the same path with a 0.3 rad step injected
+    into one joint is a configuration jump."""
+    from flipkit.baseline.classify import classify_plan, classify_segment, resample_segment
+
+    doc, _, _, plans = run
+    assert doc["locations"][0]["collocation"]["judge"]["status"] == "solved"
+    plan = Plan.load(plans / plan_filename(LOCATION, "auto"))
+    verdicts = classify_plan(plan, 500.0)
+    assert [v.status for v in verdicts] == ["solved"] * 5
+    assert min(v.measures["sigma_min"] for v in verdicts) >= 0.01
+    seg = plan.segments[3]  # the flip
+    t, q = resample_segment(seg, 500.0)
+    robot = plan.robot_for(seg, plan.cell())
+    q[len(t) // 2:, 1] += 0.3  # rad, shoulder; the references are the path's own poses, as
+    M = [robot.placement(qk) for qk in q]  # classify_plan takes them for a joint-space plan
+    v = classify_segment(seg.name, robot, t, q, np.array([m.translation for m in M]),
+                          np.array([m.rotation for m in M]))
+    assert (v.reason, v.failure_class) == ("configuration_jump", "kinematic")
+    assert v.amount == pytest.approx(0.3, abs=0.02)
 
 
 def test_ee_ik_failure_has_a_reason_from_the_tuple(run):

@@ -101,23 +101,24 @@ def test_warm_start_cuts_iterations(segments):
 
 
 def test_sqp_condensed_and_full_space_agree(segments):
-    """The SQP reaches the same solution with either form of the subproblem on a smooth NLP
-    (the translate without the arm's clearance rows): same iterations, the same point to
-    rounding. With the clearance rows (at each node the least distance over the arm's shapes
-    and the cell's boxes, piecewise smooth where the nearest pair changes) the two forms'
-    rounding differences — OSQP's tolerance on the full-space equalities, an exact LU in the
-    condensed form — can switch a nearest pair and the path: measured 11 (condensed) vs 6
-    (full) iterations to two feasible points with objectives 1.5e-3 apart (session 7; 4.5e-5
-    in session 5)."""
+    """The SQP reaches the same optimum with either form of the subproblem on a smooth NLP (the
+    translate without the arm's clearance rows), to 1e-4 of Σu². Until session 8 the two forms
+    took the same iterations to the same point to rounding; since the joint limits hold between
+    the nodes (InterpolantLimits, active along the cruise at 2.16 rad/s) OSQP's tolerance on the
+    full-space form's active rows sends it another way through a flat valley: measured 6
+    (condensed) vs 8 (full) iterations to Σu² 13 264.31 vs 13 263.90, joint paths up to 0.07
+    rad apart. With the clearance rows (piecewise smooth where the nearest pair changes) the
+    forms' rounding differences can switch a nearest pair and the path: measured 11 vs 6
+    iterations to objectives 1.5e-3 apart (session 7)."""
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
     smooth = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)),
                            options=SegmentOptions(arm_clearance=False))
     a = solve_sqp(smooth, options=SQPOptions(condense=True))
     b = solve_sqp(smooth, options=SQPOptions(condense=False))
-    assert a.success and b.success and a.iterations == b.iterations
-    assert a.objective == pytest.approx(b.objective, rel=1e-9)
-    np.testing.assert_allclose(a.x, b.x, atol=1e-8)
+    assert a.success and b.success
+    assert a.objective == pytest.approx(b.objective, rel=1e-4)
+    assert a.max_violation <= 1e-6 and b.max_violation <= 1e-6
     nlp = segments["translate"]
     a = solve_sqp(nlp, options=SQPOptions(condense=True))
     b = solve_sqp(nlp, options=SQPOptions(condense=False))

@@ -13,7 +13,8 @@ from flipkit.cli import main
 from flipkit.errors import ConfigError, VerificationError
 from flipkit.planning.plan_file import Plan
 from flipkit.behaviors.segments import SCOOP_PRESS
-from flipkit.planning.verify import GROUPS, verify_plan
+from flipkit.planning.verify import GROUPS, INTERPOLANT_TOL, verify_plan
+from flipkit.transcription.constraints.interpolant import ACC_SCALE, VEL_SCALE
 from flipkit.model.ik import solve_pose
 
 
@@ -89,6 +90,32 @@ def test_joint_velocity_limit(models):
     report = _fails(plan, "qd_limits")  # peak 1.5 * 1.1 / 0.6 = 2.75 rad/s > 2.16
     assert report.groups["qd_limits"].violation == pytest.approx(2.75 - 2.16)
     assert report.groups["dynamics"].ok and report.groups["defects"].ok
+
+
+def test_limits_between_the_nodes(models):
+    """Node values within the limits, the interpolant the controller follows beyond them:
+    node 11 of a base turn moved so that the Hermite cubic on [t_10, t_11] overshoots q̇_max."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    plan = translate_plan(models, turns=(np.array([2.0, 0, 0, 0, 0, 0]),), durations=(1.5,))
+    seg, r = plan.segments[0], models.loaded
+    assert verify_plan(plan).groups["interpolant"].ok  # a cubic is its own interpolant
+    h = seg.t[1] - seg.t[0]
+    c = 3 * (seg.q[11, 0] - seg.q[10, 0]) / h - seg.qd[10, 0] - seg.qd[11, 0]
+    seg.q[11, 0] += (r.qd_max[0] + 0.3 - c) * h / 3  # middle Bernstein coefficient 0.3 over
+    _redo_u(seg, r, 11)
+    report = _fails(plan, "interpolant")
+    for group in ("qd_limits", "qdd_limits", "dynamics"):
+        assert report.groups[group].ok, group
+    spl = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)  # dense samples: the same worst row
+    t = np.linspace(0, seg.T, 300001)
+    tol_v, tol_a = (f * report.tol for f in INTERPOLANT_TOL)
+    over_v = np.maximum(np.abs(spl(t, 1)) - r.qd_max, 0).max() / tol_v
+    over_a = np.maximum(np.abs(spl(t, 2)) - r.qdd_max, 0).max() / tol_a
+    assert 0 < over_v < 0.3 / tol_v  # the curve peaks below its Bernstein coefficient
+    # the tolerances are the solver's: its row scales (InterpolantLimits) times tol
+    assert INTERPOLANT_TOL == (1 / VEL_SCALE, 1 / ACC_SCALE)
+    assert report.groups["interpolant"].ratio == pytest.approx(max(over_v, over_a), rel=1e-4)
 
 
 def test_discontinuity_between_segments(models):

@@ -28,6 +28,8 @@ from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.collision import ArmShapes
+from flipkit.model.singular import SINGULARITY_MARGIN, branch_bounds
+from flipkit.transcription.constraints.interpolant import InterpolantLimits
 from flipkit.transcription.nlp import NLP
 from flipkit.model.robot import Robot
 
@@ -95,6 +97,9 @@ class SegmentOptions:
             boxes). ``False`` leaves them out: the problem that exact-derivative solvers
             (FATROP, exact-Hessian IPOPT; :mod:`flipkit.transcription.ocp_graph`) and the SQP
             can all be given, for the solver comparison of ``bench``.
+        singularity_margin: Keep q3 and q5 this far (rad) from the elbow and wrist
+            singularities, on the home configuration's side (:mod:`flipkit.model.singular`);
+            0 lets the plan cross them.
     """
 
     N: int = 20
@@ -106,6 +111,7 @@ class SegmentOptions:
     mu_safety: float = MU_SAFETY
     stretch: bool = False
     arm_clearance: bool = True
+    singularity_margin: float = SINGULARITY_MARGIN
 
     def __post_init__(self):
         if self.epsilon <= 0 or not np.isfinite(self.epsilon):
@@ -118,6 +124,9 @@ class SegmentOptions:
             raise ConfigError(f"release_fraction must be in [0.3, 0.9], got "
                               f"{self.release_fraction!r}")
         make_cone(self.cone, 0.5)  # validates the name
+        if not (np.isfinite(self.singularity_margin) and 0 <= self.singularity_margin < 1.5):
+            raise ConfigError(f"singularity_margin must be in [0, 1.5) rad, got "
+                              f"{self.singularity_margin!r}")
 
     def release_node(self) -> int:
         """The flip's release node r = ⌈release_fraction · N⌉."""
@@ -190,8 +199,11 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     p_floor = np.array(lim.p_min, float)  # the scoop's press takes the blade centre below h_g
     if name in ("go_to_burger", "scoop", "pickup"):
         p_floor[2] -= SCOOP_PRESS + SCOOP_TIP_BAND
+    q_lo, q_hi = branch_bounds(robot.q_min, robot.q_max, robot.q_home, q_start,
+                               options.singularity_margin)
     blocks = [
         Dynamics(L, robot.u_max / 10), HermiteSimpson(L), BezierOutput(L, options.epsilon),
+        InterpolantLimits(L, robot.qd_max, robot.qdd_max),
         FixedValues("start_state", L, np.concatenate([L.iq(0), L.iqd(0)]),
                     np.concatenate([q_start, qd_start])),
         KinematicBlock("task_position", L, "position", moving, p_floor, lim.p_max),
@@ -301,7 +313,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
         # Stopping distance at half the acceleration limit: the next segment's polynomial
         # motion cannot realise a bang-bang stop (measured: at the full 20 rad/s² flips ended
         # on the margin and 5 of 10 turn-backs from them were infeasible).
-        blocks.append(BrakingMargin(L, last, robot.q_min, robot.q_max,
+        blocks.append(BrakingMargin(L, last, q_lo, q_hi,
                                     BRAKING_FRACTION * np.asarray(robot.qdd_max)))
     if cone_nodes:
         blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
@@ -312,7 +324,7 @@ def build_segment(name: str, models: Models, q_start, qd_start=None, *, location
     x0 = initial_guess(name, L, robot, q_start, qd_start, T_hi, pose, pb, cell, rest_at_end)
 
     lb, ub, scale = (np.empty(L.n) for _ in range(3))
-    per_node = [(robot.q_min, robot.q_max, 1.0), (-robot.qd_max, robot.qd_max, 1.0),
+    per_node = [(q_lo, q_hi, 1.0), (-robot.qd_max, robot.qd_max, 1.0),
                 (-robot.qdd_max, robot.qdd_max, 10.0), (-robot.u_max, robot.u_max, robot.u_max / 10)]
     for i in all_nodes:
         for f, (lo, hi, s) in zip((L.iq, L.iqd, L.iqdd, L.iu), per_node):

@@ -18,6 +18,9 @@ defects            Hermite–Simpson interpolation and Simpson defects (rad,    
 q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         tol, tol,
                                                                                10·tol,
                                                                                tol·u_max/10
+interpolant        q̇ and q̈ limits between the nodes, on the cubic Hermite        100·tol,
+                   interpolant of (q, q̇) the controller follows: exact extremes  1000·tol
+                   of each interval's polynomial (scipy's coefficients)
 endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded;
                    serve: carry and place end poses from the recorded spot
@@ -47,7 +50,8 @@ orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     t
 
 ``tol`` (:data:`TOL` = 1e-5) is in the solver's scaled units, so every group's tolerance is
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
-and torques by u_max/10 and q̈ and the cone rows by 10, everything else is unscaled. The
+and torques by u_max/10 and q̈ and the cone rows by 10, multiplies the interpolant's velocity
+rows by 0.01 and its acceleration rows by 0.001, and leaves everything else unscaled. The
 duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
 Task-space position, velocity and acceleration bounds (cell.limits) are not checked. The
 pitch range, the cell's boxes and margin and the side table come from the plan's
@@ -80,8 +84,10 @@ from flipkit.planning.verify_flight import check_flight
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
+INTERPOLANT_TOL = (100.0, 1000.0)  # × tol: the solver's row scales 0.01 (q̇) and 0.001 (q̈)
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
+          "interpolant": "rad/s | rad/s²",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
           "flight_clearance": "m", "placing": "m", "arm_clearance": "m", "orientation": "rad",
@@ -260,6 +266,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
                 ("qdd_limits", seg.qdd, -robot.qdd_max, robot.qdd_max, 10.0),
                 ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
             add(group, k, _outside(x[i], lo, hi), tol * scale, i)
+    _check_interpolant(report, k, seg, robot, tol)
     for i in range(1, N, 2):
         dt = seg.t[i + 1] - seg.t[i - 1]
         for x, xd in ((seg.q, seg.qd), (seg.qd, seg.qdd)):
@@ -287,6 +294,26 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
             st = robot.state(seg.q[i], seg.qd[i], seg.qdd[i], (*on_blade, 0.0))
         add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
+
+
+def _check_interpolant(report, k, seg, robot, tol) -> None:
+    """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly: on
+    interval i, q = c0 τ³ + c1 τ² + c2 τ + c3 (τ ∈ [0, h]), so q̈ is linear (extremes at the
+    ends) and q̇ a parabola (extremes at the ends or at τ* = −c1 / (3 c0))."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    c = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0).c  # (4, N, nq)
+    h = np.diff(seg.t)[:, None]
+    for i, qdd in enumerate((2 * c[1], 6 * c[0] * h + 2 * c[1])):
+        for n in range(seg.N):  # node of the interval's start (i = 0) or end (i = 1)
+            report.add("interpolant", k, _outside(qdd[n], -robot.qdd_max, robot.qdd_max),
+                       INTERPOLANT_TOL[1] * tol, n + i)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = np.clip(np.nan_to_num(-c[1] / (3 * c[0]), nan=0.0, posinf=0.0, neginf=0.0), 0, h)
+    qd = 3 * c[0] * tau**2 + 2 * c[1] * tau + c[2]
+    for n in range(seg.N):
+        report.add("interpolant", k, _outside(qd[n], -robot.qd_max, robot.qd_max),
+                   INTERPOLANT_TOL[0] * tol, n)
 
 
 def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:

@@ -29,6 +29,7 @@ from flipkit.model.contact import PaperCone, PhysicalCone
 from flipkit.transcription.constraints.base import Block, FixedValues
 from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.dynamics import BezierOutput, Dynamics, HermiteSimpson
+from flipkit.transcription.constraints.interpolant import InterpolantLimits, interval_terms
 from flipkit.transcription.constraints.kinematic import (Acceleration, BladeEdgeHeights, Cone,
                                                          Height, KinematicBlock, Normal, Pitch,
                                                          Position, Rpy, TipHeight, Velocity,
@@ -116,6 +117,18 @@ def _hermite_simpson(b: HermiteSimpson, acc) -> Rows:
     return out
 
 
+def _interpolant(b: InterpolantLimits, acc) -> Rows:
+    L, nq, out = b.layout, b.layout.nq, []
+    for i in range(L.N):
+        s = acc.stage_of(i)  # holds node i and node i + 1 (itself or the copy of the next)
+        (q0, qd0), (q1, qd1) = acc.node(i, s)[:2], acc.node(i + 1, s)[:2]
+        terms = interval_terms(q0, qd0, q1, qd1, acc.var(L.T_index, s) / L.N)
+        for r, value in enumerate(terms):
+            row = (3 * i + r) * nq
+            out.append((s, value, np.arange(row, row + nq)))
+    return out
+
+
 def _alpha(L, acc, s) -> ca.SX:
     """α as an (nq, M+1) SX matrix, held by stage s."""
     idx = np.arange(L.alpha_start, L.T_index)
@@ -165,7 +178,8 @@ def _braking(b: BrakingMargin, acc) -> Rows:
 
 
 _FORMS = ((Dynamics, _dynamics), (HermiteSimpson, _hermite_simpson), (BezierOutput, _bezier),
-          (FixedValues, _fixed), (KinematicBlock, _kinematic), (BrakingMargin, _braking))
+          (FixedValues, _fixed), (KinematicBlock, _kinematic), (BrakingMargin, _braking),
+          (InterpolantLimits, _interpolant))
 
 
 def symbolic_rows(block: Block, acc) -> Rows:

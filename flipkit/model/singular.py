@@ -1,0 +1,53 @@
+"""The UR arm's elbow and wrist singularities, and joint bounds that keep a plan clear of them.
+
+The spatula Jacobian of a UR arm loses rank where sin q3 = 0 (the arm stretched out or folded
+onto itself: the elbow singularity) and where sin q5 = 0 (wrist 1 and wrist 3 axes aligned:
+the wrist singularity); the third, with the wrist centre on the base axis, lies far from the
+grill. A joint-space plan may cross either (its joint rates are bounded directly), but a
+controller or an IK that follows its spatula poses cannot, and the judge of
+:mod:`flipkit.baseline.classify` fails both methods there. :func:`branch_bounds` keeps q3 and
+q5 on the side of the singularity where the home configuration is, ``margin`` from it.
+
+Measured at q_home (session 9): the 6×6 Jacobian's smallest singular value is 0.069 with q5
+0.1 rad from its singularity and 0.014 with q3 0.1 rad from π (against 0.01, the judge's
+threshold); the Table I plans made without the bounds cross sin q5 = 0 in go to burger at 5 of
+10 locations and fold the elbow to q3 = π in 9 of 10 turn backs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flipkit.errors import ConfigError
+
+ELBOW, WRIST = 2, 4  # indices of q3 and q5
+SINGULARITY_MARGIN = 0.2  # rad, default distance of q3 and q5 from their singular values
+
+
+def branch_bounds(q_min, q_max, q_home, q_start, margin: float):
+    """Joint bounds (rad) with q3 and q5 kept within (kπ + margin, (k+1)π − margin), the
+    interval of q_home, widened to contain q_start (a plan may start closer than ``margin``).
+
+    Args:
+        q_min, q_max: Joint limits (rad). q_home: Configuration that fixes the branch (rad).
+        q_start: Start configuration of the segment (rad). margin: Distance (rad) in
+            [0, π/2); 0 leaves the bounds as they are.
+
+    Returns:
+        (lo, hi): The narrowed bounds, copies.
+    """
+    if not (math.isfinite(margin) and 0 <= margin < math.pi / 2):
+        raise ConfigError(f"singularity margin must be in [0, pi/2) rad, got {margin!r}")
+    lo, hi = np.array(q_min, float), np.array(q_max, float)
+    if margin == 0:
+        return lo, hi
+    for j in (ELBOW, WRIST):
+        k = math.floor(q_home[j] / math.pi)
+        lo[j] = min(max(lo[j], k * math.pi + margin), q_start[j])
+        hi[j] = max(min(hi[j], (k + 1) * math.pi - margin), q_start[j])
+    return lo, hi
+
+
+__all__ = ["ELBOW", "SINGULARITY_MARGIN", "WRIST", "branch_bounds"]
