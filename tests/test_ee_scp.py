@@ -186,12 +186,12 @@ def test_linearisation_is_first_order_exact(chain, cell, h):
         Cn, Dn = C + step * dC, D + step * dD
         P, O, A = B[0] @ Cn, B[0] @ Dn, B[2] @ Cn
         R = np.array([rpy_matrix(o) for o in O])
-        e_edge = max(np.max(np.abs(P[:, 2] + par[f"Ce{e}"] + sum(par[f"He{e}{j}"] * O[:, j]
-                                                                  for j in range(3))
+        e_edge = max(np.max(np.abs(P[:, 2] + par["Ce"][e] + sum(par["He"][3 * e + j] * O[:, j]
+                                                                 for j in range(3))
                                    - (P[:, 2] + R[:, 2] @ task.edges[:, e]))) for e in range(4))
         idx = qp.cone_idx
-        model = np.stack([sum(par[f"A{r}{i}"] * A[idx, i] for i in range(3))
-                          + sum(par[f"G{r}{j}"] * O[idx, j] for j in range(3)) - par[f"b{r}"]
+        model = np.stack([sum(par["A"][3 * r + i] * A[idx, i] for i in range(3))
+                          + sum(par["G"][3 * r + j] * O[idx, j] for j in range(3)) - par["b"][r]
                           for r in range(5)], axis=1)
         exact = np.einsum("rc,kjc,kj->kr", S, R[idx], A[idx] / T**2 - task.g)
         e_cone = np.max(np.abs(model - exact))

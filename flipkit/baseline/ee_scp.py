@@ -23,7 +23,7 @@ control points C, D (m, rad) are the decision variables. The constraints are imp
 points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints,
 boxes, pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised about the
 previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
-differences of :func:`flipkit.model.flight.predict_landing`) and relaxed by one elastic slack
+differences of :func:`flipkit.model.flight.landing_function`, 25 points in one call) and relaxed by one elastic slack
 σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
 (subbehaviour, samples), written once with Parameters (DPP) and cached; the duration enters
 only through Parameters (bounds scaled by T, T²; cost weights), so a duration search and a
@@ -45,6 +45,7 @@ once that has not improved by OBJ_TOL for :data:`STALE_ITERATIONS` iterations.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 
@@ -60,7 +61,7 @@ from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, RELEASE_FRACTION, SCO
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
 from flipkit.model.bezier import Bezier
-from flipkit.model.flight import TILT_MIN_DEG, predict_landing
+from flipkit.model.flight import TILT_MIN_DEG, gravity_magnitude, landing_function
 from flipkit.model.orientation import rpy_matrix, rpy_rate_matrix
 
 DEGREE = 7
@@ -122,20 +123,32 @@ class Task:
 
     def landing(self, z: np.ndarray) -> np.ndarray:
         """(x, y, cos tilt) of the landing from the release state z = (p, v, o, ȯ)."""
-        o = z[6:9]
-        out = predict_landing(z[:3], z[3:6], rpy_matrix(o), rpy_rate_matrix(o) @ z[9:],
-                              thickness=self.cell.burger.thickness,
-                              grill_height=self.cell.grill.height, gravity=self.g)
-        return np.array([*out["point"][:2], math.cos(math.radians(out["tilt_deg"]))])
+        return self._landings(np.asarray(z, float)[None])[:, 0]
+
+    def _landings(self, Z: np.ndarray) -> np.ndarray:
+        """:meth:`landing` of each row of Z (k, 12), in one call of the mapped CasADi
+        function (:func:`flipkit.model.flight.landing_function`); (3, k)."""
+        bg, hg = self.cell.burger, self.cell.grill.height
+        x = np.zeros((12, len(Z)))
+        Rs = np.empty((3, 3 * len(Z)))
+        for k, z in enumerate(Z):
+            o = z[6:9]
+            x[:6, k], x[9:, k] = z[:6], rpy_rate_matrix(o) @ z[9:]
+            Rs[:, 3 * k: 3 * k + 3] = rpy_matrix(o)
+        par = [bg.thickness, gravity_magnitude(self.g), hg + bg.thickness / 2, 0.0, 0.0, 0.0, 0.0]
+        y = np.asarray(_mapped_landing(len(Z))(x, Rs, par)[0])  # (5, k)
+        return np.vstack([y[3], y[4], np.clip(y[1], -1.0, 1.0)])
 
     def landing_jacobian(self, z: np.ndarray, h: float = 1e-6) -> tuple:
-        """Landing (3,) and its central-difference Jacobian (3, 12) at z."""
-        J = np.empty((3, 12))
-        for k in range(12):
-            e = np.zeros(12)
-            e[k] = h
-            J[:, k] = (self.landing(z + e) - self.landing(z - e)) / (2 * h)
-        return self.landing(z), J
+        """Landing (3,) and its central-difference Jacobian (3, 12) at z (one batched call)."""
+        E = h * np.eye(12)
+        Y = self._landings(np.vstack([z, z + E, z - E]))
+        return Y[:, 0], (Y[:, 1:13] - Y[:, 13:]) / (2 * h)
+
+
+@functools.lru_cache(maxsize=None)
+def _mapped_landing(k: int):
+    return landing_function().map(k)
 
 
 def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
@@ -221,11 +234,11 @@ def scp_at_duration(task: Task, T: float, C0: np.ndarray, D0: np.ndarray,
     feasible_linear = False  # (C, D) meets the linear rows (a subproblem's solution)
     best = None  # the feasible point of least objective seen, taken or not: (objective, C, D,
     stale = 0  # violation); iterations since it last improved by OBJ_TOL
+    qp.set_task(task, T)  # the task and duration Parameters hold for the whole loop
     for it in range(1, ITERATIONS + 1):
         stale += best is not None
         if stale > STALE_ITERATIONS:  # feasible, and the objective no longer falls
             break
-        qp.set_task(task, T)
         # until a subproblem solution is taken, the position is free: the start and end
         # rows (the start velocity × T) cannot be met near a guess or a warm start
         qp.linearise(task, C, D, T, trust, free_position=not feasible_linear)

@@ -111,6 +111,8 @@ def plot_joint_path(ax, path: dict, title: str = "", limits=None) -> None:
                 if np.min(np.abs(q[:, j] - bound)) < 0.3:
                     ax.axhline(bound, color=ax.lines[-1].get_color(), lw=0.6, ls=":")
     ax.set_xlim(t[0], t[-1])
+    lo, hi = ax.get_ylim()  # room below the curves for the label, none of them hidden by it
+    ax.set_ylim(lo - 0.18 * (hi - lo), hi)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("joint angle (rad)")
     if title:
