@@ -204,3 +204,24 @@ def test_newton_correction_leaves_fixed_and_bounded_variables_alone(reference):
     assert np.all(delta[fixed] == 0) and np.all(delta[at_bound] == 0)
     q = Iterate(nlp, x + D * delta, jscale)
     assert q.v.sum() < 0.5 * p.v.sum()
+
+
+def test_points_that_cannot_be_evaluated_are_never_taken(reference):
+    """A NaN row counts as infinitely violated (no merit comparison accepts the point), and a
+    start without a finite linear model ends at once with IPOPT's name for it, no exception
+    from deep inside the QP."""
+    from flipkit.solvers.iterate import Iterate
+
+    nlp, _ = reference
+    x = nlp.x0.copy()
+    x[nlp.layout.iu(3)] = np.nan  # torques: the dynamics rows are NaN there
+    p = Iterate(nlp, x, np.ones(len(nlp.jac_rows)))
+    x = nlp.x0.copy()
+    x[nlp.layout.iq(3)[0]] = np.nan  # (the SQP's projection recomputes u = RNEA, not q)
+    assert np.isinf(p.v_max) and np.isinf(p.merit(1.0))
+    q = Iterate(nlp, x, np.ones(len(nlp.jac_rows)))
+    assert np.isinf(q.v_max) and np.isinf(q.merit(1.0))
+    res = solve_sqp(nlp, x, raise_on_failure=False)
+    assert res.status == "Invalid_Number_Detected" and res.iterations == 0
+    with pytest.raises(NoSolutionFound, match="Invalid_Number_Detected"):
+        solve_sqp(nlp, x)

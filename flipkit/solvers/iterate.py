@@ -23,7 +23,12 @@ class Iterate:
         self.jac = jac * jscale  # scaled entries, pattern order
         self.cs = nlp.c_scale * self.c
         self.f = nlp.objective(x) * nlp.obj_scale
-        self.v = nlp.scaled_violation(self.c)
+        self.f = self.f if np.isfinite(self.f) else np.inf
+        # a row that cannot be evaluated here (NaN: e.g. a landing with no real time of
+        # flight) counts as infinitely violated, so that no comparison accepts the point
+        self.v = np.nan_to_num(nlp.scaled_violation(self.c), nan=np.inf)
+        if not np.all(np.isfinite(self.jac)):  # nor a point without a linear model
+            self.v = np.full_like(self.v, np.inf)
 
     @property
     def J(self) -> sp.csr_matrix:

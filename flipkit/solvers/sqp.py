@@ -51,6 +51,7 @@ subproblem is LP-like and OSQP needed 6 000–20 000 ADMM iterations per solve (
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -282,6 +283,10 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
     p = point(nlp.x0 if x0 is None else x0)
     rho, trust, mu, tighten = o.rho_min, o.trust0, o.prox, 1.0
     log, qp_iters, status, it, pred, stalls = [], 0, Status.MAX_ITER, 0, np.inf, 0
+    if not (np.all(np.isfinite(p.c)) and np.all(np.isfinite(p.jac))):  # no model to start from
+        return SolveResult(x=p.x, status=Status.INVALID_NUMBER_DETECTED, iterations=0,
+                           wall_time_s=time.perf_counter() - t0, objective=nlp.objective(p.x),
+                           max_violation=math.inf, log=log, qp_iterations=0)
     while it < o.max_iter:
         it += 1
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
