@@ -61,7 +61,7 @@ from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, RELEASE_FRACTION, SCO
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
 from flipkit.model.bezier import Bezier
-from flipkit.model.flight import TILT_MIN_DEG, gravity_magnitude, landing_function
+from flipkit.model.flight import TILT_MIN_DEG, landing_function, landing_parameters
 from flipkit.model.orientation import rpy_matrix, rpy_rate_matrix
 
 DEGREE = 7
@@ -128,14 +128,13 @@ class Task:
     def _landings(self, Z: np.ndarray) -> np.ndarray:
         """:meth:`landing` of each row of Z (k, 12), in one call of the mapped CasADi
         function (:func:`flipkit.model.flight.landing_function`); (3, k)."""
-        bg, hg = self.cell.burger, self.cell.grill.height
         x = np.zeros((12, len(Z)))
         Rs = np.empty((3, 3 * len(Z)))
         for k, z in enumerate(Z):
             o = z[6:9]
             x[:6, k], x[9:, k] = z[:6], rpy_rate_matrix(o) @ z[9:]
             Rs[:, 3 * k: 3 * k + 3] = rpy_matrix(o)
-        par = [bg.thickness, gravity_magnitude(self.g), hg + bg.thickness / 2, 0.0, 0.0, 0.0, 0.0]
+        par = landing_parameters(self.cell.burger.thickness, self.cell.grill.height, self.g)
         y = np.asarray(_mapped_landing(len(Z))(x, Rs, par)[0])  # (5, k)
         return np.vstack([y[3], y[4], np.clip(y[1], -1.0, 1.0)])
 

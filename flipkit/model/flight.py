@@ -117,6 +117,14 @@ def gravity_magnitude(gravity) -> float:
     return float(-g[2])
 
 
+def landing_parameters(thickness: float, grill_height: float, gravity, target=(0.0, 0.0),
+                       on_blade=(0.0, 0.0)) -> list:
+    """The ``par`` input of :func:`landing_function`: (h, g, z_land = h_g + h/2, target x,
+    target y, bx, by) (SI; ``gravity`` the vector, along −z)."""
+    return [float(thickness), gravity_magnitude(gravity), grill_height + thickness / 2,
+            *np.asarray(target, float)[:2], *np.asarray(on_blade, float)[:2]]
+
+
 def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravity,
                     target=(0.0, 0.0), on_blade=(0.0, 0.0)) -> dict:
     """Landing of a burger released from the blade state (p, R, v, ω) (world, SI), its
@@ -126,17 +134,15 @@ def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravit
         ``point`` (x, y, z of the centre at landing, m), ``offset`` (distance from ``target``,
         m), ``tilt_deg`` (angle of the top-face normal from +z, deg), ``time_of_flight`` (s).
     """
-    g = gravity_magnitude(gravity)
-    z_land = grill_height + thickness / 2
+    par = landing_parameters(thickness, grill_height, gravity, target, on_blade)
+    z_land = par[2]
     x = np.concatenate([p, v, np.zeros(3), w])
-    y = np.asarray(landing_function()(x, np.asarray(R, float),
-                                      [thickness, g, z_land, *np.asarray(target, float)[:2],
-                                       *np.asarray(on_blade, float)[:2]])[0])
+    y = np.asarray(landing_function()(x, np.asarray(R, float), par)[0])
     y = y.ravel()
     return {"point": [float(y[3]), float(y[4]), float(z_land)], "offset": float(y[0]),
             "tilt_deg": math.degrees(math.acos(float(np.clip(y[1], -1, 1)))),
             "time_of_flight": float(y[2])}
 
 
-__all__ = ["TILT_MIN_DEG", "landing_function", "clearance_function", "gravity_magnitude",
+__all__ = ["TILT_MIN_DEG", "landing_function", "landing_parameters", "clearance_function", "gravity_magnitude",
            "predict_landing"]

@@ -18,7 +18,8 @@ import math
 import numpy as np
 
 from flipkit.errors import ConfigError
-from flipkit.model.flight import TILT_MIN_DEG, clearance_function, gravity_magnitude, landing_function
+from flipkit.model.flight import (TILT_MIN_DEG, clearance_function, gravity_magnitude,
+                                  landing_function, landing_parameters)
 from flipkit.transcription.constraints.base import Block
 
 
@@ -64,8 +65,7 @@ class Landing(Block):
             raise ConfigError(f"release node must be inside the segment, got {release}")
         self.release = int(release)
         self.on_blade = [float(v) for v in np.asarray(on_blade, float)[:2]]
-        self.par = [thickness, gravity_magnitude(gravity), grill_height + thickness / 2,
-                    *np.asarray(target, float)[:2], *self.on_blade]
+        self.par = landing_parameters(thickness, grill_height, gravity, target, self.on_blade)
         self._add(0, 2, np.concatenate([layout.iq(release), layout.iqd(release)]))
         self.m = 2
         self._finish([-np.inf, -np.inf], [r_land, math.cos(math.radians(TILT_MIN_DEG))],
