@@ -84,3 +84,23 @@ def test_the_working_set_is_capped_by_priority():
     kept = _capped(rows, first, then, 3)
     assert kept.tolist() == [False, True, False, True, True]  # -2, -1, then the smaller `then`
     assert _capped(rows, first, then, 9) is rows
+
+
+def test_assigned_values_take_the_place_of_dot_value():
+    problem, params, _ = _problem()
+    rng = np.random.default_rng(5)
+    _set(params, rng)
+    pmap = ParameterMap(problem, problem.get_problem_data(cp.OSQP)[0])
+    new = {prm: rng.uniform(0.2, 2.0, prm.shape) for prm in params}
+    for prm, value in new.items():
+        pmap.assign(prm, value)
+    assigned = pmap.data()
+    for prm, value in new.items():
+        prm.value = value
+    expected = pmap.__class__(problem, problem.get_problem_data(cp.OSQP)[0]).data()
+    for got, want in zip(assigned, expected):
+        got = got.toarray() if sp.issparse(got) else got
+        want = want.toarray() if sp.issparse(want) else want
+        np.testing.assert_allclose(got, want, atol=1e-12)
+    with pytest.raises(SolverError, match="cannot assign"):
+        pmap.assign(params[0], np.zeros(3))

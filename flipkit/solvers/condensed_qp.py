@@ -156,11 +156,16 @@ class CondensedQP:
         I = self.ineq_rows
         G = np.asarray(JI @ T)
         base = c[I] + JI @ d_p
-        self.g.value = T.T @ (grad + hess * d_p)
-        self.G_lo.value, self.b_lo.value = G[self.lo_sel], (lo_s[I] - base)[self.lo_sel]
-        self.G_hi.value, self.b_hi.value = G[self.hi_sel], (hi_s[I] - base)[self.hi_sel]
-        self.T.value = T
-        self.box_lo.value, self.box_hi.value = d_lo - d_p, np.maximum(d_hi, d_lo) - d_p
+        values = {self.g: T.T @ (grad + hess * d_p), self.T: T,
+                  self.G_lo: G[self.lo_sel], self.b_lo: (lo_s[I] - base)[self.lo_sel],
+                  self.G_hi: G[self.hi_sel], self.b_hi: (hi_s[I] - base)[self.hi_sel],
+                  self.box_lo: d_lo - d_p, self.box_hi: np.maximum(d_hi, d_lo) - d_p}
+        compiled = getattr(self, "_driver", None)  # the first values go through cvxpy, which
+        for prm, value in values.items():  # compiles with them; later ones to the map
+            if compiled is None:
+                prm.value = value
+            else:
+                compiled.assign(prm, value)
 
     def solve(self, eps: float | None = None, max_iter: int | None = None) -> QPSolution:
         """Solve with OSQP and map back: the full-space step d and row multipliers y (m,), in

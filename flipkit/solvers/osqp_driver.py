@@ -113,6 +113,14 @@ class OSQPDriver:
             self._fixed_pattern()
         self.reset()
 
+    def assign(self, prm: cp.Parameter, value) -> None:
+        """Set a parameter's value: straight into the parameter map when there is one
+        (:meth:`~flipkit.solvers.param_map.ParameterMap.assign`), else ``prm.value``."""
+        if self._map is not None:
+            self._map.assign(prm, value)
+        else:
+            prm.value = value
+
     def reset(self) -> None:
         """Forget OSQP's state and the working set: the next solve sets up afresh."""
         self._osqp, self._x, self._y, self._active = None, None, None, None
