@@ -48,15 +48,16 @@ class InterpolantLimits(Block):
     def __init__(self, layout, qd_max, qdd_max):
         super().__init__("interpolant_limits", layout)
         nq, N = layout.nq, layout.N
-        row = 0
-        for i in range(N):
-            for _ in range(3):
-                for j in range(nq):
-                    self._add(row + j, 1, [layout.iq(i)[j], layout.iq(i + 1)[j],
-                                           layout.iqd(i)[j], layout.iqd(i + 1)[j],
-                                           layout.T_index])
-                row += nq
-        self.m = row
+        # row (i, kind, j) of interval i, kind a_0 / a_1 / c, joint j: columns q_i[j], q_{i+1}[j],
+        # q̇_i[j], q̇_{i+1}[j] and T (one dense 1 × 5 sub-block per row, built at once)
+        iq = np.array([layout.iq(i) for i in range(N + 1)])  # (N+1, nq)
+        iqd = np.array([layout.iqd(i) for i in range(N + 1)])
+        cols = np.stack([iq[:-1], iq[1:], iqd[:-1], iqd[1:], np.full((N, nq), layout.T_index)],
+                        axis=-1)  # (N, nq, 5)
+        cols = np.broadcast_to(cols[:, None], (N, 3, nq, 5))
+        self.m = 3 * N * nq
+        self._rows.append(np.repeat(np.arange(self.m), 5))
+        self._cols.append(cols.reshape(-1))
         qd_max, qdd_max = np.asarray(qd_max, float), np.asarray(qdd_max, float)
         bound = np.tile(np.concatenate([qdd_max, qdd_max, qd_max]), N)
         scale = np.tile(np.concatenate([np.full(2 * nq, ACC_SCALE), np.full(nq, VEL_SCALE)]), N)
