@@ -3,7 +3,9 @@ and a working set of inequality rows.
 
 cvxpy canonicalises the (DPP) problem; this driver keeps one ``osqp.OSQP`` object per
 problem, as osqp-python recommends: values are updated on the sparsity of the first setup
-and each solve is warm-started from the previous primal–dual pair.
+and each solve is warm-started from the previous primal–dual pair. When every Parameter is
+dense, the values reach OSQP through :class:`~flipkit.solvers.param_map.ParameterMap` (cvxpy's
+own parameter map, applied as sparse products) instead of ``get_problem_data`` per solve.
 
 Working set. On the SQP subproblems OSQP's ADMM is slowed by the ~1600 inequality rows
 (variable box, task-space bounds, cone) of which ~15 are active: the same QP with only its
@@ -12,7 +14,8 @@ first solve the inequality rows handed to OSQP are those active in the previous 
 working set); the solution is then checked against *every* row, the most violated dropped
 rows are added and the solve repeated (warm-started). The returned point satisfies all rows
 and, the dropped rows being inactive with zero multipliers, solves the full QP. A subset of
-rows being infeasible proves the full QP infeasible.
+rows being infeasible proves the full QP infeasible. The working set carried from one solve
+to the next holds at most :data:`INITIAL_ROWS` rows per variable (see :func:`_capped`).
 
 Compact mode (``compact=True``, used by the condensed subproblem of
 :mod:`flipkit.solvers.condensed_qp`): OSQP is set up afresh on the working rows alone each round,
