@@ -41,7 +41,7 @@ from flipkit.solvers.param_map import ParameterMap
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 ADD_PER_ROUND = 10  # most violated dropped rows added per round
-INITIAL_SLACK = 1e-2  # first working set: inequality rows this close to a bound at d = 0,
+INITIAL_SLACK = 1e-2  # first working set: inequality rows this close to a bound at d = 0
 INITIAL_ROWS = 2  # working set carried between solves: at most this many rows per variable
 try:
     _LIBC = ctypes.CDLL(None)  # this process's C library, for fflush
@@ -225,7 +225,9 @@ class OSQPDriver:
     def solve(self, settings: dict):
         """Solve for the current parameter values; returns (OSQP result, total ADMM iterations).
 
-        The cvxpy variables and constraint duals are set as by ``problem.solve``.
+        The cvxpy variables and constraint duals are set as by ``problem.solve``; with a
+        parameter map, ``problem.value`` carries the objective's constant term of the first
+        compile, not the current one (the SQP reads the variables and duals only).
         """
         P, A, q, l, u, chain, inverse = self._data()
         if self.compact:  # OSQP takes 32-bit indices
@@ -260,7 +262,8 @@ class OSQPDriver:
             add = np.argsort(-viol)[:ADD_PER_ROUND]
             work[add[viol[add] > tol[add]]] = True
         if res.info.status_val in (1, 2) and np.all(np.isfinite(res.x)):
-            margin = np.minimum(A @ res.x - l, u - A @ res.x)
+            z = A @ res.x
+            margin = np.minimum(z - l, u - z)
             self._active = _capped(ineq & ((np.abs(res.y) > 0) | (margin <= tol)),
                                    -np.abs(res.y), margin, cap)
         if res.info.status_val in (1, 2, 3, 4):  # cvxpy raises on the other statuses
