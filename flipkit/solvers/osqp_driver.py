@@ -37,7 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from flipkit.errors import SolverError
-from flipkit.solvers.param_map import ParameterMap
+from flipkit.solvers.param_map import ParameterMap, osqp_form
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 ADD_PER_ROUND = 10  # most violated dropped rows added per round
@@ -141,10 +141,7 @@ class OSQPDriver:
         if self._map is not None:
             return (*self._map.data(), self._chain, self._inverse)
         data, chain, inverse = self._cvxpy_data()
-        A = sp.vstack([data["A"], data["F"]]).tocsc()
-        b, g = data["b"], data["G"]
-        l = np.concatenate([b, np.full(g.shape, -np.inf)])
-        return sp.triu(data["P"], format="csc"), A, data["q"], l, np.concatenate([b, g]), chain, inverse
+        return (*osqp_form(data), chain, inverse)
 
     def _fixed_pattern(self) -> None:
         """Sparsity of P and A for every parameter value: cvxpy drops explicit zeros, OSQP's

@@ -25,6 +25,14 @@ import scipy.sparse as sp
 from flipkit.errors import SolverError
 
 
+def osqp_form(data: dict):
+    """(P upper triangle, A, q, l, u) for OSQP from cvxpy's QP data (``A x = b``, ``F x ≤ g``)."""
+    A = sp.vstack([data["A"], data["F"]]).tocsc()
+    b, g = data["b"], data["G"]
+    l = np.concatenate([b, np.full(g.shape, -np.inf)])
+    return sp.triu(data["P"], format="csc"), A, data["q"], l, np.concatenate([b, g])
+
+
 class ParameterMap:
     """OSQP's data (P, q, A, l, u) of a compiled DPP problem as sparse products of its parameters.
 
@@ -125,14 +133,11 @@ class ParameterMap:
         try:
             for prm, _ in self._columns:
                 prm.value = rng.uniform(0.5, 1.5, prm.shape) if prm.shape else 1.0
-            ref, _, _ = self.problem.get_problem_data(cp.OSQP)
             P, A, q, l, u = self.data()
-            A_ref = sp.vstack([ref["A"], ref["F"]])
-            l_ref = np.concatenate([ref["b"], np.full(ref["G"].shape, -np.inf)])
-            u_ref = np.concatenate([ref["b"], ref["G"]])
+            P_ref, A_ref, q_ref, l_ref, u_ref = osqp_form(self.problem.get_problem_data(cp.OSQP)[0])
             fin = np.isfinite(l_ref)
-            gaps = (abs(P - sp.triu(ref["P"])).max(), abs(A - A_ref).max(),
-                    np.abs(q - ref["q"]).max(), np.abs(l[fin] - l_ref[fin]).max(initial=0),
+            gaps = (abs(P - P_ref).max(), abs(A - A_ref).max(),
+                    np.abs(q - q_ref).max(), np.abs(l[fin] - l_ref[fin]).max(initial=0),
                     np.abs(u - u_ref).max(initial=0), float(np.any(np.isfinite(l) != fin)))
         finally:
             for prm, val in saved.items():
