@@ -168,13 +168,17 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         mu = min(10.0 * mu, o.prox_range[1])
     if sol.status == "optimal":
         return sol, qp, mu, attempt + 1, admm
-    if wide is not None and "infeasible" in sol.status:
-        # Infeasible within a shrunken trust box: the hard QP in the largest box Δ_max ∩ the
-        # variable bounds (the line search then shortens the step). Measured on Table I flips
-        # from the atlas: each of the four such QPs was feasible there and solved in 60–110
-        # ADMM iterations, where the elastic QP took 0.2–0.7 s. (In the variable bounds alone,
-        # without Δ_max, cold flips took steps into regions where they were declared
-        # infeasible: measured at Table I location 2.)
+    if wide is not None:
+        # Infeasible within a shrunken trust box, or no verdict from OSQP in its three tries
+        # (ADMM detects infeasibility slowly, and how slowly depends on the null-space basis:
+        # measured on the reference translate in a 1e-5 box, infeasible after 1 320 ADMM
+        # iterations with a QR basis, no verdict after 2 000 + 10 000 + 10 000 with an LU
+        # basis). Then the hard QP in the largest box Δ_max ∩ the variable bounds (the line
+        # search then shortens the step). Measured on Table I flips from the atlas: each of
+        # the four such QPs was feasible there and solved in 60–110 ADMM iterations, where
+        # the elastic QP took 0.2–0.7 s. (In the variable bounds alone, without Δ_max, cold
+        # flips took steps into regions where they were declared infeasible: measured at
+        # Table I location 2.)
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide)
         qp.cold()
         sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[-1])
