@@ -72,9 +72,10 @@ def test_stale_or_broken_atlas_is_refused(entry, tmp_path):
 def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
     from flipkit.behaviors.segments import Models, build_segment
 
-    class _NLP:  # the layout and structure key guess() reads
+    class _NLP:  # the layout, bounds and structure key guess() reads
         def __init__(self, nlp):
             self.layout, self.structure_key = nlp.layout, entry["structure"]["flip"]
+            self.x_lb, self.x_ub = nlp.x_lb, nlp.x_ub
 
     models = Models(CellConfig())
     p = tg.pickup_end(CellConfig(), LOC)
@@ -88,6 +89,11 @@ def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
     mid = atlas.guess("flip", (0.71, -0.10), nlp)  # 1 cm from a, 3 cm from b; c left out
     w = np.array([1 / 0.01**2, 1 / 0.03**2])
     np.testing.assert_allclose(mid, (w[0] * x[0] + w[1] * x[1]) / w.sum(), rtol=1e-12)
+    # an entry solved with its duration bound stretched (T beyond this NLP's bound) seeds
+    # nothing, not even at its own location: b alone is left
+    L = nlp.layout
+    atlas.solutions["flip"][0, L.T_index] = 1.5 * nlp.x_ub[L.T_index]
+    np.testing.assert_allclose(atlas.guess("flip", a, nlp), atlas.solutions["flip"][1], rtol=1e-12)
 
 
 def test_warm_started_plan_is_solved_and_verified(entry):

@@ -4,8 +4,9 @@ An atlas holds, for each grid location where the chain was solved, every segment
 vector Z (go to burger … turn back). :meth:`Atlas.guess` returns the initial guess of a
 segment at a new location: the inverse-distance-weighted mean (weights 1/d²) of the
 entries among the ``K_NEAREST`` nearest whose joint angles lie within ``BRANCH_TOL`` of
-the nearest entry's (entries on another IK branch or wrist turn are left out); an entry at
-the location itself is returned as it is. The guess only seeds the solver: the start state
+the nearest entry's (entries on another IK branch or wrist turn are left out, and so are
+entries whose duration lies outside the NLP's bounds: solved with the bound stretched); an
+entry at the location itself is returned as it is. The guess only seeds the solver: the start state
 is fixed by the segment's own rows, and the plan is checked like every plan, so an atlas
 can make a solve faster or slower, never a plan wrong.
 
@@ -159,7 +160,16 @@ class Atlas:
                              "atlas was built; rebuild it with `flipkit atlas build`")
         X = self.solutions[name]
         d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
+        # An entry whose duration lies outside this NLP's bounds was solved with the bound
+        # stretched (the planner's retry, ×1.5): clipped to the bound it violates every
+        # defect row, so it seeds nothing. Measured (session 11): two of the 35 scoops of the
+        # package's atlas (T = 0.9 s, bound 0.6 s) had the scoop declared infeasible after 9
+        # iterations, then solved cold, at their own grid locations.
+        i = nlp.layout.T_index
+        inside = (X[:, i] >= nlp.x_lb[i] - 1e-6) & (X[:, i] <= nlp.x_ub[i] + 1e-6)
+        d = np.where(inside, d, np.inf) if inside.any() else d
         near = np.argsort(d, kind="stable")[:K_NEAREST]
+        near = near[np.isfinite(d[near])]
         if d[near[0]] < 1e-9:
             x = X[near[0]].copy()
         else:
