@@ -127,8 +127,25 @@ def _bounding_sphere(geometry) -> tuple[np.ndarray, float]:
     return np.array(geometry.aabb_center), float(geometry.aabb_radius)
 
 
+_MESHES: dict = {}  # (URDF, joint names) -> the loaded shapes; their geometries are read-only
+
+
 def _mesh_shapes(robot: Robot) -> list[Shape]:
-    """The URDF's collision geometries on moving joints; meshes as their convex hulls."""
+    """The URDF's collision geometries on moving joints; meshes as their convex hulls.
+
+    Loaded once per process and URDF (loading the meshes and building their hulls takes
+    ~40 ms, measured, and every plan's verification builds its own geometry); each call
+    returns its own :class:`Shape` records around the shared, never modified, coal geometries.
+    """
+    key = (str(robot.urdf), tuple(robot.model.names))
+    if key not in _MESHES:
+        _MESHES[key] = _load_mesh_shapes(robot)
+    return [Shape(s.name, s.joint, s.placement.copy(), s.geometry, s.center.copy(), s.radius)
+            for s in _MESHES[key]]
+
+
+def _load_mesh_shapes(robot: Robot) -> list[Shape]:
+    """:func:`_mesh_shapes` without the cache."""
     import coal
 
     dirs = [str(robots_dir().parent.parent)] if robots_dir() is not None else []
