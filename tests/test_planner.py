@@ -223,3 +223,16 @@ def test_a_warm_start_found_infeasible_tries_the_stretched_bound_before_the_cold
     calls, _, _ = run(Status.MAX_ITER, True)
     assert calls == [("bound", "sqp", "warm"), ("bound", "auto", "cold"),
                      ("stretched", "auto", "cold")]
+
+
+def test_bench_flip_reports_wall_cpu_and_iterations(capsys):
+    """`bench flip` on one location: the row carries the plan's wall and CPU time and the
+    solver's iterations, and the printed table has the CPU column."""
+    from flipkit.experiments.bench import bench_flip
+
+    out = bench_flip(CellConfig(), 1, 0, atlas=None, ipopt=False)
+    row = out["rows"][0]["sqp"]
+    assert row["status"] == "solved" and row["iterations"] > 0
+    assert 0 < row["cpu_s"] and 0 < row["solve_s"] <= row["wall_s"]
+    assert out["median"]["sqp"]["cpu_s"] == row["cpu_s"]
+    assert "cpu s" in capsys.readouterr().out

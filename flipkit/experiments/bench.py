@@ -204,6 +204,15 @@ def _flip_row(plan) -> dict:
             "T_s": sum(s.T for s in segs), "segments": len(segs)}
 
 
+def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
+    """:func:`_flip_row` of ``plan_flip(location)``, with ``cpu_s`` the process CPU time (s) of
+    the call: on a shared virtual machine the wall time of identical solves (same iterations,
+    same plans) varied by up to 30 % from one minute to the next (measured, session 11)."""
+    t0 = time.process_time()
+    plan = plan_flip(location, cell=cell, **kw)
+    return {**_flip_row(plan), "cpu_s": time.process_time() - t0}
+
+
 def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
                ipopt: bool = True) -> dict:
     """Full pickup-and-flip at the first ``n_locations`` Table I locations with the SQP from
@@ -227,12 +236,11 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     if atlas is not None:
         print(f"atlas: {len(atlas)} locations on a {atlas.meta['grid'][0]} x "
               f"{atlas.meta['grid'][1]} grid")
-    print(f"{'loc':<4}{'p^b (m)':<25}{'method':<11}{'solve s':>8}{'wall s':>8}{'it':>6}"
+    print(f"{'loc':<4}{'p^b (m)':<25}{'method':<11}{'solve s':>8}{'wall s':>8}{'cpu s':>7}{'it':>6}"
           f"{'status':>8}{'T s':>6}{'dJ vs SQP':>11} | paper budget", flush=True)
     rows = []
     for k, loc in enumerate(locs, 1):
-        r = {"location": loc, **{n: _flip_row(plan_flip(loc, cell=cell, **kw))
-                                 for n, kw in methods.items()}}
+        r = {"location": loc, **{n: _timed_flip(loc, cell, kw) for n, kw in methods.items()}}
         rows.append(r)
         where = "(" + ", ".join(f"{v:.3f}" for v in loc) + ")"
         label = f"{k:<4}{where:<25}"
@@ -241,7 +249,7 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
             both = d["status"] == s["status"] == "solved"
             d["rel_objective_diff_vs_sqp"] = ((d["objective"] - s["objective"])
                                               / abs(s["objective"]) if both else float("nan"))
-            print(f"{label}{n:<11}{d['solve_s']:8.2f}{d['wall_s']:8.2f}"
+            print(f"{label}{n:<11}{d['solve_s']:8.2f}{d['wall_s']:8.2f}{d['cpu_s']:7.2f}"
                   f"{d['iterations']:6d}{d['status']:>8}{d['T_s']:6.2f}"
                   f"{d['rel_objective_diff_vs_sqp']:11.1e} | < {PAPER_PER_TRAJECTORY_S:.0f} s",
                   flush=True)
@@ -249,16 +257,16 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
                 print(f"    {n}: {d['failure']}", flush=True)
             label = " " * 29
     med = {n: {key: _med([r[n][key] for r in rows])
-               for key in ("solve_s", "wall_s", "iterations", "T_s")} for n in methods}
+               for key in ("solve_s", "wall_s", "cpu_s", "iterations", "T_s")} for n in methods}
     for n in methods:
         worst = max((r[n]["wall_s"] for r in rows), default=float("nan"))
         med[n]["worst_wall_s"] = worst
         med[n]["solved"] = sum(r[n]["status"] == "solved" for r in rows)
         print(f"{'median':<29}{n:<11}{med[n]['solve_s']:8.2f}{med[n]['wall_s']:8.2f}"
-              f"{med[n]['iterations']:6.0f}{med[n]['solved']:>5}/{len(rows)}"
+              f"{med[n]['cpu_s']:7.2f}{med[n]['iterations']:6.0f}{med[n]['solved']:>5}/{len(rows)}"
               f"{med[n]['T_s']:6.2f}   worst wall {worst:.2f} s")
     print("solve s = solver time of the five segments, wall s = the whole plan_flip call (IK, "
-          "build, solve, verify), T = executed duration of the plan (s), dJ = (ΣJ − ΣJ_SQP)"
+          "build, solve, verify), cpu s = its process CPU time, T = executed duration of the plan (s), dJ = (ΣJ − ΣJ_SQP)"
           "/ΣJ_SQP over the five segments")
     out = {"machine": machine(), "rows": rows, "median": med}
     if n_batch:
