@@ -31,3 +31,28 @@ def test_the_guard_silences_c_but_not_python(capfd):
     out = capfd.readouterr().out
     assert MESSAGE not in out and "python output" in out
     assert np.allclose(res.x, 0.0)
+
+
+def test_the_persistent_solver_adds_every_violated_row_in_one_round(monkeypatch):
+    """min ½‖x − 3‖² s.t. x ≤ 1 (30 rows, a sparse Parameter: the persistent solver). No row is
+    near its bound at x = 0, so the first round holds none of them (only cvxpy's equality
+    rows); its optimum violates all 30, and the second round holds them all (ten per round
+    would take four rounds)."""
+    import cvxpy as cp
+
+    from flipkit.solvers import osqp_driver as D
+
+    n = 30
+    x = cp.Variable(n)
+    A = cp.Parameter((n, n), sparsity=(np.arange(n), np.arange(n)))
+    A.value_sparse = sp.coo_array((np.ones(n), (np.arange(n), np.arange(n))), shape=(n, n))
+    problem = cp.Problem(cp.Minimize(0.5 * cp.sum_squares(x - 3.0)), [A @ x <= 1.0])
+    driver = D.OSQPDriver(problem)
+    assert not driver.compact and driver._map is None
+    rounds = []
+    original = D.OSQPDriver._solve_persistent
+    monkeypatch.setattr(D.OSQPDriver, "_solve_persistent",
+                        lambda self, *a: rounds.append(a[5].sum()) or original(self, *a))
+    res, _, status, solved = D.run_osqp(driver, problem, 1e-8, None)
+    assert solved and len(rounds) == 2 and rounds[1] - rounds[0] == n
+    np.testing.assert_allclose(x.value, 1.0, atol=1e-6)
