@@ -206,8 +206,10 @@ def _flip_row(plan) -> dict:
 
 def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
     """:func:`_flip_row` of ``plan_flip(location)``, with ``cpu_s`` the process CPU time (s) of
-    the call: on a shared virtual machine the wall time of identical solves (same iterations,
-    same plans) varied by up to 30 % from one minute to the next (measured, session 11)."""
+    the call. A plan runs on one thread, so CPU ≈ wall on an idle machine, and wall > CPU
+    says the machine was busy. (On the project's shared virtual machine identical solves,
+    same iterations and plans, took up to 30 % longer from one minute to the next in CPU
+    time as in wall time, measured in session 11: compare runs made side by side.)"""
     t0 = time.process_time()
     plan = plan_flip(location, cell=cell, **kw)
     return {**_flip_row(plan), "cpu_s": time.process_time() - t0}
