@@ -82,6 +82,8 @@ class Robot:
         self.frame_id = model.getFrameId(SPATULA_FRAME)
         self.spatula_in_joint = in_joint
         self.nq = model.nq
+        self._minus_identity = -np.eye(self.nq)  # ∂r/∂u, shared read-only
+        self._minus_identity.setflags(write=False)
         if self.nq != len(rc.q_home):
             raise ConfigError(f"q_home has {len(rc.q_home)} entries, robot has {self.nq} joints")
         self.q_home = np.array(rc.q_home)
@@ -140,8 +142,9 @@ class Robot:
         """
         m, d = self.model, self.data
         q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
+        # also fills the joint Jacobians data.J that getFrameJacobian reads (a separate
+        # computeJointJacobians gave bit-identical states at 200 seeded ones, and cost twice)
         pin.computeForwardKinematicsDerivatives(m, d, q, qd, qdd)
-        pin.computeJointJacobians(m, d, q)
         pin.updateFramePlacements(m, d)
         J = pin.getFrameJacobian(m, d, self.frame_id, LWA)
         M = d.oMf[self.frame_id]
@@ -190,7 +193,7 @@ class Robot:
         q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
         dq, dqd, dqdd = pin.computeRNEADerivatives(self.model, self.data, q, qd, qdd)
         tau = self.data.tau.copy()
-        return tau, np.array(dq), np.array(dqd), np.array(dqdd), -np.eye(self.nq)
+        return tau, np.array(dq), np.array(dqd), np.array(dqdd), self._minus_identity
 
     def payload_json(self) -> list[dict]:
         """The payload list of the plan file."""
