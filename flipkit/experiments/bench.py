@@ -238,8 +238,8 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     if atlas is not None:
         print(f"atlas: {len(atlas)} locations on a {atlas.meta['grid'][0]} x "
               f"{atlas.meta['grid'][1]} grid")
-    print(f"{'loc':<4}{'p^b (m)':<25}{'method':<11}{'solve s':>8}{'wall s':>8}{'cpu s':>7}{'it':>6}"
-          f"{'status':>8}{'T s':>6}{'dJ vs SQP':>11} | paper budget", flush=True)
+    print(f"{'loc':<4}{'p^b (m)':<25}{'method':<11}{'solve s':>8}{'wall s':>8}{'cpu s':>7}"
+          f"{'it':>6}{'status':>8}{'T s':>6}{'dJ vs SQP':>11} | paper budget", flush=True)
     rows = []
     for k, loc in enumerate(locs, 1):
         r = {"location": loc, **{n: _timed_flip(loc, cell, kw) for n, kw in methods.items()}}
@@ -268,8 +268,8 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
               f"{med[n]['cpu_s']:7.2f}{med[n]['iterations']:6.0f}{med[n]['solved']:>5}/{len(rows)}"
               f"{med[n]['T_s']:6.2f}   worst wall {worst:.2f} s")
     print("solve s = solver time of the five segments, wall s = the whole plan_flip call (IK, "
-          "build, solve, verify), cpu s = its process CPU time, T = executed duration of the plan (s), dJ = (ΣJ − ΣJ_SQP)"
-          "/ΣJ_SQP over the five segments")
+          "build, solve, verify), cpu s = its process CPU time, T = executed duration of the "
+          "plan (s), dJ = (ΣJ − ΣJ_SQP)/ΣJ_SQP over the five segments")
     out = {"machine": machine(), "rows": rows, "median": med}
     if n_batch:
         t0 = time.perf_counter()

@@ -149,13 +149,14 @@ class CondensedQP:
         """Condense the subproblem of a linearisation (scaled units, as
         :meth:`flipkit.solvers.full_qp.QPSubproblem.update`; ``hess`` must be positive)."""
         E, JI = self._split(jac)
-        if self.basis is None:
+        fresh = self.basis is None  # chosen at this point just now: pivoting again repeats it
+        if fresh:
             self.choose_basis(jac)
         lu = self._factor(E)
-        if lu is None:  # E_B (nearly) singular here: pivot again at this point, then by QR
+        if lu is None and not fresh:  # E_B (nearly) singular here: pivot again at this point
             self.choose_basis(jac)
             lu = self._factor(E)
-        if lu is None:
+        if lu is None:  # then by the rank-revealing QR
             self.choose_basis(jac, "qr")
             lu = self._factor(E)
             if lu is None:
