@@ -114,8 +114,10 @@ def test_sqp_condensed_and_full_space_agree(segments):
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
     smooth = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)),
                            options=SegmentOptions(arm_clearance=False))
-    a = solve_sqp(smooth, options=SQPOptions(condense=True))
-    b = solve_sqp(smooth, options=SQPOptions(condense=False))
+    # converged as tightly as before session 12 (ftol 1e-4): the forms, not the stopping
+    # rule, are compared (at the default 1e-3 each stops where its own model's gain is small)
+    a = solve_sqp(smooth, options=SQPOptions(condense=True, ftol=1e-4))
+    b = solve_sqp(smooth, options=SQPOptions(condense=False, ftol=1e-4))
     assert a.success and b.success
     assert a.objective == pytest.approx(b.objective, rel=1e-4)
     assert a.max_violation <= 1e-6 and b.max_violation <= 1e-6

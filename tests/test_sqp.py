@@ -120,10 +120,14 @@ def test_no_restoration_from_a_feasible_point():
     models = Models(CellConfig())
     nlp = build_segment("go_to_burger", models, models.bare.q_home, np.zeros(6),
                         location=(0.677778, -0.17, 0.072))
-    res = solve_sqp(nlp)
-    feasible_before = [True] + [row["violation"] <= 1e-6 for row in res.log[:-1]]
-    assert not any(row["elastic"] for row, ok in zip(res.log, feasible_before) if ok)
-    assert res.objective == pytest.approx(solve_ipopt(nlp).objective, rel=1e-3)
+    best = solve_ipopt(nlp).objective
+    for ftol, rel in ((SQPOptions().ftol, 1e-2), (1e-4, 1e-3)):
+        # the default stops at a predicted gain of 1e-3 of Σu² (measured here: 2.2e-3 above
+        # IPOPT); the tighter test of session 11 reaches IPOPT's optimum within 1e-3
+        res = solve_sqp(nlp, options=SQPOptions(ftol=ftol))
+        feasible_before = [True] + [row["violation"] <= 1e-6 for row in res.log[:-1]]
+        assert not any(row["elastic"] for row, ok in zip(res.log, feasible_before) if ok)
+        assert res.objective == pytest.approx(best, rel=rel)
 
 
 def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference):
