@@ -13,7 +13,8 @@ L-BFGS IPOPT only). ``flip``: the full
 pickup-and-flip (five segments) at the first N Table I locations with the SQP from cold
 starts, the SQP warm-started from the atlas (:mod:`flipkit.planning.atlas`; the package's
 by default) and IPOPT, then
-a batch of the first K locations with the SQP, beside the paper's budgets (Sec. I: < 20 s
+a batch of the first K locations with the SQP, cold and from the atlas (``flipkit plan
+batch``'s default), one after the other and on one worker process per CPU, beside the paper's budgets (Sec. I: < 20 s
 per trajectory, 4–5 burgers within 90 s). Times are wall-clock seconds of the solver calls
 (IPOPT's include building its CasADi problem). Before timing, every NLP structure gets one
 SQP iteration, and its hard and elastic QPs are compiled, so that cvxpy's one-off
@@ -219,7 +220,8 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
                ipopt: bool = True) -> dict:
     """Full pickup-and-flip at the first ``n_locations`` Table I locations with the SQP from
     cold starts, the SQP warm-started from ``atlas`` (if given) and IPOPT (if ``ipopt``),
-    then a batch of the first ``n_batch`` with the SQP; print; return the rows."""
+    then a batch of the first ``n_batch`` with the SQP, cold and from ``atlas``; print;
+    return the rows."""
     models, locs = models_for(cell), TABLE1_LOCATIONS[:n_locations]
     q, qd, structures = models.bare.q_home, None, []
     for name in tg.SUBBEHAVIORS:  # one NLP per structure, along the initial guesses
@@ -271,35 +273,45 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
           "build, solve, verify), cpu s = its process CPU time, T = executed duration of the "
           "plan (s), dJ = (ΣJ − ΣJ_SQP)/ΣJ_SQP over the five segments")
     out = {"machine": machine(), "rows": rows, "median": med}
-    if n_batch:
-        t0 = time.perf_counter()
-        plans = plan_batch(TABLE1_LOCATIONS[:n_batch], cell=cell, solver="sqp", progress=False)
-        wall = time.perf_counter() - t0
-        batch = [_flip_row(p) for p in plans]
-        workers = os.cpu_count() or 1
-        executor = make_executor(workers=workers)
-        try:  # a warm pool, as a running cell keeps it: imports and cvxpy compiles done
-            t_warm = time.perf_counter()
-            list(executor.map(_warm_worker, range(workers)))
-            t_warm = time.perf_counter() - t_warm
-            t0 = time.perf_counter()
-            par = plan_batch(TABLE1_LOCATIONS[:n_batch], cell=cell, solver="sqp",
-                             progress=False, executor=executor)
-            wall_par = time.perf_counter() - t0
-        finally:
-            executor.shutdown()
-        same = all(np.allclose(a.segments[-1].q, b.segments[-1].q, atol=1e-4)
-                   for a, b in zip(plans, par) if len(a.segments) == len(b.segments))
-        print(f"batch of {n_batch} (Table I 1..{n_batch}, SQP): "
-              f"{sum(b['status'] == 'solved' for b in batch)}/{n_batch} solved, solve "
-              f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s one after another; "
-              f"{workers} worker processes: wall {wall_par:.1f} s "
-              f"({sum(p.status == 'solved' for p in par)}/{n_batch} solved, same plans: {same}; "
-              f"pool warm-up {t_warm:.1f} s not counted) "
-              f"(paper: {PAPER_FIVE_BURGERS_S:.0f} s for 4-5 burgers)")
-        out["batch"] = {"n": n_batch, "wall_s": wall, "plans": batch, "workers": workers,
-                        "wall_parallel_s": wall_par, "same_plans": same}
+    if n_batch:  # cold, then from the atlas (``flipkit plan batch``'s default)
+        out["batch"] = _bench_batch(cell, n_batch, None)
+        if atlas is not None:
+            out["batch_atlas"] = _bench_batch(cell, n_batch, atlas)
     return out
+
+
+def _bench_batch(cell: CellConfig, n_batch: int, atlas) -> dict:
+    """The first ``n_batch`` Table I burgers with :func:`plan_batch` (SQP, from ``atlas`` or
+    cold), one after the other and on a warm pool of one worker process per CPU; print a
+    line; return its record."""
+    kw = {"cell": cell, "solver": "sqp", "progress": False, "atlas": atlas}
+    t0 = time.perf_counter()
+    plans = plan_batch(TABLE1_LOCATIONS[:n_batch], **kw)
+    wall = time.perf_counter() - t0
+    batch = [_flip_row(p) for p in plans]
+    workers = os.cpu_count() or 1
+    executor = make_executor(workers=workers)
+    try:  # a warm pool, as a running cell keeps it: imports and cvxpy compiles done
+        t_warm = time.perf_counter()
+        list(executor.map(_warm_worker, range(workers)))
+        t_warm = time.perf_counter() - t_warm
+        t0 = time.perf_counter()
+        par = plan_batch(TABLE1_LOCATIONS[:n_batch], executor=executor, **kw)
+        wall_par = time.perf_counter() - t0
+    finally:
+        executor.shutdown()
+    same = all(np.allclose(a.segments[-1].q, b.segments[-1].q, atol=1e-4)
+               for a, b in zip(plans, par) if len(a.segments) == len(b.segments))
+    start = "cold" if atlas is None else "from the atlas"
+    print(f"batch of {n_batch} (Table I 1..{n_batch}, SQP, {start}): "
+          f"{sum(b['status'] == 'solved' for b in batch)}/{n_batch} solved, solve "
+          f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s one after another; "
+          f"{workers} worker processes: wall {wall_par:.1f} s "
+          f"({sum(p.status == 'solved' for p in par)}/{n_batch} solved, same plans: {same}; "
+          f"pool warm-up {t_warm:.1f} s not counted) "
+          f"(paper: {PAPER_FIVE_BURGERS_S:.0f} s for 4-5 burgers)", flush=True)
+    return {"n": n_batch, "atlas": atlas is not None, "wall_s": wall, "plans": batch,
+            "workers": workers, "wall_parallel_s": wall_par, "same_plans": same}
 
 
 def _warm_worker(_) -> None:
