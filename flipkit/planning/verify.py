@@ -139,6 +139,23 @@ class VerificationReport:
             res.violation, res.segment, res.node = float(v[k]), segment, node
             res.tolerance = float(np.broadcast_to(tolerance, v.shape)[k])
 
+    def add_nodes(self, group: str, segment: int, violation, tolerance, nodes=None):
+        """Record rows given node by node: ``violation`` (n, k) holds node ``nodes[r]``'s
+        rows in row r (default nodes 0..n−1); the same as :meth:`add` once per node, in order."""
+        v = np.asarray(violation, float)
+        v = v.reshape(len(v), -1)
+        if v.size == 0:
+            return
+        tol = np.broadcast_to(tolerance, v.shape)
+        ratio = v / tol
+        ratio = np.where(np.isnan(ratio), np.inf, ratio)
+        r, c = np.unravel_index(int(np.argmax(ratio)), v.shape)
+        res = self.groups[group]
+        if res.segment is None or ratio[r, c] > res.ratio:
+            res.violation, res.segment = float(v[r, c]), segment
+            res.node = int(r if nodes is None else nodes[r])
+            res.tolerance = float(tol[r, c])
+
     @property
     def ok(self) -> bool:
         """Whether every group passes."""
@@ -257,22 +274,23 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     T_lo, T_hi = T_BOUNDS[seg.name]
     add("time_grid", k, _outside(T, T_lo, T_STRETCH * T_hi), tol)
     dyn_tol = tol * robot.u_max / 10
-    for i in range(N + 1):
-        tau = robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
-        add("dynamics", k, np.abs(tau - seg.u[i]), dyn_tol, i)
-        for group, x, lo, hi, scale in (
-                ("q_limits", seg.q, robot.q_min, robot.q_max, 1.0),
-                ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
-                ("qdd_limits", seg.qdd, -robot.qdd_max, robot.qdd_max, 10.0),
-                ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
-            add(group, k, _outside(x[i], lo, hi), tol * scale, i)
+    tau = np.array([robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
+                    for i in range(N + 1)])
+    report.add_nodes("dynamics", k, np.abs(tau - seg.u), dyn_tol)
+    for group, x, lo, hi, scale in (
+            ("q_limits", seg.q, robot.q_min, robot.q_max, 1.0),
+            ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
+            ("qdd_limits", seg.qdd, -robot.qdd_max, robot.qdd_max, 10.0),
+            ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
+        report.add_nodes(group, k, _outside(np.asarray(x), lo, hi), tol * scale)
     _check_interpolant(report, k, seg, robot, tol)
-    for i in range(1, N, 2):
-        dt = seg.t[i + 1] - seg.t[i - 1]
-        for x, xd in ((seg.q, seg.qd), (seg.qd, seg.qdd)):
-            interp = x[i] - (x[i - 1] + x[i + 1]) / 2 - dt * (xd[i - 1] - xd[i + 1]) / 8
-            simpson = x[i + 1] - x[i - 1] - dt * (xd[i - 1] + 4 * xd[i] + xd[i + 1]) / 6
-            add("defects", k, np.abs(np.concatenate([interp, simpson])), tol, i)
+    mid = np.arange(1, N, 2)  # Hermite–Simpson midpoints; a = i − 1, b = i + 1
+    dt = (seg.t[mid + 1] - seg.t[mid - 1])[:, None]
+    rows = []
+    for x, xd in ((np.asarray(seg.q), np.asarray(seg.qd)), (np.asarray(seg.qd), np.asarray(seg.qdd))):
+        xa, xi, xb, da, di, db = x[mid - 1], x[mid], x[mid + 1], xd[mid - 1], xd[mid], xd[mid + 1]
+        rows += [xi - (xa + xb) / 2 - dt * (da - db) / 8, xb - xa - dt * (da + 4 * di + db) / 6]
+    report.add_nodes("defects", k, np.abs(np.concatenate(rows, axis=1)), tol, mid)
 
     states = [robot.state(seg.q[i], seg.qd[i], seg.qdd[i]) for i in range(N + 1)]
     l, w = cell.spatula.length / 2, cell.spatula.width / 2
@@ -304,16 +322,16 @@ def _check_interpolant(report, k, seg, robot, tol) -> None:
 
     c = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0).c  # (4, N, nq)
     h = np.diff(seg.t)[:, None]
+    n = np.arange(seg.N)
     for i, qdd in enumerate((2 * c[1], 6 * c[0] * h + 2 * c[1])):
-        for n in range(seg.N):  # node of the interval's start (i = 0) or end (i = 1)
-            report.add("interpolant", k, _outside(qdd[n], -robot.qdd_max, robot.qdd_max),
-                       INTERPOLANT_TOL[1] * tol, n + i)
+        # node of the interval's start (i = 0) or end (i = 1)
+        report.add_nodes("interpolant", k, _outside(qdd, -robot.qdd_max, robot.qdd_max),
+                         INTERPOLANT_TOL[1] * tol, n + i)
     with np.errstate(divide="ignore", invalid="ignore"):
         tau = np.clip(np.nan_to_num(-c[1] / (3 * c[0]), nan=0.0, posinf=0.0, neginf=0.0), 0, h)
     qd = 3 * c[0] * tau**2 + 2 * c[1] * tau + c[2]
-    for n in range(seg.N):
-        report.add("interpolant", k, _outside(qd[n], -robot.qd_max, robot.qd_max),
-                   INTERPOLANT_TOL[0] * tol, n)
+    report.add_nodes("interpolant", k, _outside(qd, -robot.qd_max, robot.qd_max),
+                     INTERPOLANT_TOL[0] * tol, n)
 
 
 def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
