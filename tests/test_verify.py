@@ -238,3 +238,28 @@ def test_cli_exit_codes(models, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("flipkit: error:") and "not a JSON file" in err and "\n" not in err
     assert main(["verify", str(tmp_path / "missing.json")]) == 2
+
+
+def test_rows_recorded_node_by_node_match_one_call_per_node():
+    """VerificationReport.add_nodes (one call for a segment's nodes) records the same worst
+    row — violation, tolerance, node — as add once per node in order, NaN and ties included."""
+    from flipkit.planning.verify import VerificationReport
+
+    rng = np.random.default_rng(3)
+    for trial in range(50):
+        v = rng.uniform(0, 1, (7, 3)) * (rng.uniform(size=(7, 3)) < 0.5)
+        if trial % 5 == 0:
+            v[rng.integers(7), rng.integers(3)] = np.nan
+        if trial % 7 == 0:
+            v[:] = 0.25  # all tied: the first node wins
+        tol = rng.uniform(0.1, 1.0, 3)
+        nodes = np.arange(7) * 2 + 1
+        a, b = VerificationReport(1e-5, ["s"]), VerificationReport(1e-5, ["s"])
+        a.add("defects", 0, [0.01], 1.0, 0)  # an earlier segment's row in both
+        b.add("defects", 0, [0.01], 1.0, 0)
+        for r in range(7):
+            a.add("defects", 1, v[r], tol, int(nodes[r]))
+        b.add_nodes("defects", 1, v, tol, nodes)
+        ga, gb = a.groups["defects"], b.groups["defects"]
+        assert (ga.segment, ga.node, ga.tolerance) == (gb.segment, gb.node, gb.tolerance)
+        assert ga.violation == gb.violation or (np.isnan(ga.violation) and np.isnan(gb.violation))
