@@ -63,9 +63,8 @@ the record, written before session 7, against today's defaults of
 
 from __future__ import annotations
 
-import json
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -76,136 +75,17 @@ from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import (SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, T_STRETCH,
                                        grill_floor)
 from flipkit.model.contact import make_cone
-from flipkit.errors import ConfigError, FlipkitError, VerificationError
+from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.verify_clearance import CellGeometry, check_space
 from flipkit.planning.verify_flight import check_flight
+# the report's types, importable from here as before
+from flipkit.planning.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
 INTERPOLANT_TOL = (100.0, 1000.0)  # × tol: the solver's row scales 0.01 (q̇) and 0.001 (q̈)
-GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
-          "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
-          "interpolant": "rad/s | rad/s²",
-          "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
-          "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
-          "flight_clearance": "m", "placing": "m", "arm_clearance": "m", "orientation": "rad",
-          "completeness": "segments"}
-
-
-@dataclass
-class GroupResult:
-    """Worst row of a check group — the largest violation relative to its tolerance — with
-    both in the group's unit, and where (segment index, node; ``None`` if no row was checked)."""
-
-    name: str
-    unit: str
-    violation: float = 0.0
-    tolerance: float = math.inf
-    segment: int | None = None
-    node: int | None = None
-
-    @property
-    def ratio(self) -> float:
-        """violation / tolerance of the worst row (≤ 1 passes; NaN counts as infinite)."""
-        ratio = self.violation / self.tolerance
-        return math.inf if math.isnan(ratio) else ratio
-
-    @property
-    def ok(self) -> bool:
-        """Whether every row of the group is within its tolerance."""
-        return self.ratio <= 1.0
-
-
-@dataclass
-class VerificationReport:
-    """Per-group results of :func:`verify_plan`; ``segments`` lists the segment names."""
-
-    tol: float
-    segments: list
-    groups: dict = field(default_factory=lambda: {g: GroupResult(g, u) for g, u in GROUPS.items()})
-
-    def add(self, group: str, segment: int, violation, tolerance, node: int | None = None):
-        """Record the rows ``violation`` (≥ 0) against ``tolerance`` (broadcast)."""
-        v = np.atleast_1d(np.asarray(violation, float))
-        if v.size == 0:
-            return
-        ratio = v / np.broadcast_to(tolerance, v.shape)
-        ratio = np.where(np.isnan(ratio), np.inf, ratio)
-        k = int(np.argmax(ratio))
-        res = self.groups[group]
-        if res.segment is None or ratio[k] > res.ratio:
-            res.violation, res.segment, res.node = float(v[k]), segment, node
-            res.tolerance = float(np.broadcast_to(tolerance, v.shape)[k])
-
-    def add_nodes(self, group: str, segment: int, violation, tolerance, nodes=None):
-        """Record rows given node by node: ``violation`` (n, k) holds node ``nodes[r]``'s
-        rows in row r (default nodes 0..n−1); the same as :meth:`add` once per node, in order."""
-        v = np.asarray(violation, float)
-        v = v.reshape(len(v), -1)
-        if v.size == 0:
-            return
-        tol = np.broadcast_to(tolerance, v.shape)
-        ratio = v / tol
-        ratio = np.where(np.isnan(ratio), np.inf, ratio)
-        r, c = np.unravel_index(int(np.argmax(ratio)), v.shape)
-        res = self.groups[group]
-        if res.segment is None or ratio[r, c] > res.ratio:
-            res.violation, res.segment = float(v[r, c]), segment
-            res.node = int(r if nodes is None else nodes[r])
-            res.tolerance = float(tol[r, c])
-
-    @property
-    def ok(self) -> bool:
-        """Whether every group passes."""
-        return all(g.ok for g in self.groups.values())
-
-    def worst(self) -> tuple[str, int | None, float]:
-        """(group, segment index, violation) of the group with the largest violation/tolerance."""
-        g = max(self.groups.values(), key=lambda r: r.ratio)
-        return g.name, g.segment, g.violation
-
-    def summary(self) -> str:
-        """One line: pass, or the worst group, where, and by how much."""
-        if self.ok:
-            return f"plan verified: {len(self.groups)} check groups pass"
-        name, k, amount = self.worst()
-        g = self.groups[name]
-        at = f" at node {g.node}" if g.node is not None else ""
-        return (f"plan fails {name!r} in segment {k} ({self.segments[k]}){at}: violation "
-                f"{amount:.3g} {g.unit} > tolerance {g.tolerance:.3g}")
-
-    def table(self) -> str:
-        """The groups as a text table: unit, max violation, tolerance, where, ok/FAIL."""
-        rows = [f"{'group':<16}{'unit':<16}{'max violation':>14}{'tolerance':>11}  "
-                f"{'segment':<16}status"]
-        for g in self.groups.values():
-            where = "-" if g.segment is None else f"{g.segment}:{self.segments[g.segment]}"
-            tol = "-" if math.isinf(g.tolerance) else f"{g.tolerance:.2e}"
-            rows.append(f"{g.name:<16}{g.unit:<16}{g.violation:>14.3e}{tol:>11}  "
-                        f"{where:<16}{'ok' if g.ok else 'FAIL'}")
-        return "\n".join(rows)
-
-    def to_json(self) -> dict:
-        """The report as JSON values (non-finite numbers as null)."""
-        finite = lambda x: x if math.isfinite(x) else None  # noqa: E731
-        return {"ok": self.ok, "tol": self.tol, "segments": self.segments, "groups": [
-            {"name": g.name, "unit": g.unit, "max_violation": finite(g.violation),
-             "tolerance": finite(g.tolerance),
-             "segment": g.segment, "node": g.node, "ok": g.ok} for g in self.groups.values()]}
-
-    def write_json(self, path) -> None:
-        """Write :meth:`to_json` to ``path``."""
-        with open(path, "w") as fh:
-            json.dump(self.to_json(), fh, indent=1)
-
-    def raise_if_failed(self) -> None:
-        """Raise :class:`VerificationError` with :meth:`summary` when the plan fails."""
-        if not self.ok:
-            raise VerificationError(self.summary())
-
-
 def _outside(x, lo, hi) -> np.ndarray:
     """Distance of x outside the box [lo, hi] (0 inside)."""
     return np.maximum(np.maximum(np.asarray(lo) - x, x - np.asarray(hi)), 0.0)
