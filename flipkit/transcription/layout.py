@@ -38,6 +38,7 @@ class Layout:
         self.T_index = self.alpha_start + self.n_alpha
         self.n = self.T_index + 1
         self.s = np.linspace(0.0, 1.0, self.n_nodes)  # node times t_i = s_i T
+        self.key = (nq, N, degree)  # what every index of the layout depends on
 
     def _field(self, i: int, k: int) -> np.ndarray:
         start = i * self.node_size + k * self.nq

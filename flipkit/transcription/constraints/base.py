@@ -7,6 +7,8 @@ import numpy as np
 from flipkit.transcription.layout import Evaluation, Layout
 from flipkit.errors import ConfigError
 
+_PATTERNS: dict = {}  # Block._pattern's cache: (block type, key) -> (rows, cols), read-only
+
 
 class Block:
     """A group of constraints lo ≤ c(Z) ≤ hi with a fixed Jacobian sparsity pattern.
@@ -25,6 +27,22 @@ class Block:
         self._rows: list[np.ndarray] = []
         self._cols: list[np.ndarray] = []
         self.m = 0
+
+    def _pattern(self, key: tuple, fill) -> None:
+        """Fill the pattern by ``fill()`` (calls of :meth:`_add`) once per process for each
+        ``key`` — everything the pattern depends on — and reuse it (read-only) for later blocks
+        with the same key: a chain builds the same patterns for every burger (measured, session
+        12: 40 % of a segment's 13 ms build went to filling them)."""
+        key = (type(self).__name__, *key)
+        if key not in _PATTERNS:
+            fill()
+            rows, cols = (np.concatenate(a) if a else np.zeros(0, int)
+                          for a in (self._rows, self._cols))
+            rows.setflags(write=False)
+            cols.setflags(write=False)
+            _PATTERNS[key] = rows, cols
+        rows, cols = _PATTERNS[key]
+        self._rows, self._cols = [rows], [cols]
 
     def _add(self, row0: int, nrows: int, cols) -> None:
         """Append a dense nrows × len(cols) sub-block at local rows row0.. (row-major values)."""

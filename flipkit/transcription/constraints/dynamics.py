@@ -18,9 +18,13 @@ class Dynamics(Block):
     def __init__(self, layout, torque_scale):
         super().__init__("dynamics", layout)
         nq = layout.nq
-        for i in range(layout.n_nodes):
-            cols = np.concatenate([layout.iq(i), layout.iqd(i), layout.iqdd(i), layout.iu(i)])
-            self._add(i * nq, nq, cols)
+
+        def fill():
+            for i in range(layout.n_nodes):
+                cols = np.concatenate([layout.iq(i), layout.iqd(i), layout.iqdd(i), layout.iu(i)])
+                self._add(i * nq, nq, cols)
+
+        self._pattern(layout.key, fill)
         self.m = nq * layout.n_nodes
         self._finish(0.0, 0.0, np.tile(1.0 / np.asarray(torque_scale), layout.n_nodes))
 
@@ -62,19 +66,23 @@ class HermiteSimpson(Block):
 
     def __init__(self, layout, qd_scale: float = 1.0):
         super().__init__("hermite_simpson", layout)
-        nq, row = layout.nq, 0
-        self.terms = []  # per 6-row group: (list of (cols_fn, coefficient kind)), T
-        for i in range(1, layout.N, 2):
-            for xf, dxf in ((layout.iq, layout.iqd), (layout.iqd, layout.iqdd)):
-                a, b = i - 1, i + 1
-                for cols in ((xf(i), xf(a), xf(b), dxf(a), dxf(b)),  # δ
-                             (xf(b), xf(a), dxf(a), dxf(i), dxf(b))):  # σ
-                    for c in cols:
-                        self._rows.append(np.arange(row, row + nq))
-                        self._cols.append(c)
-                    self._add(row, nq, [layout.T_index])
-                    row += nq
-        self.m = row
+        nq = layout.nq
+
+        def fill():
+            row = 0
+            for i in range(1, layout.N, 2):
+                for xf, dxf in ((layout.iq, layout.iqd), (layout.iqd, layout.iqdd)):
+                    a, b = i - 1, i + 1
+                    for cols in ((xf(i), xf(a), xf(b), dxf(a), dxf(b)),  # δ
+                                 (xf(b), xf(a), dxf(a), dxf(i), dxf(b))):  # σ
+                        for c in cols:
+                            self._rows.append(np.arange(row, row + nq))
+                            self._cols.append(c)
+                        self._add(row, nq, [layout.T_index])
+                        row += nq
+
+        self._pattern(layout.key, fill)
+        self.m = 4 * nq * (layout.N // 2)
         group = np.concatenate([np.ones(2 * nq), np.full(2 * nq, qd_scale)])
         self._finish(0.0, 0.0, np.tile(group, layout.N // 2))
 
@@ -110,18 +118,22 @@ class BezierOutput(Block):
         self.eps = float(epsilon)
         nq, b = layout.nq, layout.bezier
         self.B = [b.basis(layout.s, r) for r in range(3)]  # (N+1, M+1) each
-        row = 0
-        for i in range(layout.n_nodes):
-            for f in (layout.iq, layout.iqd, layout.iqdd):
-                self._rows.append(np.arange(row, row + nq))
-                self._cols.append(f(i))
-            for j in range(nq):
-                self._add(row + j, 1, np.append(layout.ialpha(j), layout.T_index))
-            row += nq
-        for j in range(nq):  # y(0) = q_0 − α_j0
-            self._add(row + j, 1, [layout.iq(0)[j], layout.ialpha(j)[0]])
-        for j in range(nq):  # ẏ(0) = q̇_0 − M(α_j1 − α_j0)/T
-            self._add(row + nq + j, 1, [layout.iqd(0)[j], *layout.ialpha(j)[:2], layout.T_index])
+        row = nq * layout.n_nodes
+
+        def fill():
+            for i in range(layout.n_nodes):
+                for f in (layout.iq, layout.iqd, layout.iqdd):
+                    self._rows.append(np.arange(i * nq, (i + 1) * nq))
+                    self._cols.append(f(i))
+                for j in range(nq):
+                    self._add(i * nq + j, 1, np.append(layout.ialpha(j), layout.T_index))
+            for j in range(nq):  # y(0) = q_0 − α_j0
+                self._add(row + j, 1, [layout.iq(0)[j], layout.ialpha(j)[0]])
+            for j in range(nq):  # ẏ(0) = q̇_0 − M(α_j1 − α_j0)/T
+                self._add(row + nq + j, 1, [layout.iqd(0)[j], *layout.ialpha(j)[:2],
+                                            layout.T_index])
+
+        self._pattern(layout.key, fill)
         self.m = row + 2 * nq
         scale = np.concatenate([np.full(row, 1 / self.eps**2), np.ones(nq), np.full(nq, 0.1)])
         self._finish(0.0, 0.0, scale)

@@ -143,8 +143,12 @@ class KinematicBlock(Block):
         self.quantity, self.nodes, self.ctx = quantity, [int(i) for i in nodes], ctx or {}
         k = quantity.size
         fields = (layout.iq, layout.iqd, layout.iqdd)[: quantity.order + 1]
-        for r, i in enumerate(self.nodes):
-            self._add(r * k, k, np.concatenate([f(i) for f in fields]))
+
+        def fill():
+            for r, i in enumerate(self.nodes):
+                self._add(r * k, k, np.concatenate([f(i) for f in fields]))
+
+        self._pattern((*layout.key, k, quantity.order, *self.nodes), fill)
         self.m = k * len(self.nodes)
         shape = (len(self.nodes), k)
         self._finish(np.broadcast_to(lo, shape).ravel(), np.broadcast_to(hi, shape).ravel(),
