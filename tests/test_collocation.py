@@ -142,3 +142,28 @@ def test_branch_bounds_keep_the_elbow_and_wrist_on_the_home_side():
     np.testing.assert_array_equal(branch_bounds(q_min, q_max, home, home, 0.0)[0], q_min)
     with pytest.raises(ConfigError, match="singularity margin"):
         branch_bounds(q_min, q_max, home, home, 2.0)
+
+
+def test_cached_patterns_equal_freshly_filled_ones_and_are_read_only(models):
+    """Block._pattern fills a Jacobian pattern once per key and process: a segment built with
+    the cache emptied and one built from it have the same pattern, and the shared arrays
+    cannot be written through."""
+    from flipkit.transcription.constraints import base
+    from flipkit.transcription.constraints.kinematic import KinematicBlock
+
+    q0 = models.bare.q_home
+    base._PATTERNS.clear()
+    fresh = build_segment("go_to_burger", models, q0, location=TABLE1_LOCATIONS[0])
+    cached = build_segment("go_to_burger", models, q0, location=TABLE1_LOCATIONS[3])
+    assert len(base._PATTERNS) > 0
+    np.testing.assert_array_equal(fresh.jac_rows, cached.jac_rows)
+    np.testing.assert_array_equal(fresh.jac_cols, cached.jac_cols)
+    rows, _ = next(iter(base._PATTERNS.values()))
+    with pytest.raises(ValueError):
+        rows[0] = 1
+    # the key tells blocks apart: other nodes, another pattern
+    L = Layout()
+    a = KinematicBlock("a", L, "position", [0, 1], -1.0, 1.0)
+    b = KinematicBlock("b", L, "position", [2, 3], -1.0, 1.0)
+    assert not np.array_equal(a.cols, b.cols)
+    np.testing.assert_array_equal(b.cols.reshape(2, 3, 6)[:, 0], [L.iq(2), L.iq(3)])
