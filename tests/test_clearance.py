@@ -301,3 +301,22 @@ def min_clearances_in(plan, space):
     cell = replace(plan.cell(), space=space)
     geometry = CellGeometry(plan.robot_for(plan.segments[0], cell), cell)
     return min(geometry.distances(q)[:, -1].min() for seg in plan.segments for q in seg.q[1:])
+
+
+def test_nearest_at_many_configurations_is_nearest_at_each(shapes, models):
+    """ArmShapes.nearest_nodes (the NLP block's batched broad phase) gives what nearest gives
+    configuration by configuration: distance, gradient and nearest pair, under random pair
+    masks and caps (a cap below every distance: the cap, −1 and a zero gradient)."""
+    rng = np.random.default_rng(7)
+    qs = np.array(_random_configurations(models.bare, 11, 12))
+    S, B = len(shapes.names), len(shapes.box_names)
+    for cap in (CAP, 0.05, 1e-6):
+        allowed = rng.uniform(size=(len(qs), S, B)) < 0.7
+        allowed[0] = True
+        d, g, k, b = shapes.nearest_nodes(qs, allowed, cap)
+        for i, q in enumerate(qs):
+            pairs = np.argwhere(allowed[i])
+            d1, g1, k1, b1 = shapes.nearest(q, pairs, cap)
+            assert d[i] == pytest.approx(d1, abs=1e-12) and (k[i], b[i]) == (k1, b1)
+            np.testing.assert_allclose(g[i], g1, atol=1e-10)
+    assert np.all(k == -1) and np.all(d == 1e-6) and not g.any()  # cap 1e-6: every pair beyond

@@ -204,6 +204,11 @@ class ArmShapes:
         self._hi = np.array([b.upper for b in self.boxes], float)
         self._box_geoms = [(coal.Box(*b.size), coal.Transform3s(np.eye(3), np.array(b.center)),
                             np.array(b.lower), np.array(b.upper)) for b in self.boxes]
+        # each shape in its joint's frame, for :meth:`nearest_nodes`' array arithmetic
+        self._joint_of = np.array([self._joints.index(s.joint) for s in shapes])
+        self._R_in_joint = np.array([s.placement.rotation for s in shapes])
+        self._p_in_joint = np.array([s.placement.translation for s in shapes])
+        self._c_in_joint = np.array([s.placement.act(s.center) for s in shapes])
 
     def _tool_in_spatula(self) -> np.ndarray:
         """Placement of the tool flange in the spatula frame (inverse of the spatula's mount)."""
@@ -231,12 +236,15 @@ class ArmShapes:
     def _query(self, k: int, M: pin.SE3, b: int, req, res):
         """coal distance of shape k at world placement M to box b: (d, witness on the shape,
         unit normal from the shape to the box)."""
+        return self._query_at(k, M.rotation, M.translation, b, req, res)
+
+    def _query_at(self, k: int, R: np.ndarray, p: np.ndarray, b: int, req, res):
+        """:meth:`_query` with the placement given as rotation R and translation p."""
         import coal
 
         geom, tf, _, _ = self._box_geoms[b]
         res.clear()
-        d = coal.distance(self.shapes[k].geometry, coal.Transform3s(M.rotation, M.translation),
-                          geom, tf, req, res)
+        d = coal.distance(self.shapes[k].geometry, coal.Transform3s(R, p), geom, tf, req, res)
         return float(d), np.array(res.getNearestPoint1()), np.array(res.normal)
 
     def nearest(self, q, pairs, cap: float = np.inf) -> tuple[float, np.ndarray, int, int]:
@@ -264,6 +272,59 @@ class ArmShapes:
         dist, p1, n, k, b = best
         grad = np.zeros(self.robot.nq) if k < 0 else self._gradient(k, p1, n)
         return dist, grad, k, b
+
+    def nearest_nodes(self, qs, allowed, cap: float = np.inf):
+        """:meth:`nearest` at n configurations at once, the broad phase of all of them in one
+        array operation (per node, :meth:`nearest` spends more time in NumPy calls on a few
+        dozen pairs than in coal: measured 88 µs a node, 24 µs of them in coal's queries).
+
+        Args:
+            qs: (n, nq) configurations (rad).
+            allowed: (n, shapes, boxes) booleans: the pairs applied at each configuration.
+            cap: Distances beyond it read as ``cap`` (m), with a zero gradient.
+
+        Returns:
+            (d (n,), ∂d/∂q (n, nq), nearest shape (n,), nearest box (n,)), as :meth:`nearest`
+            at each configuration (indices −1 where every pair lies beyond ``cap``).
+        """
+        import coal
+
+        m, data = self.robot.model, self.robot.data
+        qs = np.asarray(qs, float)
+        n, nb = len(qs), len(self.boxes)
+        H = np.empty((n, len(self._joints), 4, 4))
+        for i, q in enumerate(qs):
+            pin.forwardKinematics(m, data, q)
+            for jj, j in enumerate(self._joints):
+                H[i, jj] = data.oMi[j].homogeneous
+        Hs = H[:, self._joint_of]  # (n, shapes, 4, 4): each shape's joint placement
+        Rj, pj = Hs[..., :3, :3], Hs[..., :3, 3]
+        Rw = np.einsum("nsij,sjk->nsik", Rj, self._R_in_joint)  # the shapes' world placements
+        pw = np.einsum("nsij,sj->nsi", Rj, self._p_in_joint) + pj
+        c = np.einsum("nsij,sj->nsi", Rj, self._c_in_joint) + pj
+        out = np.maximum(np.maximum(self._lo - c[:, :, None], c[:, :, None] - self._hi), 0.0)
+        bound = np.sqrt((out**2).sum(-1)) - self._radii[:, None]
+        bound = np.where(allowed, bound, np.inf).reshape(n, -1)
+        dist, grad = np.full(n, float(cap)), np.zeros((n, self.robot.nq))
+        shape, box = np.full(n, -1), np.full(n, -1)
+        req, res = distance_request(), coal.DistanceResult()
+        for i in range(n):
+            best = (float(cap), None, None)
+            for j in np.argsort(bound[i], kind="stable"):
+                if bound[i, j] >= best[0]:
+                    break
+                k, b = divmod(int(j), nb)
+                d, p1, normal = self._query_at(k, Rw[i, k], pw[i, k], b, req, res)
+                if d < best[0]:
+                    best, shape[i], box[i] = (d, p1, normal), k, b
+            dist[i] = best[0]
+            if shape[i] >= 0:
+                joint = self.shapes[shape[i]].joint
+                J = pin.computeJointJacobian(m, data, qs[i], joint)  # joint frame
+                R = H[i, self._joints.index(joint), :3, :3]
+                r = best[1] - H[i, self._joints.index(joint), :3, 3]
+                grad[i] = -(best[2] @ (R @ J[:3] - skew(r) @ (R @ J[3:])))
+        return dist, grad, shape, box
 
     def _gradient(self, k: int, p1: np.ndarray, n: np.ndarray) -> np.ndarray:
         """∂d/∂q = −nᵀ (J_v − [r]× J_ω) of shape k's witness point p1 (after :meth:`_place`)."""

@@ -56,6 +56,9 @@ class ArmClearance(Block):
         self.nodes = [self.nodes[r] for r in kept]
         self.pairs = [self.pairs[r] for r in kept]
         margin = margin[kept]
+        self.allowed = np.zeros((len(self.nodes), len(shapes.names), len(shapes.box_names)), bool)
+        for r, pairs in enumerate(self.pairs):
+            self.allowed[r, pairs[:, 0], pairs[:, 1]] = True
         for r, i in enumerate(self.nodes):
             self._add(r, 1, layout.iq(i))
         self.m = len(self.nodes)
@@ -63,11 +66,12 @@ class ArmClearance(Block):
         self._finish(margin, np.inf, 1.0)
 
     def evaluate(self, ev):
-        vals, jac = np.empty(self.m), []
-        for r, (i, pairs) in enumerate(zip(self.nodes, self.pairs)):
-            vals[r], grad, *self.nearest[r] = self.shapes.nearest(ev.node(i)[0], pairs, CAP)
-            jac.append(grad)
-        return vals, (np.concatenate(jac) if jac else np.zeros(0))
+        if not self.m:
+            return np.zeros(0), np.zeros(0)
+        qs = self.layout.nodes(ev.x)[self.nodes, 0]
+        vals, grad, self.nearest[:, 0], self.nearest[:, 1] = self.shapes.nearest_nodes(
+            qs, self.allowed, CAP)
+        return vals, grad.ravel()
 
 
 class CoastingClearance(Block):
