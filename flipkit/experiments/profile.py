@@ -1,9 +1,10 @@
 """Where an SQP iteration's milliseconds go, on a flip segment (issue 15's baseline).
 
-    python -m flipkit.experiments.profile [--location K] [--out FILE]
+    python -m flipkit.experiments.profile [--location K] [--atlas] [--out FILE]
 
-Plans pickup-and-flip at Table I location K (default 7, (0.73, −0.13)) once to warm up
-(cvxpy compiles each subproblem once per process), then again under :mod:`cProfile`, and
+Plans pickup-and-flip at Table I location K (default 7, (0.73, −0.13)) — from cold starts, or
+warm-started from the package's atlas (``--atlas``, as ``flipkit plan flip`` plans) — once to
+warm up (cvxpy compiles each subproblem once per process), then again under :mod:`cProfile`, and
 reports the flip segment's SQP time split into disjoint parts, in ms per SQP iteration:
 
 * ``evaluate``: constraint values and Jacobians of every block (NLP.evaluate), trial points
@@ -49,18 +50,18 @@ def _cumulative(stats: pstats.Stats, where: tuple) -> float:
     return total
 
 
-def profile_flip(location, segment: str = "flip") -> dict:
-    """Profile the SQP of one segment of ``plan_flip(location)``.
+def profile_flip(location, segment: str = "flip", atlas=None) -> dict:
+    """Profile the SQP of one segment of ``plan_flip(location, atlas=atlas)``.
 
     Returns:
-        ``{"location", "segment", "iterations", "sqp_s", "parts_ms_per_iteration": {part:
-        ms}, "solve_s_unprofiled"}``; ``parts`` sum to the SQP's time per iteration.
+        ``{"location", "segment", "atlas", "iterations", "sqp_s", "parts_ms_per_iteration":
+        {part: ms}, "solve_s_unprofiled"}``; ``parts`` sum to the SQP's time per iteration.
     """
     from flipkit.planning import planner
     from flipkit.solvers import sqp
 
-    planner.plan_flip(location)  # warm-up: compile every subproblem structure
-    plain = planner.plan_flip(location)
+    planner.plan_flip(location, atlas=atlas)  # warm-up: compile every subproblem structure
+    plain = planner.plan_flip(location, atlas=atlas)
     plain_s = next(s.solver.wall_time_s for s in plain.segments if s.name == segment)
     profiler, calls = cProfile.Profile(), []
     original = sqp.solve_sqp
@@ -78,7 +79,7 @@ def profile_flip(location, segment: str = "flip") -> dict:
 
     sqp.solve_sqp = traced
     try:
-        planner.plan_flip(location)
+        planner.plan_flip(location, atlas=atlas)
     finally:
         sqp.solve_sqp = original
     stats = pstats.Stats(profiler)
@@ -86,7 +87,8 @@ def profile_flip(location, segment: str = "flip") -> dict:
     its = sum(r.iterations for r in calls)
     parts = {name: _cumulative(stats, where) for name, where in PARTS.items()}
     parts["other"] = total - sum(parts.values())
-    return {"location": tuple(location), "segment": segment, "iterations": its,
+    return {"location": tuple(location), "segment": segment, "atlas": atlas is not None,
+            "iterations": its,
             "sqp_s": total, "solve_s_unprofiled": plain_s,
             "parts_ms_per_iteration": {k: 1e3 * v / max(its, 1) for k, v in parts.items()}}
 
@@ -96,7 +98,8 @@ def format_profile(result: dict) -> str:
     parts = result["parts_ms_per_iteration"]
     per_it = sum(parts.values())
     lines = [machine(),
-             f"segment {result['segment']} at p^b = {result['location']}: "
+             f"segment {result['segment']} at p^b = {result['location']}"
+             f"{' from the atlas' if result.get('atlas') else ', cold'}: "
              f"{result['iterations']} SQP iterations, {result['sqp_s']:.2f} s under cProfile "
              f"({result['solve_s_unprofiled']:.2f} s without), {per_it:.1f} ms per iteration",
              f"{'part':<10}{'ms/iteration':>14}{'share':>8}"]
@@ -110,11 +113,21 @@ def main(argv=None) -> int:
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--location", type=int, default=7, metavar="K",
                         help=f"Table I location 1..{len(TABLE1_LOCATIONS)} (default 7)")
+    parser.add_argument("--atlas", action="store_true",
+                        help="warm-start the chain from the package's atlas (default: cold)")
     parser.add_argument("--out", metavar="FILE", help="also write the table to FILE")
     args = parser.parse_args(argv)
     if not 1 <= args.location <= len(TABLE1_LOCATIONS):
         parser.error(f"--location must be 1..{len(TABLE1_LOCATIONS)}")
-    text = format_profile(profile_flip(TABLE1_LOCATIONS[args.location - 1]))
+    atlas = None
+    if args.atlas:
+        from flipkit.planning.atlas import default_atlas
+
+        atlas = default_atlas()
+        if atlas is None:
+            parser.error("the package's atlas does not serve the default options; "
+                         "rebuild it with `flipkit atlas build`")
+    text = format_profile(profile_flip(TABLE1_LOCATIONS[args.location - 1], atlas=atlas))
     print(text)
     if args.out:
         with open(args.out, "w") as fh:
