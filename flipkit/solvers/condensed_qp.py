@@ -30,10 +30,10 @@ from __future__ import annotations
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from flipkit.errors import ConfigError, SingularBasisError, SolverError
+from flipkit.solvers.fixed_sparse import FixedPattern
 from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
 from flipkit.solvers.subproblem import QPSolution
 from flipkit.transcription.nlp import NLP
@@ -61,13 +61,17 @@ class CondensedQP:
         if self.r <= 0:
             raise ConfigError(f"segment {nlp.name!r}: {len(self.eq_rows)} equality rows for {n} "
                               "variables leave no null space to optimise in")
-        # Jacobian entries of the equality / inequality rows, and their row numbers there.
-        self._eq_entries = eq[nlp.jac_rows]
+        # Jacobian entries of the equality / inequality rows, and their row numbers there:
+        # E (CSC, for its LU and column split) and J_I (CSR) on fixed patterns.
+        entries = eq[nlp.jac_rows]
+        self._eq_entries, self._ineq_entries = np.flatnonzero(entries), np.flatnonzero(~entries)
         rank = np.full(m, -1)
         rank[self.eq_rows] = np.arange(len(self.eq_rows))
         rank[self.ineq_rows] = np.arange(len(self.ineq_rows))
-        self._sub_rows = rank[nlp.jac_rows]
-        self._cols = nlp.jac_cols
+        sub_rows = rank[nlp.jac_rows]
+        e, i = self._eq_entries, self._ineq_entries
+        self._E = FixedPattern(sub_rows[e], nlp.jac_cols[e], (len(self.eq_rows), n), "csc")
+        self._JI = FixedPattern(sub_rows[i], nlp.jac_cols[i], (len(self.ineq_rows), n), "csr")
         ineq_lo, ineq_hi = np.isfinite(nlp.c_lo[self.ineq_rows]), np.isfinite(nlp.c_hi[self.ineq_rows])
         self.lo_sel, self.hi_sel = np.flatnonzero(ineq_lo), np.flatnonzero(ineq_hi)
         self.v = cp.Variable(self.r, name="v")
@@ -89,12 +93,13 @@ class CondensedQP:
 
     # ------------------------------------------------------------------ basis
     def _split(self, jac: np.ndarray):
-        """(E, J_I) as sparse matrices from scaled Jacobian entries on the NLP's pattern."""
-        e = self._eq_entries
-        E = sp.csc_matrix((jac[e], (self._sub_rows[e], self._cols[e])), shape=(len(self.eq_rows), self.n))
-        JI = sp.csr_matrix((jac[~e], (self._sub_rows[~e], self._cols[~e])),
-                           shape=(len(self.ineq_rows), self.n))
-        return E, JI
+        """(E's CSC data array, J_I as a CSR matrix) from scaled Jacobian entries on the NLP's
+        pattern (:class:`~flipkit.solvers.fixed_sparse.FixedPattern`)."""
+        return self._E.data(jac[self._eq_entries]), self._JI.matrix(jac[self._ineq_entries])
+
+    def _set_basis(self, basis: np.ndarray, free: np.ndarray) -> None:
+        self.basis, self.free = basis, free
+        self._EB, self._EN = self._E.columns(basis), self._E.columns(free)
 
     def choose_basis(self, jac: np.ndarray, method: str = "lu") -> None:
         """Basic columns B of E at these Jacobian values: the pivot rows of a partially pivoted
@@ -106,21 +111,22 @@ class CondensedQP:
         Table I chain (cond E_B within 1.3× of the QR's). :meth:`update` falls back to the QR
         when the LU's E_B fails the pivot check.
         """
-        E, _ = self._split(jac)
+        E = self._E.matrix(jac[self._eq_entries]).toarray()
         m = len(self.eq_rows)
         if method == "lu":
-            _, ipiv = sla.lu_factor(E.toarray().T, check_finite=False)
+            _, ipiv = sla.lu_factor(E.T, check_finite=False)
             order = np.arange(self.n)
             for i, j in enumerate(ipiv):  # LAPACK's row interchanges, applied in turn
                 order[i], order[j] = order[j], order[i]
         else:
-            _, order = sla.qr(E.toarray(), mode="r", pivoting=True, check_finite=False)
-        self.basis, self.free = np.sort(order[:m]), np.sort(order[m:])
+            _, order = sla.qr(E, mode="r", pivoting=True, check_finite=False)
+        self._set_basis(np.sort(order[:m]), np.sort(order[m:]))
 
     def _factor(self, E):
-        """Sparse LU of E_B, or None if it is singular or its pivots span more than 1e12."""
+        """Sparse LU of E_B (E given by its CSC data array), or None if it is singular or its
+        pivots span more than 1e12."""
         try:
-            lu = spla.splu(E[:, self.basis])
+            lu = spla.splu(self._EB.matrix(E))
         except RuntimeError:
             return None
         pivots = np.abs(lu.U.diagonal())
@@ -164,7 +170,7 @@ class CondensedQP:
         B, N, n, r = self.basis, self.free, self.n, self.r
         lo_s, hi_s = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
         Z = np.zeros((n, r))
-        Z[B] = -lu.solve(E[:, N].toarray())
+        Z[B] = -lu.solve(self._EN.dense(E))
         Z[N, np.arange(r)] = 1.0
         d_p = np.zeros(n)
         d_p[B] = -lu.solve(c[self.eq_rows] - lo_s[self.eq_rows])
