@@ -320,3 +320,22 @@ def test_nearest_at_many_configurations_is_nearest_at_each(shapes, models):
             assert d[i] == pytest.approx(d1, abs=1e-12) and (k[i], b[i]) == (k1, b1)
             np.testing.assert_allclose(g[i], g1, atol=1e-10)
     assert np.all(k == -1) and np.all(d == 1e-6) and not g.any()  # cap 1e-6: every pair beyond
+
+
+def test_verify_skips_only_pairs_surely_beyond_the_floor(models):
+    """CellGeometry.distances with a floor measures every pair that could lie nearer than the
+    floor exactly and gives the others a lower bound at or above it, so verify's check of the
+    margin reads the same as with every pair measured."""
+    cell = CellConfig()
+    geometry = CellGeometry(models.bare, cell)
+    hits = 0
+    for q in _random_configurations(models.bare, 5, 40):
+        exact = geometry.distances(q)
+        for floor in (cell.space.margin, 0.1):
+            got = geometry.distances(q, floor)
+            near = exact < floor
+            np.testing.assert_allclose(got[near], exact[near], atol=1e-12)
+            assert np.all(got[~near] >= np.minimum(exact[~near], floor) - 1e-12)
+            assert np.all(got <= exact + 1e-12)  # a lower bound or the distance itself
+            hits += int(near.sum())
+    assert hits > 0  # some pairs did come within the floor
