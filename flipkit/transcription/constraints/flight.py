@@ -13,6 +13,8 @@ down. The release time is then t_r = r T / N, a variable through T.
 
 from __future__ import annotations
 
+import functools
+
 import math
 
 import numpy as np
@@ -120,16 +122,30 @@ class FlightClearance(Block):
         self._finish(margin, np.inf, 1.0)
 
     def evaluate(self, ev):
-        L, r = self.layout, self.release
+        L, r, n = self.layout, self.release, len(self.nodes)
+        if not n:
+            return np.zeros(0), np.zeros(0)
         x_r, R_r, dq_r, dqd_r = _release_inputs(ev, r)
-        f, T = clearance_function(), ev.T
-        vals, jac = [], []
-        for i in self.nodes:
-            st = ev.state(i)
-            ds = L.s[i] - L.s[r]
-            x = np.concatenate([x_r, [ds * T], st.p, np.zeros(3)])
-            d, J = (np.asarray(a).ravel() for a in f(x, R_r, st.R, self.par))
-            vals.append(d[0])
-            jac.append(np.concatenate([J[:12] @ dq_r, J[:12] @ dqd_r,
-                                       J[13:16] @ st.dp_dq + J[16:19] @ st.Jw, [J[12] * ds]]))
-        return np.array(vals), np.concatenate(jac)
+        states = [ev.state(i) for i in self.nodes]
+        ds = L.s[self.nodes] - L.s[r]
+        X = np.zeros((19, n))  # one column per node: (x_r, τ, p_i, δ_i = 0)
+        X[:12] = x_r[:, None]
+        X[12] = ds * ev.T
+        X[13:16] = np.array([st.p for st in states]).T
+        Ri = np.hstack([st.R for st in states])
+        d, J = _mapped_clearance(n)(X, R_r, Ri, self.par)  # every node in one call
+        J = np.asarray(J).reshape(n, 19)
+        dp = np.array([st.dp_dq for st in states])  # (n, 3, nq)
+        Jw = np.array([st.Jw for st in states])
+        jac = np.concatenate([J[:, :12] @ dq_r, J[:, :12] @ dqd_r,
+                              np.einsum("nk,nkj->nj", J[:, 13:16], dp)
+                              + np.einsum("nk,nkj->nj", J[:, 16:19], Jw),
+                              (J[:, 12] * ds)[:, None]], axis=1)
+        return np.asarray(d).ravel(), jac.ravel()
+
+
+@functools.lru_cache(maxsize=None)
+def _mapped_clearance(n: int):
+    """:func:`~flipkit.model.flight.clearance_function` mapped over n blade poses (one CasADi
+    call instead of n: 0.8 → ~0.2 ms per flip evaluation, measured in session 12)."""
+    return clearance_function().map(n)
