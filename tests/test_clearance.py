@@ -303,10 +303,11 @@ def min_clearances_in(plan, space):
     return min(geometry.distances(q)[:, -1].min() for seg in plan.segments for q in seg.q[1:])
 
 
-def test_nearest_at_many_configurations_is_nearest_at_each(shapes, models):
-    """ArmShapes.nearest_nodes (the NLP block's batched broad phase) gives what nearest gives
-    configuration by configuration: distance, gradient and nearest pair, under random pair
-    masks and caps (a cap below every distance: the cap, −1 and a zero gradient)."""
+def test_nearest_at_many_configurations_is_the_least_pair_distance(shapes, models):
+    """ArmShapes.nearest_nodes (the NLP block's batched broad phase; nearest is it at one
+    configuration) gives, configuration by configuration, the least of the pairwise distances
+    (ArmShapes.distance, one coal query per pair): distance, gradient and nearest pair, under
+    random pair masks and caps (a cap below every distance: the cap, −1 and a zero gradient)."""
     rng = np.random.default_rng(7)
     qs = np.array(_random_configurations(models.bare, 11, 12))
     S, B = len(shapes.names), len(shapes.box_names)
@@ -315,10 +316,17 @@ def test_nearest_at_many_configurations_is_nearest_at_each(shapes, models):
         allowed[0] = True
         d, g, k, b = shapes.nearest_nodes(qs, allowed, cap)
         for i, q in enumerate(qs):
-            pairs = np.argwhere(allowed[i])
-            d1, g1, k1, b1 = shapes.nearest(q, pairs, cap)
+            pairs = [tuple(p) for p in np.argwhere(allowed[i])]
+            each = {p: shapes.distance(q, *p) for p in pairs}
+            p_min = min(pairs, key=lambda p: each[p][0])
+            if each[p_min][0] < cap:
+                d1, g1, (k1, b1) = each[p_min][0], each[p_min][1], p_min
+            else:
+                d1, g1, (k1, b1) = cap, np.zeros(models.bare.nq), (-1, -1)
             assert d[i] == pytest.approx(d1, abs=1e-12) and (k[i], b[i]) == (k1, b1)
             np.testing.assert_allclose(g[i], g1, atol=1e-10)
+            d2, g2, k2, b2 = shapes.nearest(q, np.array(pairs).reshape(-1, 2), cap)
+            assert (d2, k2, b2) == (d[i], k[i], b[i]) and np.array_equal(g2, g[i])
     assert np.all(k == -1) and np.all(d == 1e-6) and not g.any()  # cap 1e-6: every pair beyond
 
 

@@ -108,6 +108,16 @@ def distance_request():
 pin_box_support()  # before any other flipkit query: loading this module pins it
 
 
+def sphere_box_bound(centers, radii, lo, hi) -> np.ndarray:
+    """Lower bounds (m) of the distances of spheres to axis-aligned boxes: centre-to-box
+    distance minus radius, for ``centers`` (..., shapes, 3) and ``radii`` (shapes,) against
+    boxes ``lo``, ``hi`` (boxes, 3); shape (..., shapes, boxes). Bounding spheres of the arm's
+    shapes give the broad phase of the NLP's clearance rows and of verify's space check."""
+    c = np.asarray(centers, float)[..., None, :]
+    out = np.maximum(np.maximum(lo - c, c - hi), 0.0)
+    return np.sqrt((out**2).sum(-1)) - np.asarray(radii)[:, None]
+
+
 @dataclass
 class Shape:
     """One rigid shape of the arm: a coal geometry at ``placement`` in joint ``joint``'s frame,
@@ -233,13 +243,9 @@ class ArmShapes:
         joints = {j: d.oMi[j] for j in self._joints}
         return [joints[s.joint] * s.placement for s in self.shapes]
 
-    def _query(self, k: int, M: pin.SE3, b: int, req, res):
-        """coal distance of shape k at world placement M to box b: (d, witness on the shape,
-        unit normal from the shape to the box)."""
-        return self._query_at(k, M.rotation, M.translation, b, req, res)
-
-    def _query_at(self, k: int, R: np.ndarray, p: np.ndarray, b: int, req, res):
-        """:meth:`_query` with the placement given as rotation R and translation p."""
+    def _query(self, k: int, R: np.ndarray, p: np.ndarray, b: int, req, res):
+        """coal distance of shape k at world placement (R, p) to box b: (d, witness on the
+        shape, unit normal from the shape to the box)."""
         import coal
 
         geom, tf, _, _ = self._box_geoms[b]
@@ -251,27 +257,12 @@ class ArmShapes:
         """The least distance (m) over the (shape index, box index) ``pairs`` at q, capped at
         ``cap``: (min(cap, d), its gradient ∂/∂q, the nearest pair's shape and box indices;
         −1, −1 and a zero gradient when every pair lies farther than ``cap``). A broad phase
-        by bounding spheres skips the pairs that cannot be nearer; the minimum is exact."""
-        import coal
-
-        placed = self._place(q)
-        centers = np.array([M.act(s.center) for M, s in zip(placed, self.shapes)])
-        shapes, boxes = pairs[:, 0], pairs[:, 1]
-        c = centers[shapes]
-        bound = np.sqrt((np.maximum(np.maximum(self._lo[boxes] - c, c - self._hi[boxes]), 0.0)
-                         ** 2).sum(1)) - self._radii[shapes]
-        req, res = distance_request(), coal.DistanceResult()
-        best = (float(cap), None, None, -1, -1)
-        for j in np.argsort(bound, kind="stable"):
-            if bound[j] >= best[0]:
-                break
-            k, b = int(shapes[j]), int(boxes[j])
-            dist, p1, n = self._query(k, placed[k], b, req, res)
-            if dist < best[0]:
-                best = (dist, p1, n, k, b)
-        dist, p1, n, k, b = best
-        grad = np.zeros(self.robot.nq) if k < 0 else self._gradient(k, p1, n)
-        return dist, grad, k, b
+        by bounding spheres skips the pairs that cannot be nearer; the minimum is exact
+        (:meth:`nearest_nodes` at one configuration)."""
+        allowed = np.zeros((1, len(self.shapes), len(self.boxes)), bool)
+        allowed[0, pairs[:, 0], pairs[:, 1]] = True
+        dist, grad, shape, box = self.nearest_nodes(np.asarray(q, float)[None], allowed, cap)
+        return float(dist[0]), grad[0], int(shape[0]), int(box[0])
 
     def nearest_nodes(self, qs, allowed, cap: float = np.inf):
         """:meth:`nearest` at n configurations at once, the broad phase of all of them in one
@@ -302,8 +293,7 @@ class ArmShapes:
         Rw = np.einsum("nsij,sjk->nsik", Rj, self._R_in_joint)  # the shapes' world placements
         pw = np.einsum("nsij,sj->nsi", Rj, self._p_in_joint) + pj
         c = np.einsum("nsij,sj->nsi", Rj, self._c_in_joint) + pj
-        out = np.maximum(np.maximum(self._lo - c[:, :, None], c[:, :, None] - self._hi), 0.0)
-        bound = np.sqrt((out**2).sum(-1)) - self._radii[:, None]
+        bound = sphere_box_bound(c, self._radii, self._lo, self._hi)
         bound = np.where(allowed, bound, np.inf).reshape(n, -1)
         dist, grad = np.full(n, float(cap)), np.zeros((n, self.robot.nq))
         shape, box = np.full(n, -1), np.full(n, -1)
@@ -314,20 +304,18 @@ class ArmShapes:
                 if bound[i, j] >= best[0]:
                     break
                 k, b = divmod(int(j), nb)
-                d, p1, normal = self._query_at(k, Rw[i, k], pw[i, k], b, req, res)
+                d, p1, normal = self._query(k, Rw[i, k], pw[i, k], b, req, res)
                 if d < best[0]:
                     best, shape[i], box[i] = (d, p1, normal), k, b
             dist[i] = best[0]
             if shape[i] >= 0:
-                joint = self.shapes[shape[i]].joint
-                J = pin.computeJointJacobian(m, data, qs[i], joint)  # joint frame
-                R = H[i, self._joints.index(joint), :3, :3]
-                r = best[1] - H[i, self._joints.index(joint), :3, 3]
-                grad[i] = -(best[2] @ (R @ J[:3] - skew(r) @ (R @ J[3:])))
+                pin.computeJointJacobians(m, data, qs[i])
+                grad[i] = self._gradient(shape[i], best[1], best[2])
         return dist, grad, shape, box
 
     def _gradient(self, k: int, p1: np.ndarray, n: np.ndarray) -> np.ndarray:
-        """∂d/∂q = −nᵀ (J_v − [r]× J_ω) of shape k's witness point p1 (after :meth:`_place`)."""
+        """∂d/∂q = −nᵀ (J_v − [r]× J_ω) of shape k's witness point p1 (after pinocchio's
+        ``computeJointJacobians`` at the configuration, as :meth:`_place` runs it)."""
         joint = self.shapes[k].joint
         J = pin.getJointJacobian(self.robot.model, self.robot.data, joint, LWA)
         r = p1 - self.robot.data.oMi[joint].translation
@@ -338,6 +326,7 @@ class ArmShapes:
         import coal
 
         placed = self._place(q)
-        dist, p1, n = self._query(shape, placed[shape], box, distance_request(),
+        M = placed[shape]
+        dist, p1, n = self._query(shape, M.rotation, M.translation, box, distance_request(),
                                   coal.DistanceResult())
         return dist, self._gradient(shape, p1, n)

@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from flipkit.behaviors.segments import clearance_excluded
-from flipkit.model.collision import ArmShapes, distance_request
+from flipkit.model.collision import ArmShapes, distance_request, sphere_box_bound
 from flipkit.model.orientation import rpy
 
 
@@ -64,9 +64,8 @@ class CellGeometry:
                                      np.asarray(q, float))
         ns = len(self.shape_names)
         objs, places = self.gmodel.geometryObjects, self.gdata.oMg
-        c = np.array([places[s].act(self._centers[s]) for s in range(ns)])[:, None]
-        out = np.sqrt((np.maximum(np.maximum(self._lo - c, c - self._hi), 0.0) ** 2).sum(-1)
-                      ) - self._radii[:, None]
+        c = np.array([places[s].act(self._centers[s]) for s in range(ns)])
+        out = sphere_box_bound(c, self._radii, self._lo, self._hi)
         req = distance_request()
         for b in range(len(self.box_names)):
             gb, Mb = objs[ns + b].geometry, places[ns + b]
