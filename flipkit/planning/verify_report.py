@@ -53,17 +53,9 @@ class VerificationReport:
     groups: dict = field(default_factory=lambda: {g: GroupResult(g, u) for g, u in GROUPS.items()})
 
     def add(self, group: str, segment: int, violation, tolerance, node: int | None = None):
-        """Record the rows ``violation`` (≥ 0) against ``tolerance`` (broadcast)."""
+        """Record the rows ``violation`` (≥ 0) against ``tolerance`` (broadcast), at ``node``."""
         v = np.atleast_1d(np.asarray(violation, float))
-        if v.size == 0:
-            return
-        ratio = v / np.broadcast_to(tolerance, v.shape)
-        ratio = np.where(np.isnan(ratio), np.inf, ratio)
-        k = int(np.argmax(ratio))
-        res = self.groups[group]
-        if res.segment is None or ratio[k] > res.ratio:
-            res.violation, res.segment, res.node = float(v[k]), segment, node
-            res.tolerance = float(np.broadcast_to(tolerance, v.shape)[k])
+        self.add_nodes(group, segment, v[None], tolerance, [node])
 
     def add_nodes(self, group: str, segment: int, violation, tolerance, nodes=None):
         """Record rows given node by node: ``violation`` (n, k) holds node ``nodes[r]``'s
@@ -79,7 +71,8 @@ class VerificationReport:
         res = self.groups[group]
         if res.segment is None or ratio[r, c] > res.ratio:
             res.violation, res.segment = float(v[r, c]), segment
-            res.node = int(r if nodes is None else nodes[r])
+            node = r if nodes is None else nodes[r]
+            res.node = None if node is None else int(node)
             res.tolerance = float(tol[r, c])
 
     @property
