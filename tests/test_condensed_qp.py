@@ -163,3 +163,46 @@ def test_singular_basis_is_pivoted_again(segments):
     qp.update(nlp, c, bad, g, h, lo, hi)
     assert dead not in qp.basis
     assert np.abs(E @ qp.T.value).max() < 1e-9 * np.abs(qp.T.value).max()
+
+
+def _elastic_reference(nlp, c, J, g, h, lo, hi, sigma):
+    """The restoration QP with the equality rows hard and slacks on the inequality rows, in
+    full space, solved by Clarabel (an interior-point method, not OSQP) to high accuracy."""
+    import cvxpy as cp
+
+    eq = nlp.c_lo == nlp.c_hi
+    s_lo, s_hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    rl = np.flatnonzero(~eq & np.isfinite(nlp.c_lo))
+    rh = np.flatnonzero(~eq & np.isfinite(nlp.c_hi))
+    d, a, b = cp.Variable(nlp.n), cp.Variable(len(rl)), cp.Variable(len(rh))
+    E = J[np.flatnonzero(eq)]
+    cons = [E @ d == (s_lo - c)[eq], J[rl] @ d + a >= (s_lo - c)[rl],
+            J[rh] @ d - b <= (s_hi - c)[rh], d >= lo, d <= hi]
+    obj = g @ d + 0.5 * cp.sum(cp.multiply(h, cp.square(d))) + 0.5 * sigma * (
+        cp.sum_squares(a) + cp.sum_squares(b))
+    cp.Problem(cp.Minimize(obj), cons).solve(solver=cp.CLARABEL, tol_gap_abs=1e-12,
+                                              tol_gap_rel=1e-12, tol_feas=1e-12)
+    return d.value
+
+
+@pytest.mark.parametrize("name", ["scoop"])  # its guess violates inequality rows
+def test_condensed_elastic_step_is_the_reference_restoration_step(segments, name):
+    """The condensed restoration QP (equalities eliminated, slacks on the inequality rows)
+    gives the step of the same QP stated in full space and solved by an interior-point
+    method; at the scoop's guess the linearised inequality rows cannot all hold, and the
+    slacks are in use."""
+    nlp = segments[name]
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    elastic = CondensedQP(nlp, elastic=True)
+    restoration = np.full(nlp.n, 1e-4)
+    elastic.update(nlp, c, entries, 0 * g, restoration, lo, hi, 1.0)
+    sol = elastic.solve(eps=1e-10, max_iter=50000)
+    assert sol.status == "optimal"
+    eq = nlp.c_lo == nlp.c_hi
+    lin = c + J @ sol.d
+    assert np.abs((lin - nlp.c_scale * nlp.c_lo)[eq]).max() < 1e-9
+    assert np.all(sol.d >= lo - 1e-8) and np.all(sol.d <= hi + 1e-8)
+    s_lo, s_hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
+    assert np.maximum(s_lo - lin, lin - s_hi)[~eq].max() > 1e-6  # the slacks carry the rest
+    ref = _elastic_reference(nlp, c, J, 0 * g, restoration, lo, hi, 1.0)
+    assert np.abs(sol.d - ref).max() < 1e-5 * max(1.0, np.abs(ref).max())

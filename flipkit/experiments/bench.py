@@ -70,14 +70,15 @@ def machine() -> str:
 
 
 def warm_up(nlps) -> float:
-    """Compile the elastic (restoration) QP of each distinct structure (cvxpy, once per
+    """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
     process) and run one SQP iteration on it, which compiles the condensed hard QP;
     returns the time (s)."""
     t0, seen = time.perf_counter(), set()
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
-            SUBPROBLEMS.get(nlp, "elastic").compile()
+            for form in ("elastic", "condensed_elastic"):
+                SUBPROBLEMS.get(nlp, form).compile()
             solve_sqp(nlp, options=SQPOptions(max_iter=1), raise_on_failure=False)
     return time.perf_counter() - t0
 

@@ -15,7 +15,7 @@ from flipkit.solvers.full_qp import QPSubproblem
 from flipkit.solvers.subproblem import Subproblem
 from flipkit.transcription.nlp import NLP
 
-FORMS = ("full", "elastic", "condensed")
+FORMS = ("full", "elastic", "condensed", "condensed_elastic")
 
 
 class SubproblemCache:
@@ -35,7 +35,9 @@ class SubproblemCache:
         key = (nlp.structure_key, form)
         qp = self._built.get(key)
         if qp is None:
-            qp = CondensedQP(nlp) if form == "condensed" else QPSubproblem(nlp, form == "elastic")
+            elastic = form.endswith("elastic")
+            qp = (CondensedQP(nlp, elastic) if form.startswith("condensed")
+                  else QPSubproblem(nlp, elastic))
             self._built[key] = qp
         return qp
 

@@ -23,6 +23,18 @@ infeasible linearisation detected in 760 where the full-space QP ran out at 20 0
 
 Multipliers of the equality rows, which the SQP's penalty update needs, are recovered from the
 full-space stationarity condition restricted to B: E_Bᵀ y_E = −(g + h ⊙ d + J_Iᵀy_I + y_box)_B.
+
+Elastic form (``elastic=True``, the SQP's restoration step): the inequality rows get slacks
+penalised by ½σ‖s‖², the equality rows stay hard and are eliminated as above, and the step box
+stays hard:
+
+    minimise ½‖v‖² + g_vᵀv + ½σ(‖s_lo‖² + ‖s_hi‖²)   s.t.  J_I T v + s_lo ≥ lo,  J_I T v − s_hi ≤ hi,
+                                                          box_lo ≤ T v ≤ box_hi
+
+The full-space elastic QP (:mod:`flipkit.solvers.full_qp`) also softens the equality rows; it
+stays the fallback when the hard equalities and the box are incompatible. Measured on the cold
+Table I flips (session 13): the full-space restoration QPs took 65–130 ms each (530–1 200 ADMM
+iterations on ~550 variables, their slacks and every row), two or three per cold flip.
 """
 
 from __future__ import annotations
@@ -45,14 +57,15 @@ class CondensedQP:
 
     Args:
         nlp: An NLP of the structure (its pattern and bound types are used, not its values).
+        elastic: Build the restoration variant: slacks, penalised by ½σ‖s‖², on the inequality
+            rows (the equality rows and the step box stay hard).
 
     Raises:
         ConfigError: As many equality rows as variables or more (nothing left to optimise).
     """
 
-    elastic = False
-
-    def __init__(self, nlp: NLP):
+    def __init__(self, nlp: NLP, elastic: bool = False):
+        self.elastic = elastic
         n, m = nlp.n, nlp.m
         eq = nlp.c_lo == nlp.c_hi
         self.n, self.m = n, m
@@ -83,9 +96,16 @@ class CondensedQP:
         self.T = cp.Parameter((n, self.r), name="null_space_basis")
         self.box_lo = cp.Parameter(n, name="box_lo")
         self.box_hi = cp.Parameter(n, name="box_hi")
-        self.rows = {"lo": self.G_lo @ self.v >= self.b_lo, "hi": self.G_hi @ self.v <= self.b_hi,
-                     "box_lo": self.T @ self.v >= self.box_lo, "box_hi": self.T @ self.v <= self.box_hi}
+        lo_rows, hi_rows = self.G_lo @ self.v, self.G_hi @ self.v
         obj = 0.5 * cp.sum_squares(self.v) + self.g @ self.v
+        self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
+        if elastic:
+            s_lo = cp.Variable(len(self.lo_sel), name="s_lo")
+            s_hi = cp.Variable(len(self.hi_sel), name="s_hi")
+            lo_rows, hi_rows = lo_rows + s_lo, hi_rows - s_hi
+            obj = obj + 0.5 * self.slack_reg * (cp.sum_squares(s_lo) + cp.sum_squares(s_hi))
+        self.rows = {"lo": lo_rows >= self.b_lo, "hi": hi_rows <= self.b_hi,
+                     "box_lo": self.T @ self.v >= self.box_lo, "box_hi": self.T @ self.v <= self.box_hi}
         self.problem = cp.Problem(cp.Minimize(obj), list(self.rows.values()))
         if not self.problem.is_dpp():  # pragma: no cover - a programming error
             raise SolverError("the condensed subproblem must be DPP")
@@ -151,9 +171,10 @@ class CondensedQP:
 
     # ------------------------------------------------------------------ values
     def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
-               d_lo: np.ndarray, d_hi: np.ndarray) -> None:
+               d_lo: np.ndarray, d_hi: np.ndarray, slack_reg: float = 1e2) -> None:
         """Condense the subproblem of a linearisation (scaled units, as
-        :meth:`flipkit.solvers.full_qp.QPSubproblem.update`; ``hess`` must be positive)."""
+        :meth:`flipkit.solvers.full_qp.QPSubproblem.update`; ``hess`` must be positive;
+        ``slack_reg`` is σ of the elastic form's ½σ‖s‖², unused by the hard form)."""
         E, JI = self._split(jac)
         fresh = self.basis is None  # chosen at this point just now: pivoting again repeats it
         if fresh:
@@ -184,6 +205,8 @@ class CondensedQP:
                   self.G_lo: G[self.lo_sel], self.b_lo: (lo_s[I] - base)[self.lo_sel],
                   self.G_hi: G[self.hi_sel], self.b_hi: (hi_s[I] - base)[self.hi_sel],
                   self.box_lo: d_lo - d_p, self.box_hi: np.maximum(d_hi, d_lo) - d_p}
+        if self.elastic:
+            values[self.slack_reg] = slack_reg
         compiled = getattr(self, "_driver", None)  # the first values go through cvxpy, which
         for prm, value in values.items():  # compiles with them; later ones to the map
             if compiled is None:

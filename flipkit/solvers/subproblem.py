@@ -6,7 +6,8 @@ Two forms state the same convex subproblem (:mod:`flipkit.solvers.full_qp`):
   equality rows kept as rows; with ``elastic=True`` every row gets slacks (the restoration
   step);
 * **condensed** (:class:`~flipkit.solvers.condensed_qp.CondensedQP`): the equality rows
-  eliminated with a sparse LU, leaving the step in their null space (19–31 variables).
+  eliminated with a sparse LU, leaving the step in their null space (19–31 variables); with
+  ``elastic=True`` the inequality rows get slacks (the restoration step, equalities hard).
 
 :mod:`flipkit.solvers.compiled` keeps one compiled instance per NLP structure and form.
 """
@@ -38,7 +39,8 @@ class Subproblem(Protocol):
     """What the SQP asks of a subproblem: set the linearisation, solve, forget state.
 
     Attributes:
-        elastic: True for the restoration form (slacks on every row).
+        elastic: True for the restoration forms (slacks on every row in full space, on the
+            inequality rows in condensed form).
     """
 
     elastic: bool
