@@ -232,3 +232,42 @@ def test_points_that_cannot_be_evaluated_are_never_taken(reference):
     assert res.status == "Invalid_Number_Detected" and res.iterations == 0
     with pytest.raises(NoSolutionFound, match="Invalid_Number_Detected"):
         solve_sqp(nlp, x)
+
+
+def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box():
+    """The flip's cold guess, clipped to the velocity and acceleration limits, is
+    inconsistent by O(1): within the trust box of 1 the condensed restoration QP (equalities
+    hard) is infeasible and only the full-space one (every row elastic) gives a step; within
+    ``restoration_trust`` the condensed one does, it holds the linearised equalities, and it
+    removes most of the linearised violation."""
+    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.config import TABLE1_LOCATIONS, CellConfig
+    from flipkit.planning.planner import plan_flip
+    from flipkit.solvers import sqp as S
+    from flipkit.solvers.condensed_qp import CondensedQP
+    from flipkit.solvers.full_qp import QPSubproblem
+    from flipkit.solvers.iterate import Iterate
+
+    cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
+    pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
+                  if s.name == "pickup")
+    nlp = build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    o, D = SQPOptions(), nlp.x_scale
+    p = Iterate(nlp, nlp.project(nlp.x0), nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols])
+    grad = nlp.gradient(p.x) * nlp.obj_scale * D
+    hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
+    lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
+
+    def box(radius):
+        return np.maximum(lo, -radius), np.minimum(hi, radius)
+
+    args = (nlp, o, p, grad, hess, o.prox, *box(o.trust_max), 1e-4)
+    sol, qp, *_ = S._subproblem(*args)
+    assert qp.elastic and isinstance(qp, QPSubproblem)  # the condensed form had no step
+    sol, qp, *_ = S._subproblem(*args, None, box(o.restoration_trust))
+    assert qp.elastic and isinstance(qp, CondensedQP) and sol.status == "optimal"
+    eq = nlp.c_lo == nlp.c_hi
+    lin = p.cs + p.J @ sol.d
+    assert np.abs((lin - nlp.c_scale * nlp.c_lo)[eq]).max() < 1e-8
+    assert np.abs(sol.d).max() > o.trust_max  # a step the trust box of 1 could not take
+    assert S._linearised_violation(nlp, p, sol.d) < 0.1 * float(p.v.sum())

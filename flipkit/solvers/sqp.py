@@ -74,12 +74,12 @@ __all__ = ["SQPOptions", "SolveResult", "solve_sqp"]
 
 
 def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
-                eps: float, wide=None):
+                eps: float, wide=None, restore=None):
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
     raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
     if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
-    trust region), if given; else the restoration QP. Returns (solution, QP object, μ, tries,
-    ADMM iterations)."""
+    trust region), if given; else the restoration QP, in the box ``restore`` (default the
+    step box). Returns (solution, QP object, μ, tries, ADMM iterations)."""
     admm = 0
     for attempt in range(3):
         qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
@@ -119,10 +119,10 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
             return sol, qp, mu, attempt + 2, admm
     # Restoration: a least-squares (Levenberg–Marquardt) step on the rows, condensed (the
     # equalities hard) unless they and the box are incompatible, then in full space.
-    tries = attempt + 3
+    tries, box = attempt + 3, (d_lo, d_hi) if restore is None else restore
     for form in (("condensed_elastic", "elastic") if o.condense else ("elastic",)):
         qp = SUBPROBLEMS.get(nlp, form)
-        qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), d_lo, d_hi,
+        qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), *box,
                   o.slack_reg)
         sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[0] if form != "elastic" else None)
         admm += sol.iterations
@@ -242,7 +242,11 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         eps = float(np.clip(o.qp_eps_factor * theta * tighten, *o.qp_eps))
         wide = (np.maximum((nlp.x_lb - p.x) / D, -o.trust_max),
                 np.minimum((nlp.x_ub - p.x) / D, o.trust_max)) if trust < o.trust_max else None
-        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide)
+        restore = None if wide is not None else (  # the trust box at its largest
+            np.maximum((nlp.x_lb - p.x) / D, -o.restoration_trust),
+            np.minimum((nlp.x_ub - p.x) / D, o.restoration_trust))
+        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide,
+                                               restore)
         qp_iters += admm
         hard = not qp.elastic
         rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)

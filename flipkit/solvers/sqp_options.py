@@ -52,6 +52,14 @@ class SQPOptions:
         rho_min: Smallest ℓ1 penalty.
         slack_reg, restoration_prox: The elastic (restoration) step minimises
             ½σ‖s‖² + ½μ_r‖d‖², a Levenberg–Marquardt step on the violation.
+        restoration_trust: The restoration step's box |d|∞ ≤ this (∩ the variable bounds)
+            while the trust box is at its largest, ``trust_max``; after the trust box has
+            shrunk, the restoration keeps it. A cold guess clipped to the bounds (the flip's
+            wrist roll in 0.6 s exceeds the velocity and acceleration limits) is inconsistent
+            by O(1): its linearised equality rows need steps of 1.0–3.3 (measured, ten cold
+            Table I chains), so in a box of 1 the condensed restoration QP was infeasible and
+            the full-space one took 100–130 ms; in a box of 4 every restoration of those
+            chains was condensed (20 ms each).
         qp_eps, qp_eps_factor: OSQP tolerance = factor × violation (at a feasible iterate:
             × last predicted decrease), clipped to the (min, max) range (inexact SQP).
         qp_max_iter: OSQP iteration caps of the three tries of the hard QP. A subproblem
@@ -74,6 +82,7 @@ class SQPOptions:
     rho_min: float = 1e-3
     slack_reg: float = 1.0
     restoration_prox: float = 1e-4
+    restoration_trust: float = 4.0
     qp_eps: tuple[float, float] = (1e-9, 1e-4)
     qp_eps_factor: float = 0.1
     qp_max_iter: tuple[int, int, int] = (2000, 10000, 10000)
@@ -84,8 +93,8 @@ class SQPOptions:
     plateau_ftol: float = 1e-2
 
     def __post_init__(self):
-        if not (0 < self.trust_min <= self.trust0 <= self.trust_max):
-            raise ConfigError("need 0 < trust_min <= trust0 <= trust_max")
+        if not (0 < self.trust_min <= self.trust0 <= self.trust_max <= self.restoration_trust):
+            raise ConfigError("need 0 < trust_min <= trust0 <= trust_max <= restoration_trust")
         if not (0 < self.eta < 1) or self.tol <= 0 or self.ftol <= 0 or self.max_iter < 1:
             raise ConfigError("need 0 < eta < 1, tol > 0, ftol > 0 and max_iter >= 1")
         if self.reject_ftol < 0:
