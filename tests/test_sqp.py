@@ -64,7 +64,10 @@ def test_failure_raises_with_group_and_amount(reference):
 
 def test_projection_satisfies_the_dynamics_rows_exactly(reference):
     """u := RNEA(q, q̇, q̈) zeroes the dynamics rows at any point (the SQP projects every
-    trial point) and leaves every other variable alone."""
+    trial point), the fixed start state is set to its values exactly (before u, which reads
+    it), and every other variable is left alone."""
+    from flipkit.transcription.constraints.base import FixedValues
+
     nlp, _ = reference
     rng = np.random.default_rng(3)
     x = np.clip(nlp.x0 + 0.05 * nlp.x_scale * rng.standard_normal(nlp.n), nlp.x_lb, nlp.x_ub)
@@ -72,8 +75,10 @@ def test_projection_satisfies_the_dynamics_rows_exactly(reference):
     rows = nlp.block_slices["dynamics"]
     assert np.abs(nlp.constraints(x)[rows]).max() > 1e-3
     assert np.abs(nlp.constraints(xp)[rows]).max() < 1e-9
-    moved = np.flatnonzero(xp != x)
-    assert set(moved) <= set(nlp.u_index)
+    fixed = [b for b in nlp.blocks if isinstance(b, FixedValues)]
+    assert fixed and all(np.array_equal(xp[b.indices], b.target) for b in fixed)
+    fixed_idx = set(np.concatenate([b.indices for b in fixed]))
+    assert set(np.flatnonzero(xp != x)) <= set(nlp.u_index) | fixed_idx
 
 
 def test_locally_infeasible_segment_stops_early_as_infeasible():
@@ -271,3 +276,33 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box():
     assert np.abs((lin - nlp.c_scale * nlp.c_lo)[eq]).max() < 1e-8
     assert np.abs(sol.d).max() > o.trust_max  # a step the trust box of 1 could not take
     assert S._linearised_violation(nlp, p, sol.d) < 0.1 * float(p.v.sum())
+
+
+def test_a_restoration_phase_skips_the_hard_qp_until_the_violation_has_fallen():
+    """After an accepted restoration step the SQP stays in restoration — one QP per
+    iteration, no hard attempts — while the violation exceeds ``restoration_exit`` × its value
+    when the phase began; the log of a cold flip follows that rule row by row, and the flip
+    is solved."""
+    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.config import TABLE1_LOCATIONS, CellConfig
+    from flipkit.planning.planner import plan_flip
+
+    cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
+    pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
+                  if s.name == "pickup")
+    nlp = build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    res = solve_sqp(nlp)
+    assert res.status == "solved"
+    exit_ = SQPOptions().restoration_exit
+    entry, phase_rows = None, 0
+    v_prev = float(nlp.scaled_violation(nlp.constraints(nlp.project(nlp.x0))).max())
+    for row in res.log:
+        if entry is not None and v_prev > exit_ * entry:
+            assert row["elastic"] and row["qp_tries"] == 1, row
+            phase_rows += 1
+        else:
+            assert not (row["elastic"] and row["qp_tries"] == 1), row
+        accepted_restoration = row["elastic"] and row["step"] > 0
+        entry = (entry if entry is not None else v_prev) if accepted_restoration else None
+        v_prev = row["violation"]
+    assert phase_rows >= 1

@@ -34,8 +34,10 @@ by raising Σu² has a negative predicted decrease and was never tried: measured
 location 2 from a warm start, the trust box then shrank tenfold per iteration at a landing
 violation of 0.0098 until the solve was declared infeasible); when ``stall_iterations``
 restoration steps in a row barely reduce the violation, Z is a stationary point of the
-violation and the solve stops as
-``infeasible``. The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
+violation and the solve stops as ``infeasible``. An accepted restoration step opens a
+restoration phase, as in filter SQP methods: the next steps are restoration steps too, without
+the hard QP's attempts (each an ADMM run to an infeasibility verdict), until the violation is
+down to ``restoration_exit`` times its value when the phase began. The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
 violation (or, at a feasible iterate, the last predicted decrease), within ``qp_eps`` — loose
 far from a solution, tight near it, where the step must resolve residuals below ``tol``.
 
@@ -74,14 +76,15 @@ __all__ = ["SQPOptions", "SolveResult", "solve_sqp"]
 
 
 def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
-                eps: float, wide=None, restore=None):
+                eps: float, wide=None, restore=None, restoring: bool = False):
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
     raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
     if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
     trust region), if given; else the restoration QP, in the box ``restore`` (default the
-    step box). Returns (solution, QP object, μ, tries, ADMM iterations)."""
-    admm = 0
-    for attempt in range(3):
+    step box). ``restoring``: in the restoration phase, the restoration QP alone. Returns
+    (solution, QP object, μ, tries, ADMM iterations)."""
+    admm, attempt, sol = 0, -1, None
+    for attempt in range(0 if restoring else 3):
         qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
         sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
@@ -98,9 +101,9 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         if sol.status == "optimal" or "infeasible" in sol.status:
             break
         mu = min(10.0 * mu, o.prox_range[1])
-    if sol.status == "optimal":
+    if sol is not None and sol.status == "optimal":
         return sol, qp, mu, attempt + 1, admm
-    if wide is not None:
+    if wide is not None and not restoring:
         # Infeasible within a shrunken trust box, or no verdict from OSQP in its three tries
         # (ADMM detects infeasibility slowly, and how slowly depends on the null-space basis:
         # measured on the reference translate in a 1e-5 box, infeasible after 1 320 ADMM
@@ -119,7 +122,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
             return sol, qp, mu, attempt + 2, admm
     # Restoration: a least-squares (Levenberg–Marquardt) step on the rows, condensed (the
     # equalities hard) unless they and the box are incompatible, then in full space.
-    tries, box = attempt + 3, (d_lo, d_hi) if restore is None else restore
+    tries, box = 1 if restoring else attempt + 3, (d_lo, d_hi) if restore is None else restore
     for form in (("condensed_elastic", "elastic") if o.condense else ("elastic",)):
         qp = SUBPROBLEMS.get(nlp, form)
         qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), *box,
@@ -229,6 +232,7 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
     p = point(nlp.x0 if x0 is None else x0)
     rho, trust, mu, tighten = o.rho_min, o.trust0, o.prox, 1.0
     log, qp_iters, status, it, pred, stalls = [], 0, Status.MAX_ITER, 0, np.inf, 0
+    entry = None  # the violation where the restoration phase began (None: not in it)
     if not (np.all(np.isfinite(p.c)) and np.all(np.isfinite(p.jac))):  # no model to start from
         return SolveResult(x=p.x, status=Status.INVALID_NUMBER_DETECTED, iterations=0,
                            wall_time_s=time.perf_counter() - t0, objective=nlp.objective(p.x),
@@ -245,8 +249,10 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         restore = None if wide is not None else (  # the trust box at its largest
             np.maximum((nlp.x_lb - p.x) / D, -o.restoration_trust),
             np.minimum((nlp.x_ub - p.x) / D, o.restoration_trust))
+        restoring = entry is not None and p.v_max > o.restoration_exit * entry
+        v_before = p.v_max
         sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide,
-                                               restore)
+                                               restore, restoring)
         qp_iters += admm
         hard = not qp.elastic
         rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)
@@ -302,6 +308,9 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         if not hard:  # restoration: count the steps that barely reduce the violation
             gain = _square_violation(p) - _square_violation(trial) if accepted else 0.0
             stalls = stalls + 1 if gain < o.stall_progress * _square_violation(p) else 0
+        # The restoration phase: entered by an accepted restoration step, left when the
+        # violation is down to restoration_exit × its value at entry (or a step is rejected).
+        entry = (entry if entry is not None else v_before) if accepted and not hard else None
         if accepted:
             p = trial
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": p.v_max,

@@ -57,6 +57,9 @@ class NLP:
         self.c_hi = np.concatenate([b.hi for b in self.blocks])
         self.c_scale = np.concatenate([b.scale for b in self.blocks])
         self.u_index = np.concatenate([layout.iu(i) for i in range(layout.n_nodes)])
+        # exact corrections of the trial points, fixed values first (project_order 0)
+        self._projections = sorted((b for b in self.blocks if hasattr(b, "project")),
+                                   key=lambda b: getattr(b, "project_order", 1))
         self.obj_scale = 1.0 / (layout.n_nodes * 1e4)  # Σu² of a UR10 holding a pose is ~1e4/node
 
     @property
@@ -95,11 +98,11 @@ class NLP:
         return h
 
     def project(self, x) -> np.ndarray:
-        """x with the blocks' exact corrections applied (u from the dynamics), within bounds."""
+        """x with the blocks' exact corrections applied (fixed values, then u from the
+        dynamics), within bounds."""
         x = np.asarray(x, float)
-        for b in self.blocks:
-            if hasattr(b, "project"):
-                x = b.project(x, self.robot)
+        for b in self._projections:
+            x = b.project(x, self.robot)
         return np.clip(x, self.x_lb, self.x_ub)
 
     # ------------------------------------------------------------- feasibility

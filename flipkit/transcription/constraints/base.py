@@ -87,5 +87,14 @@ class FixedValues(Block):
         self._cols.append(self.indices)
         self._finish(self.target, self.target, scale)
 
+    project_order = 0  # before the dynamics' projection, which reads the fixed q, q̇, q̈
+
+    def project(self, x: np.ndarray, robot) -> np.ndarray:
+        """x with Z[idx] = target exactly: a start or end state is held to the bit, not to
+        the round-off of a QP step (a plan starts exactly where it was asked to)."""
+        x = np.array(x, float)
+        x[self.indices] = self.target
+        return x
+
     def evaluate(self, ev):
         return ev.x[self.indices].copy(), np.ones(self.m)
