@@ -37,9 +37,10 @@ restoration steps in a row barely reduce the violation, Z is a stationary point 
 violation and the solve stops as ``infeasible``. An accepted restoration step opens a
 restoration phase, as in filter SQP methods: the next steps are restoration steps too, without
 the hard QP's attempts (each an ADMM run to an infeasibility verdict), until the violation is
-down to ``restoration_exit`` times its value when the phase began. The OSQP tolerance follows the iterate (inexact SQP): 0.1 × the
-violation (or, at a feasible iterate, the last predicted decrease), within ``qp_eps`` — loose
-far from a solution, tight near it, where the step must resolve residuals below ``tol``.
+down to ``restoration_exit`` times its value when the phase began. The OSQP tolerance follows
+the iterate (inexact SQP): 0.1 × the violation (or, at a feasible iterate, the last predicted
+decrease), within ``qp_eps`` — loose far from a solution, tight near it, where the step must
+resolve residuals below ``tol``.
 
 Converged: the hard QP's predicted decrease ≤ ``ftol``·J̃ and max scaled violation ≤ ``tol``
 (a stationary point a hair outside gets up to three minimum-norm Newton corrections), or a
@@ -61,6 +62,7 @@ from __future__ import annotations
 
 import math
 import time
+
 import numpy as np
 
 from flipkit.errors import NoSolutionFound
