@@ -306,3 +306,19 @@ def test_a_restoration_phase_skips_the_hard_qp_until_the_violation_has_fallen():
         entry = (entry if entry is not None else v_prev) if accepted_restoration else None
         v_prev = row["violation"]
     assert phase_rows >= 1
+
+
+def test_a_rejected_step_never_widens_the_trust_box():
+    """A rejected step shrinks Δ to a tenth of the shorter of the step and Δ. The step of the
+    largest box (taken when a shrunken box is infeasible) is longer than Δ: a tenth of its
+    length once set Δ back to the same value at the same point, and a flip from the atlas ran
+    85 identical iterations to max_iter (measured)."""
+    from flipkit.solvers import sqp as S
+
+    o = SQPOptions()
+    trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=2.38e-3, trust=2.38e-4, mu=1.0)
+    assert trust == pytest.approx(2.38e-5)
+    trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=1e-3, trust=0.5, mu=1.0)
+    assert trust == pytest.approx(1e-4)  # a short rejected step: a tenth of its length
+    trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=1e-9, trust=1e-6, mu=1.0)
+    assert trust == o.trust_min

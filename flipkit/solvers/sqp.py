@@ -174,8 +174,11 @@ def _adapt(o: SQPOptions, accepted: bool, step: float, ratio: float, d_len: floa
         trust = min(2.0 * trust, o.trust_max)
     elif accepted and step < 1.0:
         trust = max(step * d_len, o.trust_min)
-    elif not accepted:
-        trust = max(0.1 * d_len, o.trust_min) if d_len > 0 else 0.1 * trust
+    elif not accepted:  # never wider than before: a rejected step from the largest box
+        # (wide, longer than Δ) once reset Δ to a tenth of its own length, the same Δ at the
+        # same point each time: 85 identical iterations to max_iter (measured, a flip from
+        # the atlas at (0.87, −0.42); then the cold fallback solved it)
+        trust = max(0.1 * min(d_len, trust), o.trust_min) if d_len > 0 else 0.1 * trust
     return trust, mu
 
 
