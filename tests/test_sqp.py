@@ -239,24 +239,32 @@ def test_points_that_cannot_be_evaluated_are_never_taken(reference):
         solve_sqp(nlp, x)
 
 
-def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box():
+@pytest.fixture(scope="module")
+def cold_flip():
+    """The flip segment of Table I location 7 from its cold initial guess, built from the end
+    state of the pickup that plan_flip solves there."""
+    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.config import TABLE1_LOCATIONS, CellConfig
+    from flipkit.planning.planner import plan_flip
+
+    cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
+    pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
+                  if s.name == "pickup")
+    return build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+
+
+def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_flip):
     """The flip's cold guess, clipped to the velocity and acceleration limits, is
     inconsistent by O(1): within the trust box of 1 the condensed restoration QP (equalities
     hard) is infeasible and only the full-space one (every row elastic) gives a step; within
     ``restoration_trust`` the condensed one does, it holds the linearised equalities, and it
     removes most of the linearised violation."""
-    from flipkit.behaviors.segments import Models, build_segment
-    from flipkit.config import TABLE1_LOCATIONS, CellConfig
-    from flipkit.planning.planner import plan_flip
     from flipkit.solvers import sqp as S
     from flipkit.solvers.condensed_qp import CondensedQP
     from flipkit.solvers.full_qp import QPSubproblem
     from flipkit.solvers.iterate import Iterate
 
-    cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
-    pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
-                  if s.name == "pickup")
-    nlp = build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    nlp = cold_flip
     o, D = SQPOptions(), nlp.x_scale
     p = Iterate(nlp, nlp.project(nlp.x0), nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols])
     grad = nlp.gradient(p.x) * nlp.obj_scale * D
@@ -278,19 +286,12 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box():
     assert S._linearised_violation(nlp, p, sol.d) < 0.1 * float(p.v.sum())
 
 
-def test_a_restoration_phase_skips_the_hard_qp_until_the_violation_has_fallen():
+def test_a_restoration_phase_skips_the_hard_qp_until_the_violation_has_fallen(cold_flip):
     """After an accepted restoration step the SQP stays in restoration — one QP per
     iteration, no hard attempts — while the violation exceeds ``restoration_exit`` × its value
     when the phase began; the log of a cold flip follows that rule row by row, and the flip
     is solved."""
-    from flipkit.behaviors.segments import Models, build_segment
-    from flipkit.config import TABLE1_LOCATIONS, CellConfig
-    from flipkit.planning.planner import plan_flip
-
-    cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
-    pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
-                  if s.name == "pickup")
-    nlp = build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    nlp = cold_flip
     res = solve_sqp(nlp)
     assert res.status == "solved"
     exit_ = SQPOptions().restoration_exit
