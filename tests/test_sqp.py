@@ -277,7 +277,7 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     args = (nlp, o, p, grad, hess, o.prox, *box(o.trust_max), 1e-4)
     sol, qp, *_ = S._subproblem(*args)
     assert qp.elastic and isinstance(qp, QPSubproblem)  # the condensed form had no step
-    sol, qp, *_ = S._subproblem(*args, None, box(o.restoration_trust))
+    sol, qp, *_ = S._subproblem(*args, None, o.restoration_trust)
     assert qp.elastic and isinstance(qp, CondensedQP) and sol.status == "optimal"
     eq = nlp.c_lo == nlp.c_hi
     lin = p.cs + p.J @ sol.d

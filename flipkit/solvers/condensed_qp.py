@@ -98,8 +98,8 @@ class CondensedQP:
         self.box_hi = cp.Parameter(n, name="box_hi")
         lo_rows, hi_rows = self.G_lo @ self.v, self.G_hi @ self.v
         obj = 0.5 * cp.sum_squares(self.v) + self.g @ self.v
-        self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
         if elastic:
+            self.slack_reg = cp.Parameter(nonneg=True, name="slack_regularisation")
             s_lo = cp.Variable(len(self.lo_sel), name="s_lo")
             s_hi = cp.Variable(len(self.hi_sel), name="s_hi")
             lo_rows, hi_rows = lo_rows + s_lo, hi_rows - s_hi

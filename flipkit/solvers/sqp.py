@@ -82,9 +82,9 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
     raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
     if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
-    trust region), if given; else the restoration QP, in the box ``restore`` (default the
-    step box). ``restoring``: in the restoration phase, the restoration QP alone. Returns
-    (solution, QP object, μ, tries, ADMM iterations)."""
+    trust region), if given; else the restoration QP, in the box ±``restore`` ∩ the variable
+    bounds (default the step box). ``restoring``: in the restoration phase, the restoration QP
+    alone. Returns (solution, QP object, μ, tries, ADMM iterations)."""
     admm, attempt, sol = 0, -1, None
     for attempt in range(0 if restoring else 3):
         qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
@@ -124,7 +124,10 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
             return sol, qp, mu, attempt + 2, admm
     # Restoration: a least-squares (Levenberg–Marquardt) step on the rows, condensed (the
     # equalities hard) unless they and the box are incompatible, then in full space.
-    tries, box = 1 if restoring else attempt + 3, (d_lo, d_hi) if restore is None else restore
+    tries, box = 1 if restoring else attempt + 3, (d_lo, d_hi)
+    if restore is not None:
+        box = (np.maximum((nlp.x_lb - p.x) / nlp.x_scale, -restore),
+               np.minimum((nlp.x_ub - p.x) / nlp.x_scale, restore))
     for form in (("condensed_elastic", "elastic") if o.condense else ("elastic",)):
         qp = SUBPROBLEMS.get(nlp, form)
         qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), *box,
@@ -251,9 +254,7 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         eps = float(np.clip(o.qp_eps_factor * theta * tighten, *o.qp_eps))
         wide = (np.maximum((nlp.x_lb - p.x) / D, -o.trust_max),
                 np.minimum((nlp.x_ub - p.x) / D, o.trust_max)) if trust < o.trust_max else None
-        restore = None if wide is not None else (  # the trust box at its largest
-            np.maximum((nlp.x_lb - p.x) / D, -o.restoration_trust),
-            np.minimum((nlp.x_ub - p.x) / D, o.restoration_trust))
+        restore = None if wide is not None else o.restoration_trust  # Δ at its largest
         restoring = entry is not None and p.v_max > o.restoration_exit * entry
         v_before = p.v_max
         sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide,
