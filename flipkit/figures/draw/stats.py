@@ -8,15 +8,47 @@ import numpy as np
 from flipkit.figures.style import ACTUAL_COLOR, DESIRED_COLOR, SOLVER_COLORS, SOLVER_LABELS
 
 def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.ndarray]:
-    """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default)."""
+    """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default).
+
+    The bounds always contain the observed ratio ``k / n``: at ``k = 0`` the lower bound is
+    exactly 0 and at ``k = n`` the upper bound is exactly 1 (in floating point the closed form
+    gives ``1 - 1e-16`` there, which would make an error bar negative). Entries with ``n = 0``
+    are NaN.
+
+    Args:
+        successes: Successes ``k`` (array-like, ``0 <= k <= n``).
+        trials: Trials ``n`` (array-like, ``n >= 0``).
+        z: Standard-normal quantile of the two-sided level (1.96 for 95 %).
+
+    Raises:
+        ValueError: If a count is negative, not finite, or ``k > n``.
+    """
     k, n = np.asarray(successes, float), np.asarray(trials, float)
+    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(n))):
+        raise ValueError("wilson_interval: counts must be finite")
+    if np.any(k < 0) or np.any(n < 0) or np.any(k > n):
+        raise ValueError("wilson_interval: counts must satisfy 0 <= successes <= trials")
     n_safe = np.where(n > 0, n, 1.0)
     p = k / n_safe
     den = 1 + z**2 / n_safe
     mid = (p + z**2 / (2 * n_safe)) / den
     half = z * np.sqrt(p * (1 - p) / n_safe + z**2 / (4 * n_safe**2)) / den
-    lo, hi = np.clip(mid - half, 0, 1), np.clip(mid + half, 0, 1)
+    lo = np.minimum(np.clip(mid - half, 0, 1), p)
+    hi = np.maximum(np.clip(mid + half, 0, 1), p)
+    lo, hi = np.where(k == 0, 0.0, lo), np.where(k == n, 1.0, hi)
     return np.where(n > 0, lo, np.nan), np.where(n > 0, hi, np.nan)
+
+
+def ratio_error_bars(successes, trials, z: float = 1.96):
+    """Observed ratios and their Wilson error bars, ready for ``Axes.errorbar``.
+
+    Returns:
+        ``(ratio, [below, above])``: NaN where ``n = 0``; the bars are never negative.
+    """
+    k, n = np.asarray(successes, float), np.asarray(trials, float)
+    lo, hi = wilson_interval(k, n, z)
+    ratio = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
+    return ratio, [np.maximum(ratio - lo, 0.0), np.maximum(hi - ratio, 0.0)]
 
 
 def plot_success(ax, labels, ours_k, ours_n, paper_k, paper_n, title: str = "",
@@ -34,9 +66,8 @@ def plot_success(ax, labels, ours_k, ours_n, paper_k, paper_n, title: str = "",
     if pooled:
         x[-1] += 0.5
         ax.axvline(x[-1] - 0.75, color="0.6", lw=0.6, ls=":")
-    lo, hi = wilson_interval(ours_k, ours_n)
-    ratio = np.where(ours_n > 0, ours_k / np.where(ours_n > 0, ours_n, 1), np.nan)
-    ax.errorbar(x + 0.12, ratio, yerr=[ratio - lo, hi - ratio], fmt="o", color=ACTUAL_COLOR,
+    ratio, bars = ratio_error_bars(ours_k, ours_n)
+    ax.errorbar(x + 0.12, ratio, yerr=bars, fmt="o", color=ACTUAL_COLOR,
                 ms=4, capsize=1.5, lw=0.8, label="ours (simulated), 95 % CI")
     ax.plot(x - 0.12, paper_k / paper_n, "s", mfc="white", mec=DESIRED_COLOR, ms=4.5, mew=1.0,
             label="paper (real robot)")
@@ -75,10 +106,9 @@ def plot_success_series(ax, labels, series, paper_k, paper_n, title: str = "",
         k, n = np.asarray(sr["k"], float), np.asarray(sr["n"], float)
         if pooled:
             k, n = np.append(k, k.sum()), np.append(n, n.sum())
-        lo, hi = wilson_interval(k, n)
-        ratio = np.where(n > 0, k / np.where(n > 0, n, 1), np.nan)
+        ratio, bars = ratio_error_bars(k, n)
         color = sr.get("color", f"C{j - 1}")
-        ax.errorbar(x - 0.35 + width * (j + 0.5), ratio, yerr=[ratio - lo, hi - ratio],
+        ax.errorbar(x - 0.35 + width * (j + 0.5), ratio, yerr=bars,
                     fmt=sr.get("marker", "o"), color=color, mfc="white" if sr.get("open")
                     else color, ms=3.5, capsize=1.2, lw=0.7, label=sr["label"])
     ax.set_xticks(x, labels)
@@ -159,12 +189,14 @@ def plot_sensitivity(axes, result: dict, stages=("scoop", "pickup", "flip"),
     for ax, stage in zip(axes, stages):
         for end, marker, color in (("low", "v", DESIRED_COLOR), ("high", "^", ACTUAL_COLOR)):
             r = [result["parameters"][n][end] for n in names]
-            ratio = np.array([c["success"][stage] / c["trials"] for c in r])
+            ratio = np.array([c["success"][stage] / c["trials"] if c["trials"] else np.nan
+                              for c in r])
             off = -0.12 if end == "low" else 0.12
             ax.plot(ratio, y + off, marker, color=color, ms=3.5, ls="none",
                     label=f"{end} end of range")
         if nominal is not None:
-            ax.axvline(nominal["success"][stage] / nominal["trials"], color="0.3", lw=0.9,
+            if nominal["trials"]:
+                ax.axvline(nominal["success"][stage] / nominal["trials"], color="0.3", lw=0.9,
                        ls=":", label="nominal")
         ax.set_xlim(-0.05, 1.05)
         ax.set_ylim(-0.6, len(names) - 0.4)
