@@ -59,7 +59,7 @@ def failed_plan(flip_plan_file, tmp_path):
 
 
 @pytest.mark.parametrize("case, message", [
-    ("extension", "valid choices: '.gif', '.mp4'"), ("missing", "cannot read"),
+    ("extension", "give a file ending in .gif or .mp4"), ("missing", "cannot read"),
     ("failed", "solved flip plan"), ("not_json", "JSON"),
 ])
 def test_bad_input_exits_2(flip_plan_file, failed_plan, tmp_path, capsys, case, message):

@@ -79,8 +79,8 @@ def test_cli(plan, tmp_path, capsys):
 
 
 def test_a_tampered_plan_is_not_exported(plan, tmp_path, capsys):
-    """A joint angle moved by 0.01 rad: verify fails it, so export exits 1, names the failed
-    check and writes no file (a controller never gets an unverified trajectory)."""
+    """A joint angle moved by 0.01 rad: verify fails it, so export refuses it (exit 2), names
+    the failed check and writes no file (a controller never gets an unverified trajectory)."""
     import json
 
     path = plan.to_json(tmp_path / "plan.json")
@@ -88,11 +88,11 @@ def test_a_tampered_plan_is_not_exported(plan, tmp_path, capsys):
     doc["segments"][0]["q"][7][2] += 0.01
     path.write_text(json.dumps(doc))
     out = tmp_path / "traj.csv"
-    assert main(["export", str(path), "--rate", "250", "--csv", str(out)]) == 1
+    assert main(["export", str(path), "--rate", "250", "--csv", str(out)]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "plan fails" in err and "nothing written" in err
+    assert "\n" not in err and "plan fails" in err and "refused" in err
     assert not out.exists()
-    assert main(["export", str(path), "--rate", "250", "--csv", str(out), "--force"]) == 1
+    assert main(["export", str(path), "--rate", "250", "--csv", str(out), "--force"]) == 2
     assert not out.exists()
     with pytest.raises(FlipkitError, match="plan fails 'dynamics'|plan fails 'defects'"):
         write_csv(Plan.load(path), out, 250.0)

@@ -1,8 +1,9 @@
 """``flipkit animate``: render the simulated execution of a flip plan to a GIF or MP4.
 
 Exit status: 0 written; 2 bad input (missing or malformed plan file, a plan that is not a
-solved flip plan, an unknown extension, a bad size or rate, no offscreen GL) — one line on
-stderr.
+solved flip plan or fails ``flipkit verify``, an unknown extension, an output that is the
+plan, a size or frame rate out of range, no offscreen GL) — one line on stderr, nothing
+written.
 """
 
 from __future__ import annotations
@@ -12,6 +13,9 @@ import os
 from pathlib import Path
 
 MODES = ("feedforward", "position")  # flipkit.simulation.execute.MODES (checked in tests)
+FORMATS = (".gif", ".mp4")  # flipkit.simulation.animate.FORMATS (checked in tests)
+FPS_RANGE = (1.0, 120.0)  # frames/s
+SIZE_RANGE = (16, 4096)  # pixels, width and height
 
 
 def register(subparsers) -> None:
@@ -26,9 +30,9 @@ def register(subparsers) -> None:
                         help="output animation (.gif with Pillow; .mp4 needs imageio-ffmpeg)")
     parser.add_argument("--mode", choices=MODES, default="feedforward",
                         help="joint controller (default feedforward)")
-    parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
-    parser.add_argument("--width", type=int, default=480, help="pixels (default 480)")
-    parser.add_argument("--height", type=int, default=360, help="pixels (default 360)")
+    parser.add_argument("--fps", type=float, default=30.0, help="frames per second in [1, 120] (default 30)")
+    parser.add_argument("--width", type=int, default=480, help="pixels in [16, 4096] (default 480)")
+    parser.add_argument("--height", type=int, default=360, help="pixels in [16, 4096] (default 360)")
     parser.add_argument("--filmstrip", metavar="FILE.png",
                         help="also write the key frames (release, mid-flight, landing) as a PNG")
     parser.add_argument("--replan", action="store_true",
@@ -39,30 +43,34 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the input, simulate, render, write."""
-    os.environ.setdefault("MUJOCO_GL", "osmesa")  # before anything imports mujoco
-    from flipkit.simulation.animate import FORMATS, write_animation, write_filmstrip
-    from flipkit.errors import FlipkitError, InvalidChoiceError
-    from flipkit.simulation.execute import execute_plan
-    from flipkit.planning.plan_file import Plan
+    """Check the outputs and options, load and verify the plan, simulate, render, write."""
+    from flipkit.cli.common import check_float, check_int, precheck_plan
+    from flipkit.fileio import check_output, replace_with
 
-    ext = Path(args.out).suffix.lower()
-    if ext not in FORMATS:
-        raise InvalidChoiceError("animation format", ext or args.out, FORMATS)
-    plan = Plan.load(args.plan)
-    if plan.behavior != "flip" or plan.status != "solved":
-        raise FlipkitError(f"{args.plan}: a {plan.status} {plan.behavior} plan; animate needs a "
-                           f"solved flip plan")
+    check_output(args.out, "--out", FORMATS, inputs=[args.plan])
+    if args.filmstrip:
+        check_output(args.filmstrip, "--filmstrip", (".png",), inputs=[args.plan],
+                     outputs=[args.out])
+    check_float("--fps", args.fps, *FPS_RANGE, "frames/s")
+    check_int("--width", args.width, *SIZE_RANGE)
+    check_int("--height", args.height, *SIZE_RANGE)
+    precheck_plan(args.plan)
+    os.environ.setdefault("MUJOCO_GL", "osmesa")  # before anything imports mujoco
+    from flipkit.simulation.animate import write_animation, write_filmstrip
+    from flipkit.simulation.execute import execute_plan
+    from flipkit.planning.verify import load_verified
+
+    plan = load_verified(args.plan, ("flip",))
     replan = None
     if args.replan:
         from flipkit.planning.planner import replan_flip
 
         replan = replan_flip
     ex = execute_plan(plan, args.mode, replan=replan)
-    out = write_animation(ex, args.out, args.fps, args.width, args.height,
-                          progress=not args.no_progress)
+    out = replace_with(args.out, lambda tmp: write_animation(
+        ex, tmp, args.fps, args.width, args.height, progress=not args.no_progress))
     if args.filmstrip:
-        write_filmstrip(ex, args.filmstrip)
+        replace_with(args.filmstrip, lambda tmp: write_filmstrip(ex, tmp))
     print(f"flipkit animate: {args.mode} execution, {ex.run.t[-1]:.2f} s, wrote {out}"
           + (f" and {args.filmstrip}" if args.filmstrip else ""))
     return 0

@@ -1,12 +1,14 @@
-"""Options and output helpers shared by the sweep commands (compare-ik, validate)."""
+"""Options, bounds and file helpers shared by the sub-commands: the sweep options
+(compare-ik, validate), numeric options checked against their documented ranges, the cheap
+first reading of a plan file, and JSON written atomically."""
 
 from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
+import math
 
-from flipkit.errors import FlipkitError
+from flipkit.errors import ConfigError
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 
@@ -24,9 +26,48 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+MAX_TRIALS = 10_000  # trials per location of validate
+MAX_WORKERS = 256  # local worker processes
+MAX_GRID = 50  # points per axis of a grid over the grill (atlas build, compare-ik)
+
+
+def check_int(flag: str, value, lo: int, hi: int) -> int:
+    """``value`` of the option ``flag`` as an integer in [lo, hi].
+
+    Raises:
+        ConfigError: One line naming the flag, the range and the value.
+    """
+    if value is None or isinstance(value, bool) or int(value) != value or not lo <= value <= hi:
+        raise ConfigError(f"{flag} must be an integer in [{lo}, {hi}], got {value!r}")
+    return int(value)
+
+
+def check_float(flag: str, value, lo: float, hi: float, unit: str) -> float:
+    """``value`` of the option ``flag`` as a finite number in [lo, hi] (``unit``).
+
+    Raises:
+        ConfigError: One line naming the flag, the range and the value.
+    """
+    if value is None or not (math.isfinite(value) and lo <= value <= hi):
+        raise ConfigError(f"{flag} must be a number in [{lo:g}, {hi:g}] {unit}, got {value!r}")
+    return float(value)
+
+
+def precheck_plan(path) -> None:
+    """The cheap checks of a plan file (:func:`flipkit.planning.plan_doc.read_plan_doc`),
+    before a command imports the models: a malformed file is refused at once."""
+    from flipkit.planning.plan_doc import read_plan_doc
+
+    read_plan_doc(path)
+
+
 def write_json(path, doc: dict) -> None:
-    """Write ``doc`` as indented JSON (no NaN) to ``path``, or a one-line FlipkitError."""
+    """Write ``doc`` as indented JSON (no NaN) to ``path`` atomically, or a one-line
+    FlipkitError."""
+    from flipkit.fileio import write_text
+
     try:
-        Path(path).write_text(json.dumps(doc, indent=1, allow_nan=False) + "\n")
-    except OSError as exc:
-        raise FlipkitError(f"cannot write {path}: {exc.strerror or exc}") from None
+        text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    except ValueError as exc:
+        raise ConfigError(f"cannot write {path}: {exc}") from None
+    write_text(path, text)

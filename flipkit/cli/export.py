@@ -1,27 +1,32 @@
 """``flipkit export``: verify a plan, resample it at a controller rate and write it as CSV.
 
-Exit status: 0 written; 1 the plan fails verification (one line names the failed check; no
-file is written); 2 bad input (unreadable or malformed plan, bad rate, unwritable output).
+Exit status: 0 written; 2 refused, nothing written — one line on stderr: an unreadable or
+malformed plan, a plan that fails verification (the line names the failed check), a rate
+outside [1, 10000] Hz or one that gives fewer than two rows, an output that is not a
+writable ``.csv`` file or is the plan itself.
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
+
+RATE_RANGE = (1.0, 10_000.0)  # Hz, --rate (flipkit.planning.export.RATE_RANGE)
 
 
 def register(subparsers) -> None:
     """Add the ``export`` sub-command to the ``flipkit`` parser."""
     parser = subparsers.add_parser(
         "export", help="resample a plan at a controller rate and write t, q, qd as CSV",
-        description="Verify the plan (as flipkit verify; exit 1 and write nothing if it "
+        description="Verify the plan (as flipkit verify; exit 2 and write nothing if it "
                     "fails), then resample the concatenated segments of a plan at the controller rate "
                     "(cubic Hermite interpolation between nodes, as the collocation) and "
                     "write the columns t,q1..q6,qd1..qd6 (s, rad, rad/s).")
     parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/2; /1 is read too)")
     parser.add_argument("--rate", type=float, required=True, metavar="HZ",
-                        help="controller rate (Hz), e.g. 125 or 500")
-    parser.add_argument("--csv", required=True, metavar="OUT.csv", help="output CSV file")
+                        help="controller rate (Hz) in [1, 10000], e.g. 125 or 500; at least two "
+                             "rows over the plan's duration")
+    parser.add_argument("--csv", required=True, metavar="OUT.csv",
+                        help="output CSV file (.csv; not the plan)")
     parser.add_argument("--force", action="store_true",
                         help="export even a plan whose status is not 'solved' (it must still "
                              "pass verification)")
@@ -29,17 +34,18 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Load, resample, write; print one line with the row count."""
-    from flipkit.errors import VerificationError
+    """Check the output and rate, load, verify, resample, write; one line with the row count."""
+    from flipkit.cli.common import check_float, precheck_plan
+    from flipkit.fileio import check_output
+
+    check_output(args.csv, "--csv", (".csv",), inputs=[args.plan])
+    check_float("--rate", args.rate, RATE_RANGE[0], RATE_RANGE[1], "Hz")
+    precheck_plan(args.plan)
     from flipkit.planning.export import write_csv
     from flipkit.planning.plan_file import Plan
 
     plan = Plan.load(args.plan)
-    try:
-        rows = write_csv(plan, args.csv, args.rate, force=args.force)
-    except VerificationError as exc:
-        print(f"flipkit export: {exc}; nothing written", file=sys.stderr)
-        return 1
+    rows = write_csv(plan, args.csv, args.rate, force=args.force, where=args.plan)
     total = sum(s.T for s in plan.segments)
     print(f"flipkit export: wrote {rows} rows ({total:.3f} s at {args.rate:g} Hz) to {args.csv}")
     return 0

@@ -1,16 +1,20 @@
 """``flipkit validate``: simulated trials of pickup-and-flip plans (the paper's Table I).
 
 Exit status: 0 the trials ran (whatever their outcomes); 2 bad input (missing or malformed
-plan file, a plan that is not a solved flip plan, trials ≤ 0, a location off the grill, an
-unreachable scheduler, an unwritable output) — one line on stderr.
+plan file, a plan that is not a solved flip or serve plan or fails ``flipkit verify``,
+trials outside [1, 10000], a rate outside [10, 100000] Hz, a location off the grill, an
+unreachable scheduler, an output that is not a writable ``.json`` file or is the plan) — one
+line on stderr, checked before any trial runs, nothing written.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 
-from flipkit.cli.common import SOLVER_CHOICES, add_sweep_arguments, write_json
+from flipkit.cli.common import (MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
+                                check_float, check_int, precheck_plan, write_json)
+
+RATE_RANGE = (10.0, 100_000.0)  # Hz, --rate of the PD controller
 
 
 def register(subparsers) -> None:
@@ -29,14 +33,14 @@ def register(subparsers) -> None:
                       help="plan every location of a named set (table1: the paper's ten), "
                            "then simulate")
     parser.add_argument("--trials", type=int, required=True, metavar="K",
-                        help="simulated trials per location (>= 1)")
+                        help=f"simulated trials per location, in [1, {MAX_TRIALS}]")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="trial i draws from numpy default_rng(S + i) (default 0)")
     parser.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
                         help="collocation solver for --locations (default auto: the SQP, then IPOPT where it fails)")
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
-                        help="PD controller rate (Hz, default 1000)")
+                        help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
                         help="joint controller: plan torques + PD (feedforward, default) or "
                              "the robot's PD position control on servo-rate, delayed desired "
@@ -46,7 +50,8 @@ def register(subparsers) -> None:
                              "on the blade and re-plan pickup, flip and turn back for it "
                              "(serve: at the end of the carry, re-plan place and return home)")
     add_sweep_arguments(parser)
-    parser.add_argument("--json", required=True, metavar="OUT.json", help="output file")
+    parser.add_argument("--json", required=True, metavar="OUT.json",
+                        help="output file (.json; not the plan)")
     parser.set_defaults(run=run)
 
 
@@ -68,15 +73,26 @@ def format_table(out: dict) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Check the input, run the trials on the executor, write the JSON, print the table."""
+    from flipkit.fileio import check_output, check_output_dir
+
+    check_int("--trials", args.trials, 1, MAX_TRIALS)
+    check_float("--rate", args.rate, *RATE_RANGE, "Hz")
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    inputs = [args.plan]
+    check_output(args.json, "--json", (".json",), inputs=inputs)
+    for flag, directory in (("--plans", args.plans), ("--cache", args.cache)):
+        if directory is not None:
+            check_output_dir(directory, flag, inputs=inputs)
+    if args.plan is not None:
+        precheck_plan(args.plan)
+        from flipkit.planning.verify import load_verified
+
+        load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
     from flipkit.experiments.compare_ik import LOCATION_SETS
-    from flipkit.errors import ConfigError
     from flipkit.experiments.sweep import make_executor
     from flipkit.experiments.trials import validate_locations, validate_plan_file
 
-    if args.trials < 1:
-        raise ConfigError(f"--trials must be at least 1, got {args.trials}")
-    if not (math.isfinite(args.rate) and args.rate > 0):
-        raise ConfigError(f"--rate must be a positive number of Hz, got {args.rate}")
     common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
                   replan=args.replan)
     with make_executor(args.scheduler, args.workers) as executor:

@@ -19,26 +19,30 @@ def register(subparsers) -> None:
                     "between segments, friction cone and grill clearance. Exit 0 if the plan "
                     "passes, 1 if it fails, 2 if the file is unreadable or malformed.")
     parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/2; /1 is read too)")
-    parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT")
+    parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT (.json; not the plan)")
     parser.add_argument("--tol", type=float, metavar="TOL",
-                        help="tolerance in the solver's scaled units (default: "
+                        help="tolerance in the solver's scaled units, in [1e-12, 1] (default: "
                              "flipkit.planning.verify.TOL, 10x the SQP feasibility tolerance)")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Verify, print the table and the verdict; 0 pass, 1 fail."""
-    from flipkit.errors import FlipkitError
+    from flipkit.cli.common import check_float, precheck_plan
+    from flipkit.fileio import check_output
+
+    if args.json:
+        check_output(args.json, "--json", (".json",), inputs=[args.plan])
+    if args.tol is not None:
+        check_float("--tol", args.tol, 1e-12, 1.0, "(scaled units)")
+    precheck_plan(args.plan)
     from flipkit.planning.plan_file import Plan
     from flipkit.planning.verify import TOL, verify_plan
 
     report = verify_plan(Plan.load(args.plan), tol=TOL if args.tol is None else args.tol)
     print(report.table())
     if args.json:
-        try:
-            report.write_json(args.json)
-        except OSError as exc:
-            raise FlipkitError(f"cannot write {args.json}: {exc.strerror or exc}") from None
+        report.write_json(args.json)
     if report.ok:
         print(f"flipkit verify: {report.summary()}")
         return 0

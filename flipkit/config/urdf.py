@@ -34,12 +34,14 @@ def resolve_urdf(name: str) -> str:
 
     Raises:
         ConfigError: example-robot-data is not installed, the name escapes its directory, or
-            the file does not exist.
+            the file does not exist or is not a regular file (a device, a directory).
     """
     if not name.startswith(ERD_PREFIX):
         path = Path(name)
-        if not path.is_file():
+        if not path.exists():
             raise ConfigError(f"URDF file not found: {name}")
+        if not path.is_file():
+            raise ConfigError(f"URDF {name}: not a regular file; give the path of a .urdf file")
         return str(path.resolve())
     rel = PurePosixPath(name[len(ERD_PREFIX):])
     if rel.is_absolute() or ".." in rel.parts or not rel.parts:
@@ -74,6 +76,29 @@ def default_urdf() -> str:
     return resolve_urdf(ERD_PREFIX + UR10_URDF)
 
 
+MAX_URDF_BYTES = 16 * 2**20  # bytes: the UR10's URDF is 10 kB
+
+
 def urdf_sha256(path: str) -> str:
     """sha256 (hex) of the URDF file's bytes."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def check_urdf_text(path: str) -> None:
+    """Refuse a file that cannot be a URDF before a model is built from it: larger than
+    :data:`MAX_URDF_BYTES`, not UTF-8 text, or without a ``<robot`` element.
+
+    Raises:
+        ConfigError: One line naming the file.
+    """
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_URDF_BYTES:
+            raise ConfigError(f"URDF {path}: larger than {MAX_URDF_BYTES} bytes")
+        text = p.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise ConfigError(f"URDF {path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"URDF {path}: not a URDF (not UTF-8 text)") from None
+    if "<robot" not in text:
+        raise ConfigError(f"URDF {path}: not a URDF (no <robot> element)")

@@ -97,7 +97,8 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
         :func:`flipkit.experiments.trials.validate`, stages :data:`SERVE_STAGES`.
 
     Raises:
-        FlipkitError: The file is missing, malformed, not a serve plan or not solved.
+        FlipkitError: The file is missing, malformed, not a serve plan, not solved or fails
+            :func:`~flipkit.planning.verify.verify_plan`.
     """
     from pathlib import Path
 
@@ -106,6 +107,9 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     plan = Plan.load(path)
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
+    from flipkit.planning.verify import require_verified
+
+    require_verified(plan, path, ("serve",))  # nothing unverified is simulated
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,

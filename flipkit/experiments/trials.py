@@ -337,8 +337,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
     """:func:`validate` of one plan file (a serve plan: :func:`~flipkit.experiments.serve_trials.validate_serve`);
-    raises FlipkitError (one line) if it is missing, malformed, not a flip or serve plan or
-    not solved. ``kwargs`` as :func:`validate`."""
+    raises FlipkitError (one line) if it is missing, malformed, not a flip or serve plan, not
+    solved or fails :func:`~flipkit.planning.verify.verify_plan`. ``kwargs`` as :func:`validate`."""
     plan = Plan.load(path)
     if plan.behavior == "serve":  # the serve judge (flipkit.experiments.serve_trials)
         from flipkit.experiments.serve_trials import validate_serve
@@ -347,6 +347,9 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
         raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip or serve plan")
     if plan.status != "solved":
         raise FlipkitError(f"{path}: plan status is {plan.status!r}; validate needs a solved plan")
+    from flipkit.planning.verify import require_verified
+
+    require_verified(plan, path, ("flip",))  # nothing unverified is simulated
     info = {"status": plan.status, "file": str(path)}
     return validate([(plan.burger["location"].tolist(), info, Path(path).read_text())], trials,
                     seed, **kwargs)

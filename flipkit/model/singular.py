@@ -52,4 +52,58 @@ def branch_bounds(q_min, q_max, q_home, q_start, margin: float):
     return lo, hi
 
 
-__all__ = ["ELBOW", "SINGULARITY_MARGIN", "WRIST", "branch_bounds"]
+def branch_band(q_home, margin: float = SINGULARITY_MARGIN) -> np.ndarray:
+    """The band (kπ + margin, (k+1)π − margin) of q3 and q5 that holds q_home (rad), as rows
+    (lo, hi) for the joints (ELBOW, WRIST): the bounds :func:`branch_bounds` imposes on a
+    plan that starts inside them.
+
+    Returns:
+        (2, 2) array: row j is (lo, hi) of joint (ELBOW, WRIST)[j] (rad).
+    """
+    if not (math.isfinite(margin) and 0 <= margin < math.pi / 2):
+        raise ConfigError(f"singularity margin must be in [0, pi/2) rad, got {margin!r}")
+    band = []
+    for j in (ELBOW, WRIST):
+        k = math.floor(float(q_home[j]) / math.pi)
+        band.append((k * math.pi + margin, (k + 1) * math.pi - margin))
+    return np.array(band)
+
+
+def branch_violation(q, q_home, margin: float = SINGULARITY_MARGIN) -> np.ndarray:
+    """How far (rad, ≥ 0) q3 and q5 of each configuration lie outside :func:`branch_band`.
+
+    Args:
+        q: Configurations (n, nq) or (nq,) (rad). q_home: Fixes the branch (rad).
+        margin: Distance (rad) from the singular values.
+
+    Returns:
+        (n, 2) array: columns q3 (elbow) and q5 (wrist); 0 inside the band.
+    """
+    q = np.atleast_2d(np.asarray(q, float))
+    band = branch_band(q_home, margin)
+    x = q[:, [ELBOW, WRIST]]
+    return np.maximum(np.maximum(band[:, 0] - x, x - band[:, 1]), 0.0)
+
+
+def check_start(q, q_home, what: str = "start configuration",
+                margin: float = SINGULARITY_MARGIN) -> None:
+    """Refuse a start configuration whose q3 or q5 lies within ``margin`` of its singular
+    value (or on the other side of it): every plan from there would fail
+    ``verify`` (group ``singularity``).
+
+    Raises:
+        ConfigError: One line naming ``what``, the joint, its value and the band to use.
+    """
+    v = branch_violation(q, q_home, margin)[0]
+    band = branch_band(q_home, margin)
+    for col, (j, name) in enumerate(((ELBOW, "q3 (elbow)"), (WRIST, "q5 (wrist)"))):
+        if v[col] > 0:
+            lo, hi = band[col]
+            raise ConfigError(
+                f"{what}: {name} = {float(np.asarray(q, float)[j]):.3f} rad is within "
+                f"{margin:g} rad of its singularity (or past it); give {name.split()[0]} in "
+                f"[{lo:.3f}, {hi:.3f}] rad, the side of q_home")
+
+
+__all__ = ["ELBOW", "SINGULARITY_MARGIN", "WRIST", "branch_band", "branch_bounds",
+           "branch_violation", "check_start"]

@@ -23,9 +23,11 @@ from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.errors import FlipkitError
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.verify import TOL, verify_plan
+from flipkit.fileio import replace_with
+from flipkit.planning.verify import TOL, require_verified
 
 MAX_ROWS = 10_000_000  # refuse absurd rates rather than fill the disk
+RATE_RANGE = (1.0, 10_000.0)  # Hz: controller rates accepted
 _EPS = 1e-9  # s, slack on the last sample time (floating-point T_total · rate)
 
 
@@ -34,8 +36,9 @@ def _check_rate(rate) -> float:
         rate = float(rate)
     except (TypeError, ValueError):
         raise FlipkitError(f"export rate must be a number (Hz), got {rate!r}") from None
-    if not (math.isfinite(rate) and rate > 0):
-        raise FlipkitError(f"export rate must be a positive finite number (Hz), got {rate!r}")
+    lo, hi = RATE_RANGE
+    if not (math.isfinite(rate) and lo <= rate <= hi):
+        raise FlipkitError(f"export rate must be in [{lo:g}, {hi:g}] Hz, got {rate!r}")
     return rate
 
 
@@ -60,6 +63,9 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
     total = float(durations.sum())
     n = int(math.floor(total * rate + _EPS * rate)) + 1
+    if n < 2:
+        raise FlipkitError(f"export at {rate:g} Hz gives {n} row over the plan's {total:.3f} s; "
+                           f"give a rate of at least {math.ceil(1 / total):g} Hz for two rows")
     if n > MAX_ROWS:
         raise FlipkitError(f"export would write {n} rows ({total:.3f} s at {rate:g} Hz); "
                            f"the limit is {MAX_ROWS}")
@@ -77,7 +83,8 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     return t, q, qd
 
 
-def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL) -> int:
+def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL,
+              where=None) -> int:
     """Verify ``plan``, then write ``t,q1..qn,qd1..qdn`` (s, rad, rad/s) at ``rate`` to
     ``path``; return the row count.
 
@@ -87,19 +94,19 @@ def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float 
         plan: The plan. path: Output CSV. rate: Controller rate (Hz).
         force: Export even a plan whose status is not ``solved`` (it must still verify).
         tol: Verification tolerance (scaled units, :data:`flipkit.planning.verify.TOL`).
+        where: How messages name the plan (its file); default ``"plan"``.
 
     Raises:
-        VerificationError: The plan fails the independent check (the message names the worst
+        VerificationError: The plan is not solved (without ``force``) or fails the
+            independent check (the message names the worst
             check group, its segment and amount); nothing is written.
         FlipkitError: As :func:`resample`, or the file cannot be written.
     """
     t, q, qd = resample(plan, rate, force=force)
-    verify_plan(plan, tol=tol).raise_if_failed()
+    require_verified(plan, "plan" if where is None else where, force=force, tol=tol)
     nq = q.shape[1]
     header = ",".join(["t"] + [f"q{j + 1}" for j in range(nq)] + [f"qd{j + 1}" for j in range(nq)])
-    try:
-        np.savetxt(Path(path), np.column_stack([t, q, qd]), delimiter=",", header=header,
-                   comments="", fmt="%.17g")
-    except OSError as exc:
-        raise FlipkitError(f"cannot write {path}: {exc.strerror or exc}") from None
+    replace_with(Path(path), lambda tmp: np.savetxt(tmp, np.column_stack([t, q, qd]),
+                                                    delimiter=",", header=header, comments="",
+                                                    fmt="%.17g"))
     return t.size

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import functools
 import json
-import os
 from importlib import resources
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,6 +30,7 @@ from flipkit.behaviors.segments import CARRIES_BURGER
 from flipkit.config import BurgerConfig, CellConfig, GrillConfig, RobotConfig, SpatulaConfig
 from flipkit.model.contact import CONE_FORMS
 from flipkit.errors import ConfigError, PlanFileError
+from flipkit.fileio import OutputPathError, write_text
 from flipkit.behaviors.serve import SERVE_SUBBEHAVIORS
 from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
@@ -38,10 +38,9 @@ from flipkit.planning.json_fields import (check_array, check_choice, check_keys,
 from flipkit.planning.segment import SEGMENT_KEYS, Segment, default_payload
 from flipkit.planning.cell_record import cell_geometry, geometry_configs
 from flipkit.provenance import git_commit
-from flipkit.config.urdf import portable_urdf, resolve_urdf, urdf_sha256
+from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, urdf_sha256
 
-FORMAT = "flipkit-plan/2"
-FORMATS = ("flipkit-plan/1", FORMAT)  # readable; /1: before per-segment payloads and portable URDFs
+from flipkit.planning.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
 PLAN_BEHAVIORS = ("translate", "flip", "serve")
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
@@ -234,12 +233,13 @@ class Plan:
         r, w = self.robot, self.spatula["width"]
         try:
             path = resolve_urdf(r["urdf"])
+            check_urdf_text(path)
         except ConfigError as exc:
             raise PlanFileError(f"robot.urdf: {exc}") from None
         if r.get("urdf_sha256") is not None and urdf_sha256(path) != r["urdf_sha256"]:
             raise PlanFileError(f"robot.urdf: {path} is not the URDF the plan was made with "
-                                f"(sha256 {urdf_sha256(path)[:12]}..., recorded "
-                                f"{r['urdf_sha256'][:12]}...)")
+                                "(its sha256 differs from robot.urdf_sha256); give the plan's "
+                                "URDF or plan again")
         spatula = next((b for b in r["payload"] if b.get("name", "spatula") == "spatula"), None)
         if spatula is None:
             raise PlanFileError("robot.payload: no spatula body")
@@ -284,7 +284,13 @@ class Plan:
             name = segment
         else:
             payload, name = segment.payload, segment.name
-        robot = Robot(cell or self.cell(), with_burger="burger" in payload)
+        cell = cell or self.cell()
+        try:
+            robot = Robot(cell, with_burger="burger" in payload)
+        except (ValueError, RuntimeError, KeyError, IndexError) as exc:  # pinocchio's parser
+            reason = " ".join(str(exc).split())[:160]
+            raise PlanFileError(f"robot.urdf: {self.robot['urdf']} cannot be built into the arm's "
+                                f"model ({type(exc).__name__}: {reason})") from None
         if not np.allclose(robot.spatula_in_parent, self.robot["spatula_in_parent"], atol=1e-9):
             raise PlanFileError("robot.spatula_in_parent: not the flipkit spatula mount")
         recorded = {b["name"]: (k, b) for k, b in enumerate(self.robot["payload"])}
@@ -332,13 +338,10 @@ class Plan:
         if self.cell_geometry is not None:
             doc["cell_geometry"] = self.cell_geometry
         path = Path(path)
-        tmp = path.with_name(path.name + ".tmp")
         try:
-            tmp.write_text(dumps(doc) + "\n")
-            os.replace(tmp, path)
-        except OSError as exc:
-            raise PlanFileError(f"{path}: cannot write plan file ({exc.strerror or exc})") from None
-        return path
+            return write_text(path, dumps(doc) + "\n")
+        except OutputPathError as exc:
+            raise PlanFileError(f"{path}: cannot write plan file ({exc})") from None
 
     @classmethod
     def load(cls, path) -> "Plan":
@@ -352,28 +355,19 @@ class Plan:
                 (the one-line message names the file and the offending key).
         """
         path = Path(path)
+        doc = read_plan_doc(path)  # file, JSON, format, top-level keys: before any schema
         try:
-            doc = json.loads(path.read_text())
-        except OSError as exc:
-            raise PlanFileError(f"{path}: cannot read plan file ({exc.strerror or exc})") from None
-        except (UnicodeDecodeError, ValueError) as exc:
-            msg = str(exc).splitlines()[0]
-            raise PlanFileError(f"{path}: not a JSON file ({msg})") from None
-        try:
-            if isinstance(doc, dict) and doc.get("format") not in FORMATS:
-                raise ConfigError(f"format: expected one of {', '.join(map(repr, FORMATS))}, "
-                                  f"got {doc.get('format')!r}")
             keys = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
                     "cone", "segments", "created_by")
-            try:  # before the plan is built (it replaces the segment dicts), reported after
-                check_schema(doc)  # the key checks, whose messages are the more precise
-                schema_error = None
-            except ConfigError as exc:
-                schema_error = exc
-            plan = cls(**check_keys(doc, "", keys), format=doc["format"],
-                       cell_geometry=doc.get("cell_geometry"))
-            if schema_error is not None:
-                raise schema_error
+            fields = check_keys(doc, "", keys)
+            if isinstance(fields["segments"], list):  # the plan replaces the segment dicts:
+                fields["segments"] = list(fields["segments"])  # the schema sees the file's
+            # the key checks first: their messages are the more precise, and a file they
+            # refuse is refused without importing jsonschema
+            plan = cls(**fields, format=doc["format"], cell_geometry=doc.get("cell_geometry"))
+            check_schema(doc)
             return plan
+        except RecursionError:
+            raise PlanFileError(f"{path}: nested too deeply to be a plan file") from None
         except ConfigError as exc:
             raise PlanFileError(f"{path}: {exc}") from None

@@ -46,6 +46,9 @@ arm_clearance      every link (URDF collision hull), the handle and the blade  t
                    but the pairs the segment exempts (clearance_excluded);
                    coal distances, :mod:`flipkit.planning.verify_clearance` (m)
 orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     tol
+singularity        q3 and q5 at every node within the band of q_home held      tol
+                   SINGULARITY_MARGIN (0.2 rad) from sin q = 0: the planner's
+                   bounds (:func:`flipkit.model.singular.branch_bounds`) (rad)
 =================  ==========================================================  ==============
 
 ``tol`` (:data:`TOL` = 1e-5) is in the solver's scaled units, so every group's tolerance is
@@ -77,6 +80,7 @@ from flipkit.behaviors.segments import (SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, T
 from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
+from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.verify_clearance import CellGeometry, check_space
 from flipkit.planning.verify_flight import check_flight
@@ -164,6 +168,8 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
             ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
         report.add_nodes(group, k, _outside(np.asarray(x), lo, hi), tol * scale)
     _check_interpolant(report, k, seg, robot, tol)
+    report.add_nodes("singularity", k, branch_violation(seg.q, plan.robot["q_home"],
+                                                        SINGULARITY_MARGIN), tol)
     mid = np.arange(1, N, 2)  # Hermite–Simpson midpoints; a = i − 1, b = i + 1
     dt = (seg.t[mid + 1] - seg.t[mid - 1])[:, None]
     rows = []
@@ -288,3 +294,46 @@ def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
         end = states[-1]
         rest = sv.predicted_rest(cell, end.p, rpy(end.R)[2], on_blade)
         add("placing", k, [np.linalg.norm(rest - spot)], 1e-3, N)
+
+
+def require_verified(plan: Plan, where, behaviors=None, *, force: bool = False,
+                     tol: float = TOL) -> VerificationReport:
+    """The gate before anything runs a plan (simulates, renders, exports it): the plan is of
+    one of ``behaviors``, ``solved`` (unless ``force``) and passes :func:`verify_plan`.
+
+    Args:
+        plan: The plan. where: How messages name it (its file).
+        behaviors: The behaviours accepted (``None``: any).
+        force: Accept a plan whose status is not ``solved`` (it must still verify).
+        tol: Verification tolerance (scaled units, :data:`TOL`).
+
+    Returns:
+        The passing report.
+
+    Raises:
+        VerificationError: The plan is of another behaviour, not solved, or fails a check
+            group (one line naming the file, the group, its segment and amount).
+    """
+    from flipkit.errors import VerificationError
+
+    wanted = "" if behaviors is None else " " + " or ".join(behaviors)
+    if (behaviors is not None and plan.behavior not in behaviors) or (
+            plan.status != "solved" and not force):
+        raise VerificationError(f"{where}: plan status is {plan.status!r}, behavior "
+                                f"{plan.behavior!r}; this needs a solved{wanted} plan")
+    report = verify_plan(plan, tol=tol)
+    if not report.ok:
+        raise VerificationError(f"{where}: {report.summary()}; refused (`flipkit verify "
+                                f"{where}` lists every check)")
+    return report
+
+
+def load_verified(path, behaviors=None, *, force: bool = False, tol: float = TOL) -> Plan:
+    """:meth:`Plan.load` then :func:`require_verified`: a plan file that may be run.
+
+    Raises:
+        PlanFileError: As :meth:`Plan.load`. VerificationError: As :func:`require_verified`.
+    """
+    plan = Plan.load(path)
+    require_verified(plan, path, behaviors, force=force, tol=tol)
+    return plan

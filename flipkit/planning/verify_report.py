@@ -17,7 +17,7 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
           "flight_clearance": "m", "placing": "m", "arm_clearance": "m", "orientation": "rad",
-          "completeness": "segments"}
+          "singularity": "rad", "completeness": "segments"}
 
 
 @dataclass
@@ -115,9 +115,10 @@ class VerificationReport:
              "segment": g.segment, "node": g.node, "ok": g.ok} for g in self.groups.values()]}
 
     def write_json(self, path) -> None:
-        """Write :meth:`to_json` to ``path``."""
-        with open(path, "w") as fh:
-            json.dump(self.to_json(), fh, indent=1)
+        """Write :meth:`to_json` to ``path`` atomically (:func:`flipkit.fileio.write_text`)."""
+        from flipkit.fileio import write_text
+
+        write_text(path, json.dumps(self.to_json(), indent=1))
 
     def raise_if_failed(self) -> None:
         """Raise :class:`VerificationError` with :meth:`summary` when the plan fails."""

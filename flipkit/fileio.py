@@ -1,0 +1,202 @@
+"""Input and output files of the command line and the library: checked before any work,
+written atomically.
+
+An input is read only if it is a regular file of bounded size (a device such as
+``/dev/zero`` or a directory is refused by name, not reported as missing); text is decoded
+as UTF-8 with an optional byte-order mark. An output path is checked before anything is
+computed: its directory exists and is writable, its suffix names a format the command
+writes, and it is neither an input of the same command (same file after resolving links)
+nor another of its outputs. Outputs are written to a temporary file in the same directory
+and renamed over the target (:func:`os.replace`), so an interrupted run leaves the old file
+or the new one, never a part.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import tempfile
+from pathlib import Path
+from typing import Callable, Iterable
+
+from flipkit.errors import ConfigError
+
+MAX_INPUT_BYTES = 256 * 2**20  # bytes: the largest input file read (plans are < 1 MB)
+
+
+class InputFileError(ConfigError):
+    """An input file that is missing, not a regular file, too large or not decodable."""
+
+
+class OutputPathError(ConfigError):
+    """An output path that cannot be written, has an unknown format or names an input."""
+
+
+def check_input(path, what: str, max_bytes: int = MAX_INPUT_BYTES) -> Path:
+    """The path of an input file, checked to be a readable regular file of at most
+    ``max_bytes`` bytes.
+
+    Args:
+        path: The file. what: How the message names it (e.g. ``"--burgers"``).
+        max_bytes: Largest size accepted (bytes).
+
+    Raises:
+        InputFileError: One line naming ``what`` and the path.
+    """
+    p = Path(path)
+    try:
+        st = p.stat()
+    except OSError as exc:
+        reason = "not found" if isinstance(exc, FileNotFoundError) else (exc.strerror or exc)
+        raise InputFileError(f"{what} {p}: {reason}") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputFileError(f"{what} {p}: is a directory, expected a file")
+    if not stat.S_ISREG(st.st_mode):
+        raise InputFileError(f"{what} {p}: not a regular file (a device, pipe or socket)")
+    if st.st_size > max_bytes:
+        raise InputFileError(f"{what} {p}: {st.st_size} bytes, more than the "
+                             f"{max_bytes} bytes accepted")
+    if not os.access(p, os.R_OK):
+        raise InputFileError(f"{what} {p}: permission denied")
+    return p
+
+
+def read_text(path, what: str, max_bytes: int = MAX_INPUT_BYTES) -> str:
+    """The text of an input file (UTF-8, a leading byte-order mark dropped).
+
+    Raises:
+        InputFileError: As :func:`check_input`, or the bytes are not UTF-8.
+    """
+    p = check_input(path, what, max_bytes)
+    try:
+        return p.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputFileError(f"{what} {p}: not UTF-8 text (byte {exc.start})") from None
+    except OSError as exc:
+        raise InputFileError(f"{what} {p}: cannot read ({exc.strerror or exc})") from None
+
+
+def _same_file(a: Path, b) -> bool:
+    """Whether ``a`` and ``b`` name the same file (resolved; by inode where both exist)."""
+    b = Path(b)
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return a.resolve() == b.resolve()
+
+
+def _writable_dir(directory: Path, what: str, path) -> None:
+    if not directory.is_dir():
+        raise OutputPathError(f"{what} {path}: directory {directory} does not exist")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise OutputPathError(f"{what} {path}: directory {directory} is not writable")
+
+
+def check_output(path, what: str, suffixes: Iterable[str] | None, inputs: Iterable = (),
+                 outputs: Iterable = ()) -> Path:
+    """The path of an output file, checked before any work.
+
+    Args:
+        path: The output file. what: The flag that names it (e.g. ``"--json"``).
+        suffixes: The formats written, by suffix (lower case, e.g. ``(".json",)``); ``None``
+            accepts any.
+        inputs: The command's input files: the output may be none of them.
+        outputs: The command's other outputs: the output may be none of them.
+
+    Raises:
+        OutputPathError: One line naming ``what``, the path and what to change.
+    """
+    p = Path(path)
+    if suffixes is not None:
+        suffixes = tuple(suffixes)
+        if p.suffix.lower() not in suffixes:
+            raise OutputPathError(f"{what} {p}: unknown output format "
+                                  f"{p.suffix or '(no suffix)'!r}; give a file ending in "
+                                  f"{' or '.join(suffixes)}")
+    if p.is_dir():
+        raise OutputPathError(f"{what} {p}: is a directory; give a file name")
+    if p.exists() and not p.is_file():
+        raise OutputPathError(f"{what} {p}: not a regular file; give a file name")
+    _writable_dir(p.parent if str(p.parent) else Path("."), what, p)
+    for other in inputs:
+        if other is not None and _same_file(p, other):
+            raise OutputPathError(f"{what} {p}: is an input of this command ({other}); "
+                                  "give another output path")
+    for other in outputs:
+        if other is not None and _same_file(p, other):
+            raise OutputPathError(f"{what} {p}: is also another output of this command; "
+                                  "give another path")
+    return p
+
+
+def check_output_dir(path, what: str, inputs: Iterable = (), names: Iterable[str] = ()) -> Path:
+    """The path of an output directory (created when written), checked before any work:
+    not an existing file, its nearest existing ancestor writable, and none of the files
+    ``names`` that will be written in it an input.
+
+    Raises:
+        OutputPathError: One line naming ``what``, the path and what to change.
+    """
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise OutputPathError(f"{what} {p}: exists and is not a directory; give a directory")
+    base = p
+    while not base.exists():
+        if base.parent == base:
+            break
+        base = base.parent
+    _writable_dir(base, what, p)
+    inputs = [i for i in inputs if i is not None]
+    for name in names:
+        for other in inputs:
+            if _same_file(p / name, other):
+                raise OutputPathError(f"{what} {p}: would overwrite the input {other} with "
+                                      f"{name}; give another directory")
+    return p
+
+
+def _file_mode(path: Path) -> int:
+    """The permission bits a new ``path`` gets: those of the file it replaces, else 0o666
+    less the umask (as :func:`open` would create it), not mkstemp's 0o600."""
+    try:
+        return stat.S_IMODE(path.stat().st_mode)
+    except OSError:
+        mask = os.umask(0o022)
+        os.umask(mask)
+        return 0o666 & ~mask
+
+
+def replace_with(path, write: Callable[[Path], object]) -> Path:
+    """Write ``path`` atomically: ``write(tmp)`` fills a temporary file in the same directory
+    (with the same suffix, for writers that choose the format by it), which is then renamed
+    over ``path``. On any exception the temporary file is removed and ``path`` is unchanged.
+
+    Raises:
+        OutputPathError: The file cannot be written (``OSError``).
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".",
+                               prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}")
+    os.close(fd)
+    tmp = Path(tmp)
+    try:
+        write(tmp)
+        os.chmod(tmp, _file_mode(path))
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise OutputPathError(f"cannot write {path}: {exc.strerror or exc}") from None
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def write_text(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically (:func:`replace_with`)."""
+    return replace_with(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+__all__ = ["MAX_INPUT_BYTES", "InputFileError", "OutputPathError", "check_input",
+           "check_output", "check_output_dir", "read_text", "replace_with", "write_text"]
