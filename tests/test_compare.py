@@ -134,7 +134,7 @@ def test_dask_executor_gives_the_same_statuses(run):
     ([], "give --locations"),
     (["--burger", "0.2", "0.0", "0.072"], "outside the grill"),
     (["--burger", "nan", "0.0", "0.072"], "finite"),
-    (["--grid", "0", "2"], "grid nx"),
+    (["--grid", "0", "2"], "--grid must be an integer in [1, 50]"),
 ])
 def test_bad_input_exits_2(tmp_path, capsys, extra, message):
     assert main(["compare-ik", *extra, "--json", str(tmp_path / "o.json")]) == 2

@@ -5,8 +5,9 @@
 
 ``build`` solves pickup-and-flip cold on an NX × NY grid over the grill (local worker
 processes, or a Dask cluster with ``--scheduler``) and writes one compressed file (default:
-the package's own, ``flipkit/data/atlas.npz``, which ``plan flip`` uses). Exit 0 written;
-2 bad input or no location solved.
+the package's own, ``flipkit/data/atlas.npz``, which ``plan flip`` uses). NX and NY lie in
+[1, 50], the output ends in ``.npz`` and its directory is writable (checked before solving).
+Exit 0 written; 2 bad input or no location solved.
 """
 
 from __future__ import annotations
@@ -22,12 +23,13 @@ def register(subparsers) -> None:
     sub = p.add_subparsers(dest="action", required=True, metavar="ACTION")
     b = sub.add_parser("build", help="solve the grid and write the atlas")
     b.add_argument("--grid", nargs=2, type=int, metavar=("NX", "NY"), default=None,
-                   help="grid over the grill area (default 5 7)")
+                   help="grid over the grill area, each in [1, 50] (default 5 7)")
     b.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler (default: local "
                                                           "worker processes)")
-    b.add_argument("--workers", type=int, metavar="K", help="local worker processes "
-                                                            "(default: the CPU count)")
-    b.add_argument("--out", metavar="FILE", help="output (default: the package's atlas)")
+    b.add_argument("--workers", type=int, metavar="K", help="local worker processes, in "
+                                                            "[1, 256] (default: the CPU count)")
+    b.add_argument("--out", metavar="FILE.npz",
+                   help="output, .npz (default: the package's atlas)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
     b.set_defaults(run=run_build)
     i = sub.add_parser("info", help="describe an atlas")
@@ -37,17 +39,20 @@ def register(subparsers) -> None:
 
 def run_build(args: argparse.Namespace) -> int:
     """Build, write, summarise."""
-    from flipkit.errors import ConfigError
+    from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
     from flipkit.experiments.atlas import DEFAULT_GRID, build_atlas
+    from flipkit.fileio import check_output
     from flipkit.planning.atlas import default_path
 
     grid = tuple(args.grid) if args.grid else DEFAULT_GRID
-    if min(grid) < 1 or (args.workers is not None and args.workers < 1):
-        raise ConfigError(f"--grid needs two positive integers and --workers a positive one, "
-                          f"got {grid} and {args.workers}")
+    for n in grid:
+        check_int("--grid", n, 1, MAX_GRID)
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    out = check_output(args.out or default_path(), "--out", (".npz",))
     atlas = build_atlas(grid=grid, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
-    out = atlas.save(args.out or default_path())
+    out = atlas.save(out)
     m = atlas.meta
     print(f"flipkit atlas: {len(atlas)}/{grid[0] * grid[1]} locations solved "
           f"({len(m['failed'])} failed), cold median {m['median_wall_s']:.2f} s and "

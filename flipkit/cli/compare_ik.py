@@ -27,7 +27,7 @@ def register(subparsers) -> None:
     parser.add_argument("--locations", choices=("table1",),
                         help="a named location set: table1 = the paper's ten Table I points")
     parser.add_argument("--grid", nargs=2, type=int, metavar=("NX", "NY"),
-                        help="an NX x NY grid of cell centres over the grill area")
+                        help="an NX x NY grid of cell centres over the grill area, each in [1, 50]")
     parser.add_argument("--burger", nargs=3, type=float, action="append", metavar=("X", "Y", "Z"),
                         help="one more burger location (m); may be repeated")
     parser.add_argument("--solver", choices=SOLVER_CHOICES, default="sqp",
@@ -43,8 +43,19 @@ def run(args: argparse.Namespace) -> int:
     from flipkit.experiments.compare_ik import LOCATION_SETS, compare_ik, format_summary
     from flipkit.experiments.sweep import grill_grid, make_executor
 
+    from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
+    from flipkit.fileio import check_output, check_output_dir
+
     if args.locations is None and args.grid is None and not args.burger:
         raise ConfigError("give --locations table1, --grid NX NY and/or --burger X Y Z")
+    for n in args.grid or ():
+        check_int("--grid", n, 1, MAX_GRID)
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    check_output(args.json, "--json", (".json",))
+    for flag, directory in (("--plans", args.plans), ("--cache", args.cache)):
+        if directory is not None:
+            check_output_dir(directory, flag)
     locations = list(LOCATION_SETS[args.locations]) if args.locations else []
     if args.grid is not None:
         locations += grill_grid(nx=args.grid[0], ny=args.grid[1])

@@ -15,9 +15,10 @@ passed the check.
 from __future__ import annotations
 
 import argparse
-import os
 import csv
+import io
 import math
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -26,6 +27,7 @@ from flipkit.errors import ConfigError, FlipkitError
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 CSV_COLUMNS = (("x", "y", "z"), ("px", "py", "pz"))
+R_LAND_RANGE = (0.001, 0.2)  # m, --r-land
 DESCRIPTION = (
     "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
     "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
@@ -49,7 +51,7 @@ def register(subparsers) -> None:
                             "fails), sqp (cvxpy/OSQP) or ipopt (CasADi)")
         if json_out:
             p.add_argument("--json", required=True, metavar="PLAN.json",
-                           help="output plan file (flipkit-plan/2)")
+                           help="output plan file (flipkit-plan/2, .json; not an input)")
 
     t = sub.add_parser("translate", help="carry the burger flat from one point to another",
                        description="Translate the flat spatula (burger on it) between two "
@@ -58,7 +60,7 @@ def register(subparsers) -> None:
                    help="start position X Y Z (m); the start configuration is found by IK")
     t.add_argument("--to", dest="goal", nargs="+", required=True, metavar="X",
                    help="goal position X Y Z (m)")
-    t.add_argument("--yaw", default="0", metavar="RAD", help="spatula heading o_z (rad)")
+    t.add_argument("--yaw", default="0", metavar="RAD", help="spatula heading o_z (rad), any finite number: wrapped to (-pi, pi]")
     common(t)
     t.set_defaults(run=run_translate)
 
@@ -66,13 +68,16 @@ def register(subparsers) -> None:
                        description="Go to burger, scoop, pickup, flip and turn back "
                                    "(eqs. 22-27), chained by (29).")
     f.add_argument("--burger", nargs="+", required=True, metavar="X",
-                   help="burger location X Y Z (m), on the grill (z = grill height)")
+                   help="burger location X Y Z (m), on the grill (z = grill height, +-0.01 m)")
     f.add_argument("--start-q", nargs="+", metavar="Q",
-                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest, within "
+                        "the joint limits, q3 and q5 on q_home's side of the elbow and wrist "
+                        "singularities and 0.2 rad from them")
     f.add_argument("--land", nargs="+", metavar="X",
                    help="landing spot X Y (m) on the grill; default where the burger lies")
     f.add_argument("--r-land", default="0.02", metavar="M",
-                   help="radius (m) of the landing disc about the spot (default 0.02)")
+                   help="radius (m) of the landing disc about the spot, in [0.001, 0.2] "
+                        "(default 0.02)")
     atlas_arguments(f)
     common(f)
     f.set_defaults(run=run_flip)
@@ -82,11 +87,13 @@ def register(subparsers) -> None:
                                    "friction cone, place on the table by tilting the blade "
                                    "and withdrawing it, return home.")
     s.add_argument("--burger", nargs="+", required=True, metavar="X",
-                   help="burger location X Y Z (m), on the grill (z = grill height)")
+                   help="burger location X Y Z (m), on the grill (z = grill height, +-0.01 m)")
     s.add_argument("--table-spot", nargs="+", required=True, metavar="X",
                    help="where the burger should rest on the table, X Y (m)")
     s.add_argument("--start-q", nargs="+", metavar="Q",
-                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest")
+                   help="start configuration Q1 .. Q6 (rad), default q_home; at rest, within "
+                        "the joint limits, q3 and q5 on q_home's side of the elbow and wrist "
+                        "singularities and 0.2 rad from them")
     atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
     s.set_defaults(run=run_serve)
@@ -96,11 +103,14 @@ def register(subparsers) -> None:
                                    "previous solved plan ended; write DIR/burger_<k>.json "
                                    "and DIR/summary.csv.")
     b.add_argument("--burgers", required=True, metavar="FILE.csv",
-                   help="CSV with header x,y,z (or px,py,pz); lines starting with # skipped")
-    b.add_argument("--out", required=True, metavar="DIR", help="output directory")
+                   help="CSV with header x,y,z (or px,py,pz), 1 to 5 rows, burgers one "
+                        "diameter apart; lines starting with # skipped")
+    b.add_argument("--out", required=True, metavar="DIR",
+                   help="output directory (burger_<k>.json, summary.csv; not holding an "
+                        "input of those names)")
     b.add_argument("--workers", type=int, default=None, metavar="K",
-                   help="plan the burgers in K worker processes (default: the CPU count; 1: "
-                        "one after another in this process)")
+                   help="plan the burgers in K worker processes, in [1, 256] (default: the "
+                        "CPU count; 1: one after another in this process)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
     atlas_arguments(b)
     common(b, json_out=False)
@@ -121,6 +131,70 @@ def _numbers(what: str, values, count: int | None = None) -> list[float]:
     return out
 
 
+BURGER_HEIGHT_TOL = 0.01  # m: |z − h_g| accepted (flipkit.behaviors.targets.check_location)
+
+
+def _yaw(value) -> float:
+    """``--yaw`` (rad) wrapped to (−π, π]: 2π plans as 0."""
+    y = _numbers("--yaw", value)[0]
+    return math.pi - (math.pi - y) % (2 * math.pi)
+
+
+def _on_grill(loc, cell, what: str) -> None:
+    """Refuse a burger location (m) whose height is more than BURGER_HEIGHT_TOL from h_g."""
+    h = cell.grill.height
+    if abs(loc[2] - h) > BURGER_HEIGHT_TOL:
+        raise ConfigError(f"{what}: z = {loc[2]:g} m is not on the grill surface: give z = "
+                          f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
+
+
+def _burger(values, cell) -> list[float]:
+    """``--burger X Y Z`` (m), its height on the grill surface within BURGER_HEIGHT_TOL."""
+    loc = _numbers("--burger", values, 3)
+    _on_grill(loc, cell, "--burger")
+    return loc
+
+
+def _start_q(values, cell):
+    """``--start-q Q1 .. Q6`` (rad) within the joint limits and on q_home's side of the elbow
+    and wrist singularities, SINGULARITY_MARGIN from them (every plan from there would fail
+    verify's ``singularity`` check); ``None`` if not given."""
+    if values is None:
+        return None
+    from flipkit.model.singular import check_start
+    from flipkit.planning.inputs import check_joint_vector
+    from flipkit.planning.planner import models_for
+
+    q = _numbers("--start-q", values, 6)
+    robot = models_for(cell).for_segment("go_to_burger")
+    q = check_joint_vector("--start-q", q, robot.q_min, robot.q_max, "rad")
+    check_start(q, robot.q_home, "--start-q")
+    return q
+
+
+def _json_out(args, inputs=()) -> None:
+    """``--json``: a writable ``.json`` file, not an input (checked before planning)."""
+    from flipkit.fileio import check_output
+
+    check_output(args.json, "--json", (".json",), inputs=[*inputs, getattr(args, "atlas", None)])
+
+
+def check_spacing(locations, diameter: float, where: str) -> None:
+    """Refuse two burgers closer than one diameter (m): they would overlap on the grill.
+
+    Raises:
+        ConfigError: One line naming the two rows (from 1) and their distance.
+    """
+    for i, a in enumerate(locations):
+        for j in range(i + 1, len(locations)):
+            b = locations[j]
+            gap = math.hypot(a[0] - b[0], a[1] - b[1])
+            if gap < diameter:
+                raise ConfigError(f"{where}: burgers {i + 1} and {j + 1} are {gap * 1e3:.0f} mm "
+                                  f"apart on the grill; they need one burger diameter "
+                                  f"({diameter * 1e3:.0f} mm)")
+
+
 def read_locations(path) -> list[tuple[float, float, float]]:
     """Burger locations (m) from a CSV with columns x,y,z or px,py,pz (others ignored).
 
@@ -132,11 +206,13 @@ def read_locations(path) -> list[tuple[float, float, float]]:
     """
     from flipkit.planning.planner import MAX_BATCH
 
+    from flipkit.fileio import InputFileError, read_text
+
     try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or exc
-        raise ConfigError(f"{path}: cannot read burger CSV ({reason})") from None
+        text = read_text(path, "--burgers", 2**20)
+    except InputFileError as exc:
+        raise ConfigError(f"--burgers {path}: cannot read burger CSV "
+                          f"({str(exc).split(': ', 1)[-1]})") from None
     lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
@@ -194,8 +270,9 @@ def run_translate(args: argparse.Namespace) -> int:
     from flipkit.planning.planner import plan_translate
 
     _quiet()
+    _json_out(args)
     start, goal = _numbers("--from", args.start, 3), _numbers("--to", args.goal, 3)
-    plan = plan_translate(start, goal, solver=args.solver, yaw=_numbers("--yaw", args.yaw)[0])
+    plan = plan_translate(start, goal, solver=args.solver, yaw=_yaw(args.yaw))
     plan.to_json(args.json)
     return _report(plan, args.json)
 
@@ -205,11 +282,19 @@ def run_flip(args: argparse.Namespace) -> int:
     from flipkit.behaviors.segments import SegmentOptions
     from flipkit.planning.planner import plan_flip
 
+    from flipkit.config import CellConfig
+
     _quiet()
-    location = _numbers("--burger", args.burger, 3)
-    q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
+    _json_out(args)
+    cell = CellConfig()
+    location = _burger(args.burger, cell)
     land = None if args.land is None else _numbers("--land", args.land, 2)
-    options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
+    r_land = _numbers("--r-land", args.r_land)[0]
+    if not R_LAND_RANGE[0] <= r_land <= R_LAND_RANGE[1]:
+        raise ConfigError(f"--r-land must be in [{R_LAND_RANGE[0]:g}, {R_LAND_RANGE[1]:g}] m, "
+                          f"got {r_land:g}")
+    options = SegmentOptions(r_land=r_land)
+    q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, options)
     plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
                      atlas=atlas)
@@ -244,11 +329,21 @@ def run_serve(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     from flipkit.planning.planner import plan_serve
 
-    _quiet()
-    location = _numbers("--burger", args.burger, 3)
-    spot = _numbers("--table-spot", args.table_spot, 2)
-    q_start = None if args.start_q is None else _numbers("--start-q", args.start_q, 6)
     from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.serve import check_table_spot
+    from flipkit.config import CellConfig
+    from flipkit.errors import UnreachableError
+
+    _quiet()
+    _json_out(args)
+    cell = CellConfig()
+    location = _burger(args.burger, cell)
+    spot = _numbers("--table-spot", args.table_spot, 2)
+    try:
+        check_table_spot(cell, spot)
+    except UnreachableError as exc:
+        raise UnreachableError(f"--table-spot: {exc}") from None
+    q_start = _start_q(args.start_q, cell)
 
     atlas = _atlas(args, SegmentOptions())
     plan = plan_serve(location, spot, q_start, solver=args.solver, atlas=atlas)
@@ -261,14 +356,26 @@ def run_serve(args: argparse.Namespace) -> int:
 def run_batch(args: argparse.Namespace) -> int:
     """Plan the batch, write every plan and summary.csv, print the table."""
     from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.fileio import write_text
     from flipkit.planning.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
 
+    from flipkit.cli.common import MAX_WORKERS, check_int
+    from flipkit.config import CellConfig
+    from flipkit.fileio import check_output_dir
+
     _quiet()
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
     locations = read_locations(args.burgers)
+    cell = CellConfig()
+    for k, loc in enumerate(locations, 1):
+        _on_grill(loc, cell, f"{args.burgers}: burger {k}")
+    check_spacing(locations, cell.burger.diameter, str(args.burgers))
+    check_output_dir(args.out, "--out", inputs=[args.burgers, args.atlas],
+                     names=[*(f"burger_{k}.json" for k in range(1, len(locations) + 1)),
+                            "summary.csv"])
     atlas = _atlas(args, SegmentOptions())
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    if workers < 1:
-        raise ConfigError(f"--workers must be a positive integer, got {workers}")
     executor = None
     if workers > 1 and len(locations) > 1:
         from flipkit.experiments.sweep import make_executor
@@ -286,11 +393,12 @@ def run_batch(args: argparse.Namespace) -> int:
         rows = summary_table(plans)
         for k, plan in enumerate(plans, 1):
             plan.to_json(out / f"burger_{k}.json")
-        with open(out / "summary.csv", "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(SUMMARY_HEADER[:1] + ("x", "y", "z") + SUMMARY_HEADER[2:])
-            for k, loc, *rest in rows:
-                w.writerow([k, *loc, *rest])
+        text = io.StringIO(newline="")
+        w = csv.writer(text)
+        w.writerow(SUMMARY_HEADER[:1] + ("x", "y", "z") + SUMMARY_HEADER[2:])
+        for k, loc, *rest in rows:
+            w.writerow([k, *loc, *rest])
+        write_text(out / "summary.csv", text.getvalue())
     except OSError as exc:
         raise FlipkitError(f"{out}: cannot write ({exc.strerror or exc})") from None
     print(format_summary(rows))

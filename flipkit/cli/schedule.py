@@ -3,10 +3,11 @@
 Exit status: 0 every motion planned, solved and verified; 1 a motion's plan failed — one
 line per failure on stderr; the timeline and the plan files (the failed one with
 ``"status": "failed"``) are still written; 2 bad input (unreadable or malformed CSV, wrong
-header, a non-finite or negative number, a burger off the grill, duplicate ids, two burgers
-closer than one diameter on the grill at once) or a motion kind without a planner
-(``flipkit.planning.planner.plan_serve`` missing) — one line on stderr, nothing planned,
-nothing written.
+header, a non-finite number, a drop time outside [0, 86400] s, a burger off the grill,
+duplicate ids, two burgers closer than one diameter on the grill at once, more burgers to
+serve than table spots), an output that is not writable, of an unknown format or the cook
+order itself, or a motion kind without a planner (``flipkit.planning.planner.plan_serve``
+missing) — one line on stderr, nothing planned, nothing written.
 """
 
 from __future__ import annotations
@@ -19,8 +20,9 @@ import warnings
 from pathlib import Path
 
 from flipkit.cli.common import SOLVER_CHOICES, write_json
-from flipkit.errors import ConfigError, FlipkitError
+from flipkit.errors import FlipkitError
 
+FIGURE_FORMATS = (".pdf", ".png", ".svg")  # --figure, by suffix
 DESCRIPTION = (
     "Flip every burger of a cook order at its 90 s mark and serve it to a table spot after "
     "60 s on its second side, with one arm: the motions are ordered earliest deadline "
@@ -35,10 +37,11 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("schedule", help="schedule and plan the flips and serves of a "
                                                 "cook (one arm)", description=DESCRIPTION)
     p.add_argument("burgers", metavar="BURGERS.csv",
-                   help="cook order: header burger,t_drop,x,y (id, drop time s, grill "
-                        "position m); lines starting with # skipped")
-    p.add_argument("--json", required=True, metavar="TIMELINE.json", help="timeline output")
-    p.add_argument("--figure", metavar="PATH", help="Gantt chart (PDF or PNG by suffix)")
+                   help="cook order: header burger,t_drop,x,y (id, drop time s in [0, "
+                        "86400], grill position m); lines starting with # skipped")
+    p.add_argument("--json", required=True, metavar="TIMELINE.json",
+                   help="timeline output (.json; not the cook order)")
+    p.add_argument("--figure", metavar="PATH", help="Gantt chart (.pdf, .png or .svg)")
     p.add_argument("--plans", metavar="DIR",
                    help="directory for the motions' plan files (default: TIMELINE_plans/ "
                         "beside the timeline); the timeline names them relative to its own "
@@ -48,8 +51,8 @@ def register(subparsers) -> None:
     p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
                    help="NLP solver (default auto: the SQP, then IPOPT where it fails)")
     p.add_argument("--workers", type=int, default=None, metavar="K",
-                   help="plan the motions ahead in K worker processes (default: the CPU "
-                        "count; 1: one after another in this process)")
+                   help="plan the motions ahead in K worker processes, in [1, 256] "
+                        "(default: the CPU count; 1: one after another in this process)")
     p.add_argument("--no-atlas", action="store_true",
                    help="flips from cold starts (default: warm-started from the package's "
                         "atlas, `flipkit atlas build`, when it serves the default options)")
@@ -69,19 +72,28 @@ def run(args: argparse.Namespace) -> int:
     from flipkit.planning.motions import default_planners
     from flipkit.planning.schedule import format_timeline, schedule_cook
 
+    from flipkit.cli.common import MAX_WORKERS, check_int
+    from flipkit.fileio import check_output, check_output_dir
+
     warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+    inputs = [args.burgers]
+    check_output(args.json, "--json", (".json",), inputs=inputs)
+    if args.figure:
+        check_output(args.figure, "--figure", FIGURE_FORMATS, inputs=inputs,
+                     outputs=[args.json])
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
     cell = CellConfig()
-    burgers = read_cook_csv(args.burgers, cell)
+    burgers = read_cook_csv(args.burgers, cell, serve=not args.flip_only)
     kinds = ("flip",) if args.flip_only else ("flip", "serve")
     atlas = None if args.no_atlas else default_atlas(cell)
     planners = default_planners(kinds, cell, args.solver, atlas)  # MissingPlannerError first
     timeline_path = Path(args.json)
     plans = Path(args.plans) if args.plans else timeline_path.with_name(
         timeline_path.stem + "_plans")
+    check_output_dir(plans, "--plans", inputs=inputs + [args.json, args.figure])
     q_home = cell.robot.q_home
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    if workers < 1:
-        raise ConfigError(f"--workers must be a positive integer, got {workers}")
     executor = None
     if workers > 1:
         from flipkit.experiments.sweep import make_executor
@@ -89,7 +101,8 @@ def run(args: argparse.Namespace) -> int:
         from flipkit.planning.prefetch import PrefetchPlanners
 
         executor = make_executor(workers=workers)
-        planners = PrefetchPlanners(check_cook(burgers, cell), kinds, q_home,
+        planners = PrefetchPlanners(check_cook(burgers, cell, serve=not args.flip_only),
+                                    kinds, q_home,
                                     table_spots(cell), executor, cell, args.solver, atlas)
     try:
         timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
@@ -139,15 +152,16 @@ def _figure(doc: dict, path) -> None:
 
     from flipkit import figures
     from flipkit.figures.draw import plot_schedule
+    from flipkit.fileio import replace_with
 
     with figures.style():
         fig, ax = plt.subplots(figsize=(figures.PAGE_WIDTH, 0.35 * len(doc["burgers"]) + 1.6),
                                layout="constrained")
         plot_schedule(ax, doc)
         try:
-            fig.savefig(path, metadata={"CreationDate": None} if str(path).endswith(".pdf")
-                        else None)
-        except (OSError, ValueError) as exc:
+            replace_with(path, lambda tmp: fig.savefig(
+                tmp, metadata={"CreationDate": None} if str(path).endswith(".pdf") else None))
+        except ValueError as exc:
             raise FlipkitError(f"cannot write figure {path}: {exc}") from None
         finally:
             plt.close(fig)

@@ -107,13 +107,15 @@ class Atlas:
 
     # ----------------------------------------------------------------- files
     def save(self, path) -> Path:
-        """Write one compressed ``.npz`` (float32 solutions: a guess needs no more)."""
+        """Write one compressed ``.npz`` (float32 solutions: a guess needs no more),
+        atomically (:func:`flipkit.fileio.replace_with`)."""
+        from flipkit.fileio import replace_with
+
         path = Path(path)
         arrays = {f"x_{k}": v.astype(np.float32) for k, v in self.solutions.items()}
         header = {"format": FORMAT, "structure": self.structure, **self.meta}
-        np.savez_compressed(path, locations=self.locations, header=np.array(json.dumps(header)),
-                            **arrays)
-        return path
+        return replace_with(path, lambda tmp: np.savez_compressed(
+            tmp, locations=self.locations, header=np.array(json.dumps(header)), **arrays))
 
     @classmethod
     def load(cls, path, cell: CellConfig | None = None,
@@ -123,13 +125,30 @@ class Atlas:
         Raises:
             AtlasError: Unreadable, not an atlas, or stale (other options or cell).
         """
+        from flipkit.fileio import InputFileError, check_input
+
+        try:
+            check_input(path, "atlas")
+            with open(path, "rb") as fh:
+                magic = fh.read(4)
+        except (InputFileError, OSError) as exc:
+            raise AtlasError(f"cannot read atlas {path}: "
+                             f"{str(exc).split(': ', 1)[-1]}") from None
+        if magic != b"PK\x03\x04":  # every .npz is a zip archive
+            raise AtlasError(f"cannot read atlas {path}: not an .npz archive; give a file "
+                             "written by `flipkit atlas build`, or --no-atlas")
         try:
             with np.load(Path(path), allow_pickle=False) as data:
                 header = json.loads(str(data["header"]))
                 locations = data["locations"]
                 solutions = {k[2:]: data[k] for k in data.files if k.startswith("x_")}
-        except (OSError, ValueError, KeyError) as exc:
-            raise AtlasError(f"cannot read atlas {path}: {' '.join(str(exc).split())}") from None
+        except (OSError, ValueError, KeyError, RecursionError) as exc:
+            reason = ("an array holds Python objects, which are never loaded"
+                      if "allow_pickle" in str(exc) else " ".join(str(exc).split())[:200])
+            raise AtlasError(f"cannot read atlas {path}: {reason}; give a file written by "
+                             "`flipkit atlas build`") from None
+        if not isinstance(header, dict):
+            raise AtlasError(f"{path}: not a {FORMAT} file (its header is not an object)")
         if header.get("format") != FORMAT:
             raise AtlasError(f"{path}: not a {FORMAT} file (format {header.get('format')!r})")
         structure = header.pop("structure", {})

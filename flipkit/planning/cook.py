@@ -26,6 +26,7 @@ FIRST_SIDE_S = 90.0  # s on the first side (paper Sec. I)
 SECOND_SIDE_S = 60.0  # s on the second side (paper Sec. I)
 CSV_HEADER = ("burger", "t_drop", "x", "y")
 SPOT_GAP = 0.01  # m: clearance between served burgers and from the table's edge (ours)
+MAX_T_DROP = 24 * 3600.0  # s: latest drop time accepted (a day on the order's clock)
 EXAMPLE_ORDER = Path(__file__).resolve().parents[1] / "data" / "cook_five.csv"  # 5 in 20 s
 
 
@@ -63,18 +64,20 @@ class CookBurger:
         return (self.x, self.y, cell.grill.height)
 
 
-def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order"
-               ) -> list[CookBurger]:
+def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order",
+               serve: bool = True) -> list[CookBurger]:
     """Check a cook order; return it sorted by drop time (ties: as given).
 
-    Checks: at least one burger; ids non-empty and unique; drop times finite and ≥ 0;
-    positions finite and on the grill (:meth:`~flipkit.config.GrillConfig.contains`); two
-    burgers on the grill at once (nominal stays [t_drop, t_drop + 150 s] overlapping) at
-    least one burger diameter apart; no more burgers than table spots.
+    Checks: at least one burger; ids non-empty and unique; drop times finite and in
+    [0, :data:`MAX_T_DROP`] s; positions finite and on the grill
+    (:meth:`~flipkit.config.GrillConfig.contains`); two burgers on the grill at once (nominal
+    stays [t_drop, t_drop + 150 s] overlapping) at least one burger diameter apart; with
+    ``serve``, no more burgers than table spots.
 
     Args:
         burgers: :class:`CookBurger` rows. cell: The cell (default
             :class:`~flipkit.config.CellConfig`). where: Prefix of error messages.
+        serve: Whether the burgers are served (the table's capacity applies).
 
     Raises:
         CookOrderError: The first problem found, one line naming the burger.
@@ -96,6 +99,9 @@ def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order
         if b.t_drop < 0:
             raise CookOrderError(f"{where}: burger {b.burger!r}: t_drop must be >= 0 s, "
                                  f"got {b.t_drop:g}")
+        if b.t_drop > MAX_T_DROP:
+            raise CookOrderError(f"{where}: burger {b.burger!r}: t_drop must be <= "
+                                 f"{MAX_T_DROP:g} s (a day), got {b.t_drop:g}")
         if not cell.grill.contains((b.x, b.y)):
             g = cell.grill
             raise CookOrderError(
@@ -113,15 +119,17 @@ def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order
                     f"apart on the grill at the same time; they need one burger diameter "
                     f"({d * 1e3:.0f} mm)")
     capacity = len(table_spots(cell))
-    if len(rows) > capacity:
+    if serve and len(rows) > capacity:
         raise CookOrderError(f"{where}: {len(rows)} burgers, but the table holds "
-                             f"{capacity} served burgers")
+                             f"{capacity} served burgers; split the order or plan the flips "
+                             f"alone (--flip-only)")
     return sorted(rows, key=lambda b: b.t_drop)
 
 
-def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
-    """Read a cook order CSV: header ``burger,t_drop,x,y`` (in that order), one row per
-    burger; blank lines and lines starting with ``#`` are skipped.
+def read_cook_csv(path, cell: CellConfig | None = None, serve: bool = True) -> list[CookBurger]:
+    """Read a cook order CSV (UTF-8, with or without a byte-order mark): header
+    ``burger,t_drop,x,y`` (in that order), one row per burger; blank lines and lines starting
+    with ``#`` are skipped. ``serve`` as :func:`check_cook`.
 
     Returns:
         The burgers sorted by drop time (:func:`check_cook`).
@@ -131,11 +139,13 @@ def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
             values, a non-numeric or non-finite number, and everything :func:`check_cook`
             refuses — one line naming the file (and the line).
     """
+    from flipkit.fileio import InputFileError, read_text
+
     try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or exc
-        raise CookOrderError(f"{path}: cannot read the cook order ({reason})") from None
+        text = read_text(path, "cook order", 2**20)
+    except InputFileError as exc:
+        raise CookOrderError(f"{path}: cannot read the cook order "
+                             f"({str(exc).split(': ', 1)[-1]})") from None
     lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
@@ -159,7 +169,7 @@ def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
             raise CookOrderError(f"{path}: line {n}: t_drop, x and y must be numbers, got "
                                  f"{','.join(cells[1:])}") from None
         burgers.append(CookBurger(cells[0], t_drop, x, y))
-    return check_cook(burgers, cell, where=str(path))
+    return check_cook(burgers, cell, where=str(path), serve=serve)
 
 
 def table_spots(cell: CellConfig | None = None, gap: float = SPOT_GAP) -> list[tuple]:
@@ -189,5 +199,5 @@ def table_spots(cell: CellConfig | None = None, gap: float = SPOT_GAP) -> list[t
     return sorted(spots, key=lambda s: (round(float(np.hypot(*(np.array(s) - centre))), 9), s))
 
 
-__all__ = ["CSV_HEADER", "EXAMPLE_ORDER", "FIRST_SIDE_S", "SECOND_SIDE_S", "SPOT_GAP", "CookBurger",
+__all__ = ["CSV_HEADER", "EXAMPLE_ORDER", "FIRST_SIDE_S", "MAX_T_DROP", "SECOND_SIDE_S", "SPOT_GAP", "CookBurger",
            "CookOrderError", "check_cook", "read_cook_csv", "table_spots"]

@@ -207,7 +207,7 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
     for kind in kinds:
         if kind not in planners:
             raise MissingPlannerError(f"no planner given for the {kind!r} motions")
-    order = check_cook(burgers, cell)
+    order = check_cook(burgers, cell, serve="serve" in kinds)
     spots = list(table_spots(cell) if spots is None else spots)
     if "serve" in kinds and len(spots) < len(order):
         raise ConfigError(f"{len(order)} burgers but {len(spots)} table spots")
