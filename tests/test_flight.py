@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import central_fd
 
-from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.behaviors.segments import R_LAND, SegmentOptions, build_segment
 from flipkit.transcription.layout import Evaluation
 from flipkit.config import CellConfig
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
@@ -108,8 +108,8 @@ def test_landing_spot_off_the_grill_is_refused(flip_nlp):
 def test_solved_flip_records_a_landing_that_verify_recomputes(flip_plan):
     flip = next(s for s in flip_plan.segments if s.name == "flip")
     land = flip.landing
-    assert flip.release["node"] == 14 and land["r_land"] == 0.02
-    assert land["offset"] <= 0.02 + 1e-6 and land["tilt_deg"] >= 150.0 - 1e-6
+    assert flip.release["node"] == 14 and land["r_land"] == R_LAND
+    assert land["offset"] <= R_LAND + 1e-6 and land["tilt_deg"] >= 150.0 - 1e-6
     np.testing.assert_allclose(land["target"], flip_plan.burger["location"][:2])
     cell = flip_plan.cell()
     again = recompute_landing(flip_plan.robot_for("flip", cell), flip, cell)
@@ -158,7 +158,7 @@ def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
 
 @pytest.mark.parametrize("extra, message", [
     (["--land", "2", "0"], "landing spot (2.000, 0.000) is outside the grill"),
-    (["--r-land", "0"], "r_land must be in (0, 0.1] m"),
+    (["--r-land", "0"], "--r-land must be in"),
     (["--land", "0.7"], "--land"),
 ])
 def test_cli_landing_options_fail_in_one_line(tmp_path, capsys, extra, message):

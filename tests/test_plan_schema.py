@@ -16,7 +16,7 @@ def test_a_solved_flip_plan_matches_the_documented_format(flip_plan_file):
     jsonschema.validate(doc, SCHEMA)
     flip = next(s for s in doc["segments"] if s["name"] == "flip")
     assert set(flip["landing"]) == {"target", "r_land", "point", "offset", "tilt_deg",
-                                    "time_of_flight", "burger_on_blade"}
+                                    "time_of_flight", "burger_on_blade", "scenarios"}
 
 
 def test_the_schema_rejects_a_flip_without_landing_and_a_scoop_with_one(flip_plan_file):

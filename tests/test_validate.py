@@ -70,9 +70,10 @@ def test_perturbation_draws_within_their_ranges():
     assert all(abs(x["grill_offset_m"]) <= 0.002 for x in d)
     assert all(0.8 <= x["mu_factor"] <= 1.2 and 0.9 <= x["mass_factor"] <= 1.1 for x in d)
     assert np.std([x["dx_m"] for x in d]) == pytest.approx(0.005, rel=0.2)
-    zero = Perturbations(0.0, 0.0, (1.0, 1.0), (1.0, 1.0)).draw(rng)
+    assert np.std([x["sense_dx_m"] for x in d]) == pytest.approx(0.005, rel=0.2)
+    zero = Perturbations(0.0, 0.0, (1.0, 1.0), (1.0, 1.0), 0.0).draw(rng)
     assert zero == {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0,
-                    "mass_factor": 1.0}
+                    "mass_factor": 1.0, "sense_dx_m": 0.0, "sense_dy_m": 0.0}
     with pytest.raises(ConfigError):
         Perturbations(position_sigma=-0.001)
     with pytest.raises(ConfigError):

@@ -8,6 +8,7 @@ Constructors validate their arguments and raise :class:`~flipkit.errors.ConfigEr
 * :mod:`~flipkit.config.physics`: the simulated cell's physical parameters and their ranges;
 * :mod:`~flipkit.config.space`: the cell's solid boxes (grill, table, back wall) and the
   margin the whole arm keeps from them;
+* :mod:`~flipkit.config.uncertainty`: the scoop's outcome spread that robust flips plan for;
 * :mod:`~flipkit.config.urdf`: URDFs named portably (plan files), with their sha256;
 * :mod:`~flipkit.config.checks`: the argument checks they share.
 """
@@ -16,10 +17,12 @@ from flipkit.config.cell import (GRAVITY, TABLE1_LOCATIONS, BurgerConfig, CellCo
                                  GrillConfig, RobotConfig, SpatulaConfig, TableConfig, TaskLimits)
 from flipkit.config.physics import PHYSICAL_RANGES, PhysicsConfig, with_parameter
 from flipkit.config.space import BACK_WALL, CellBox, SpaceConfig
+from flipkit.config.uncertainty import ScoopUncertainty
 from flipkit.config.urdf import default_urdf, portable_urdf, resolve_urdf, urdf_sha256
 
 __all__ = ["BACK_WALL", "GRAVITY", "PHYSICAL_RANGES", "TABLE1_LOCATIONS", "BurgerConfig",
-           "CellBox", "CellConfig", "GrillConfig", "PhysicsConfig", "RobotConfig", "SpaceConfig",
+           "CellBox", "CellConfig", "GrillConfig", "PhysicsConfig", "RobotConfig", "ScoopUncertainty",
+           "SpaceConfig",
            "SpatulaConfig",
            "TableConfig", "TaskLimits", "default_urdf", "portable_urdf", "resolve_urdf",
            "urdf_sha256", "with_parameter"]

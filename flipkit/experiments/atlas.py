@@ -44,8 +44,11 @@ def solve_entry(item) -> dict:
     models, q, qd = models_for(cell), None, None
     for seg in plan.segments:
         q0 = seg.q[0] if q is None else q
+        landing = seg.landing or {}  # a robust flip's scenario rows are part of its NLP
         nlp = build_segment(seg.name, models, q0, seg.qd[0] if qd is None else qd,
-                            location=location, options=options)
+                            location=location, options=options,
+                            on_blade=landing.get("burger_on_blade", (0.0, 0.0)),
+                            scenarios=[r["burger_on_blade"] for r in landing.get("scenarios", [])])
         out["structure"][seg.name] = nlp.structure_key
         out["x"][seg.name] = nlp.layout.pack(seg.q, seg.qd, seg.qdd, seg.u, seg.alpha, seg.T).tolist()
         q, qd = seg.q[-1], seg.qd[-1]

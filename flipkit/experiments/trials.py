@@ -16,7 +16,7 @@ the previous ones succeeded, as in Table I.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +26,7 @@ from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.experiments.perturbations import Perturbations
 from flipkit.planning.plan_file import Plan
 
 TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
@@ -33,46 +34,6 @@ HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to l
 STAGES = ("scoop", "pickup", "flip")
 _PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
               "cone", "segments", "created_by")
-
-
-@dataclass(frozen=True)
-class Perturbations:
-    """How each trial's real cell differs from the plan's model.
-
-    Attributes:
-        position_sigma: Standard deviation (m) of the Gaussian burger placement error, drawn
-            independently in x and in y. Default 5 mm (a burger put down by hand).
-        grill_offset: Half-width a (m) of the uniform grill-height offset U(−a, a).
-            Default 2 mm.
-        mu_scale: Range (lo, hi) of the uniform factor on the burger–spatula friction
-            coefficient μ (the burger–grill friction is unchanged). Default (0.8, 1.2).
-        mass_scale: Range (lo, hi) of the uniform factor on the burger mass, in MuJoCo and in
-            the arm's payload (not in the feed-forward). Default (0.9, 1.1).
-    """
-
-    position_sigma: float = 0.005
-    grill_offset: float = 0.002
-    mu_scale: tuple = (0.8, 1.2)
-    mass_scale: tuple = (0.9, 1.1)
-
-    def __post_init__(self):
-        for name in ("position_sigma", "grill_offset"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
-                raise ConfigError(f"{name} must be a non-negative number (m)")
-        for name in ("mu_scale", "mass_scale"):
-            lo, hi = (float(v) for v in getattr(self, name))
-            if not (0 < lo <= hi < np.inf):
-                raise ConfigError(f"{name} must be a range 0 < lo <= hi, got {(lo, hi)}")
-            object.__setattr__(self, name, (lo, hi))
-
-    def draw(self, rng: np.random.Generator) -> dict:
-        """One trial's perturbation: ``dx_m``, ``dy_m``, ``grill_offset_m`` (m),
-        ``mu_factor``, ``mass_factor``, drawn in this order."""
-        dx, dy = rng.normal(0.0, self.position_sigma, 2)
-        return {"dx_m": float(dx), "dy_m": float(dy),
-                "grill_offset_m": float(rng.uniform(-self.grill_offset, self.grill_offset)),
-                "mu_factor": float(rng.uniform(*self.mu_scale)),
-                "mass_factor": float(rng.uniform(*self.mass_scale))}
 
 
 def plan_from_text(text: str) -> Plan:
@@ -156,6 +117,8 @@ def run_trial(job: dict) -> dict:
         job: ``plan_text`` (a solved flip plan file's text), ``trial`` (index), ``seed``,
             ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
             rate, Hz), ``mode`` (:data:`flipkit.simulation.execute.MODES`; default ``"feedforward"``),
+            ``command`` (position mode's command stream,
+            :data:`flipkit.planning.servo_command.COMMANDS`; default ``"compensated"``),
             optionally ``replan`` (bool, see :func:`validate`) and ``physics``
             (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
             simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
@@ -184,8 +147,9 @@ def run_trial(job: dict) -> dict:
         from flipkit.planning.planner import replan_flip
 
         replan = replan_flip
+    command = job.get("command", "compensated")
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan)
+                      replan=replan, command=command)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
@@ -194,10 +158,11 @@ def run_trial(job: dict) -> dict:
     ok["flip"] = ok["pickup"] and flip.ok
     return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, flip, run),
             "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
-            "perturbation": draw, "tracking": errors, "mode": mode,
+            "perturbation": draw, "tracking": errors, "mode": mode, "command": command,
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
             "predicted_landing_xy": _predicted(ex.plan),
-            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
+            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
+                       "time_s": ex.replan_time_s}
             if replan is not None else None, "physics": dict(job.get("physics") or {})}
 
 
@@ -246,13 +211,14 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
                rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
-               replan: bool = False, physics: dict | None = None) -> list:
+               replan: bool = False, physics: dict | None = None,
+               command: str = "compensated") -> list:
     """The :func:`run_trial` jobs of one plan (``physics``: see :func:`run_trial`; the key
     is left out when empty, so the cache keys of nominal trials do not change)."""
     extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
     return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
              "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
-             "replan": bool(replan), **extra} for i in range(trials)]
+             "replan": bool(replan), "command": command, **extra} for i in range(trials)]
 
 
 def trial_key(job: dict) -> dict:
@@ -289,7 +255,7 @@ def plan_location(job: dict) -> dict:
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
              rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
-             replan: bool = False) -> dict:
+             replan: bool = False, command: str = "compensated") -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -303,6 +269,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
             and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planner.replan_flip`);
             ``False`` runs the plans open loop.
+        command: Position mode's command stream (:data:`flipkit.planning.servo_command.COMMANDS`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
 
     Returns:
@@ -320,14 +287,16 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
         if text is not None:
-            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan)
+            new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan,
+                             command=command)
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
-            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "locations": entries,
+            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
+            "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
                         "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},

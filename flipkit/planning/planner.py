@@ -23,10 +23,11 @@ import numpy as np
 
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
-from flipkit.config import CellConfig
+from flipkit.config import CellConfig, ScoopUncertainty
 from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoiceError,
                             UnreachableError)
 from flipkit.model.ik import solve_pose
+from flipkit.model.scoop import ScoopPath
 from flipkit.planning.inputs import check_joint_vector, check_position
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
@@ -110,7 +111,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
-              solver: str = "auto", land=None, on_blade=(0.0, 0.0),
+              solver: str = "auto", land=None, on_blade=None,
               options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.behaviors.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
@@ -123,7 +124,9 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         land: Landing spot (x, y) (m) on the grill; default where the burger was picked up.
             The flipped burger's centre must land within ``options.r_land`` of it.
         on_blade: Where the burger's centre will sit on the blade (x, y) (blade frame, m)
-            when it is released; default the blade centre.
+            when it is released; default ``None``: where the scoop model
+            (:func:`scoop_scenarios`) says the planned scoop leaves it, and with
+            ``options.robust`` every scenario of its spread lands too.
         cell, solver, options: As :func:`plan_translate`.
         atlas: A warm-start :class:`~flipkit.planning.atlas.Atlas` built for ``cell`` and
             ``options``: each segment starts from the atlas's interpolated solution (and
@@ -145,7 +148,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
-    on_blade = _on_blade(on_blade, cell)
+    on_blade = None if on_blade is None else _on_blade(on_blade, cell)
     models = models_for(cell)
     robot = models.bare
     q = robot.q_home.copy() if q_start is None else check_joint_vector(
@@ -177,15 +180,53 @@ def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
     return xy
 
 
+def scoop_scenarios(segment: Segment, location, cell: CellConfig,
+                    uncertainty: ScoopUncertainty = ScoopUncertainty()) -> tuple:
+    """Where the solved ``segment`` (a scoop) leaves the burger on the blade, and the spread.
+
+    The friction model of :mod:`flipkit.model.scoop` with the cell's nominal patty and grill
+    gives the predicted place (x, y) (m, blade frame). The scenarios bound its spread over what
+    the cell does not know (:class:`~flipkit.config.ScoopUncertainty`): the burger-blade
+    friction at both ends of its range combined with the burger put ± k σ along the scoop
+    (the extremes of x), and ± k σ sideways (y, which the scoop does not change).
+
+    Returns:
+        ``(predicted, scenarios)``: (2,) and a list of four (x, y), clipped to the blade.
+    """
+    robot = models_for(cell).bare
+    path = ScoopPath(robot, segment.t, segment.q, segment.qd, location,
+                     grill_height=cell.grill.height)
+    kw = {"diameter": cell.burger.diameter, "mu_grill": cell.physics.mu_grill,
+          "rim": cell.physics.burger_edge_radius}
+    mu, d = cell.burger.mu, uncertainty.placement
+    nominal = path.outcome(mu_blade=mu, **kw)
+    xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), **kw)[0]
+          for f in uncertainty.mu_scale for s in (-d, d)]
+    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    scenarios = [(min(xs), nominal[1]), (max(xs), nominal[1]),
+                 (nominal[0], nominal[1] - d), (nominal[0], nominal[1] + d)]
+    return np.clip(nominal, -half, half), [np.clip(v, -half, half) for v in scenarios]
+
+
 def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0,
            guess=None) -> Plan:
-    """The flip's subbehaviours after the segments ``done`` from (q, q̇)."""
+    """The flip's subbehaviours after the segments ``done`` from (q, q̇); ``on_blade`` None:
+    the flip is planned for where the scoop model puts the burger after the solved scoop,
+    and with ``options.robust`` for the scenarios of its spread too."""
+    where = {"on_blade": on_blade, "scenarios": ()}
+
     def build(name, q, qd, o):
-        return build_segment(name, models, q, qd, location=pb, land=spot, on_blade=on_blade,
-                             options=o)
+        return build_segment(name, models, q, qd, location=pb, land=spot,
+                             on_blade=(0.0, 0.0) if where["on_blade"] is None
+                             else where["on_blade"], scenarios=where["scenarios"], options=o)
+
+    def decorate(name, seg):
+        if name == "scoop" and on_blade is None:
+            where["on_blade"], scenarios = scoop_scenarios(seg, pb, cell)
+            where["scenarios"] = scenarios if options.robust else ()
 
     return chain_segments("flip", tg.SUBBEHAVIORS, build, q, qd, done, cell, solver, options,
-                          t0, pb, guess=guess)
+                          t0, pb, decorate=decorate, guess=guess)
 
 
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",

@@ -24,6 +24,25 @@ _PLACING_KEYS = ("spot", "on_blade", "heading", "pitch")
 _LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
 
 
+def _scenarios(rows) -> list[dict]:
+    """The checked ``landing.scenarios`` records of a robust flip: for each place of the
+    burger on the blade, its predicted landing (the keys of ``landing`` but ``target``)."""
+    if not isinstance(rows, list):
+        raise ConfigError("landing.scenarios: expected a list of landing records")
+    out = []
+    for k, row in enumerate(rows):
+        f = check_keys(row, f"landing.scenarios[{k}]", ("burger_on_blade", *_LANDING_KEYS[1:]))
+        out.append({"burger_on_blade": check_array(f"landing.scenarios[{k}].burger_on_blade",
+                                                   f["burger_on_blade"], (2,)).tolist(),
+                    "r_land": check_number(f"landing.scenarios[{k}].r_land", f["r_land"],
+                                           positive=True),
+                    "point": check_array(f"landing.scenarios[{k}].point", f["point"],
+                                         (3,)).tolist(),
+                    **{key: check_number(f"landing.scenarios[{k}].{key}", f[key])
+                       for key in _LANDING_KEYS[3:]}})
+    return out
+
+
 @dataclass(frozen=True)
 class SolverInfo:
     """Solver statistics of a segment: name, status, iterations, wall time (s), objective
@@ -135,7 +154,9 @@ class Segment:
                 **{k: check_number(f"landing.{k}", f[k]) for k in _LANDING_KEYS[3:]},
                 "burger_on_blade": check_array("landing.burger_on_blade",
                                           self.landing.get("burger_on_blade", (0.0, 0.0)),
-                                          (2,)).tolist()}
+                                          (2,)).tolist(),
+                **({"scenarios": _scenarios(self.landing["scenarios"])}
+                   if self.landing.get("scenarios") else {})}
         if self.placing is not None:
             if self.name not in ("carry", "place"):
                 raise ConfigError("placing: only carry and place segments have it")
@@ -175,6 +196,9 @@ class Segment:
         block = next((b for b in nlp.blocks if b.name == "landing"), None)
         if block is not None:
             release, landing = block.record(nlp.robot, x)
+            more = next((b for b in nlp.blocks if b.name == "landing_scenarios"), None)
+            if more is not None:
+                landing["scenarios"] = more.record(nlp.robot, x)
         return cls(nlp.name, T, L.s * T, nodes[:, 0], nodes[:, 1], nodes[:, 2], nodes[:, 3],
                    L.alpha(x), list(nlp.cone_nodes), info, goal, release, landing,
                    [body["name"] for body in nlp.robot.payload])

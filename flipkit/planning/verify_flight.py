@@ -11,7 +11,9 @@ pinocchio.
 
 Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt short
 of :data:`TILT_MIN_DEG` (deg), and the recorded prediction against the recomputed one (point
-m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.verify.LANDING_TOL`). Group
+m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.verify.LANDING_TOL`).
+Group ``landing_scenarios`` (robust flips): the same rows for every recorded scenario of the
+burger's place on the blade, each against its own ``r_land``. Group
 ``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes
 after the release.
 """
@@ -28,8 +30,11 @@ TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
 _LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
 
 
-def recompute_landing(robot, seg, cell) -> dict | None:
+def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
     """Release state and ballistic landing of ``seg``'s burger; ``None`` without a release.
+
+    ``on_blade``: the burger's centre on the blade (x, y) (m); default the one recorded in
+    ``seg.landing``.
 
     Returns:
         ``c0``, ``v0`` (centre and its velocity at release, m, m/s), ``w`` (rad/s), ``R0``
@@ -42,7 +47,8 @@ def recompute_landing(robot, seg, cell) -> dict | None:
     _, _, _, Jw = robot.pose_jacobians(seg.q[r])
     w = Jw @ seg.qd[r]
     h, g = cell.burger.thickness, np.asarray(cell.gravity, float)
-    bx, by = (seg.landing or {}).get("burger_on_blade", (0.0, 0.0))
+    bx, by = ((seg.landing or {}).get("burger_on_blade", (0.0, 0.0)) if on_blade is None
+              else on_blade)
     arm = st.R @ np.array([bx, by, h / 2])
     c0, v0 = st.p + arm, st.v + np.cross(w, arm)
     z_land = cell.grill.height + h / 2
@@ -96,6 +102,17 @@ def check_flight(report, k, seg, robot, cell, states) -> None:
     add("landing", k, [abs(pred["tilt_deg"] - rec["tilt_deg"])], tol["deg"], r)
     add("landing", k, [abs(pred["time_of_flight"] - rec["time_of_flight"])], tol["s"], r)
     add("landing", k, [abs(seg.release["time"] - seg.t[r])], tol["s"], r)
+    for row in rec.get("scenarios", ()):  # a robust flip: every scenario lands too
+        alt = recompute_landing(robot, seg, cell, row["burger_on_blade"])
+        if alt is None:
+            add("landing_scenarios", k, [math.inf], tol["m"], r)
+            continue
+        miss = float(np.linalg.norm(alt["point"][:2] - np.asarray(rec["target"])))
+        add("landing_scenarios", k, [max(miss - row["r_land"], 0.0)], tol["m"], r)
+        add("landing_scenarios", k, [max(TILT_MIN_DEG - alt["tilt_deg"], 0.0)], tol["deg"], r)
+        add("landing_scenarios", k, np.abs(alt["point"] - np.asarray(row["point"])), tol["m"], r)
+        add("landing_scenarios", k, [abs(alt["time_of_flight"] - row["time_of_flight"])],
+            tol["s"], r)
     for i in range(r + 1, seg.N + 1):
         tau = seg.t[i] - seg.t[r]
         c = pred["c0"] + pred["v0"] * tau + 0.5 * np.asarray(cell.gravity) * tau**2

@@ -16,7 +16,8 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "interpolant": "rad/s | rad/s²",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
-          "flight_clearance": "m", "placing": "m", "arm_clearance": "m", "orientation": "rad",
+          "landing_scenarios": "m | deg | s", "flight_clearance": "m", "placing": "m",
+          "arm_clearance": "m", "orientation": "rad",
           "singularity": "rad", "completeness": "segments"}
 
 

@@ -8,12 +8,14 @@ decides how hard it pushes. Two controllers (``mode``):
 * ``"feedforward"``: u = u_plan(t) + Kp (q_d − q) + Kd (q̇_d − q̇), clipped to the URDF effort
   limits; u_plan linearly interpolated per segment, (q_d, q̇_d) a cubic Hermite spline of the
   plan's (q, q̇) per segment (as :mod:`flipkit.simulation.tracking`).
-* ``"position"`` (paper, footnote 2: the robot's own PD position control on desired positions
-  and velocities): no plan torques. The desired (q, q̇) are sampled at the servo rate
+* ``"position"`` (paper, footnote 2: the robot's own PD position control on commanded positions
+  and velocities): no plan torques. The commands are sampled at the servo rate
   (``physics.servo_rate_hz``, zero-order hold) and arrive ``physics.latency_s`` late; the
   controller adds gravity compensation from *its own* model — the arm with the spatula as its
   configured payload, not the burger (a UR controller knows only the payload it is told) —
-  evaluated at the measured q, plus the same PD.
+  evaluated at the measured q, plus the same PD. The commands are the plan's (q, q̇)
+  pre-compensated for that servo (:mod:`flipkit.planning.servo_command`), or as they are
+  (``command="raw"``).
 
 The plant's burger (mass, friction, placement, grill height) follows the trial's perturbation
 draw; the plan's feed-forward ignores it. After the plan the last desired state is held for
@@ -22,6 +24,7 @@ draw; the plan's feed-forward ignores it. After the plan the last desired state 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, replace
 
 import mujoco
@@ -29,6 +32,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
+from flipkit.planning.servo_command import COMMANDS, command_lead, position_command
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
@@ -41,7 +45,8 @@ HOLD_S = 1.0  # s after the plan: the flipped burger lands
 # burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
 # μ × 0.81, sensed after the scoop; the place depends on where it lies then).
 SENSE_AFTER = {"flip": "scoop", "serve": "carry"}
-NO_DRAW = {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0}
+NO_DRAW = {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0,
+           "sense_dx_m": 0.0, "sense_dy_m": 0.0}
 
 
 @dataclass
@@ -60,11 +65,14 @@ class Execution:
         mode: The controller. scene: The compiled cell.
         plan: The plan executed (the replanned one when ``replan`` was given).
         sensed_on_blade: The burger's centre on the blade (x, y) (m) measured after the scoop
-            (serve: the carry) and handed to ``replan``; ``None`` open loop. A burger whose
+            (serve: the carry), with the camera's error of the draw, and handed to ``replan``;
+            ``None`` open loop. A burger whose
             centre is not over the blade, or not resting on it, is not re-planned for
             (``replan_failure`` says where it was).
         replan_failure: Why the replan failed (the original, verified plan then ran on), or
             ``None``.
+        replan_time_s: Wall time (s) of the replan; the arm held at rest that long (rounded
+            up to a control step) before the replanned motion. ``None`` open loop.
     """
 
     run: BurgerRun
@@ -80,6 +88,12 @@ class Execution:
     plan: object = None
     sensed_on_blade: list | None = None
     replan_failure: str | None = None
+    replan_time_s: float | None = None
+
+
+def _paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
+    """Plan times of run times ``t`` (s) when the plan stops at ``t_pause`` for ``pause`` s."""
+    return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
 
 
 def _desired(plan, t: np.ndarray):
@@ -120,7 +134,8 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 
 def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
-                 rate_hz: float = 1000.0, replan=None) -> Execution:
+                 rate_hz: float = 1000.0, replan=None,
+                 command: str = "compensated") -> Execution:
     """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
@@ -130,12 +145,19 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         mode: ``"feedforward"`` or ``"position"`` (module docstring).
         draw: A perturbation (:meth:`flipkit.experiments.trials.Perturbations.draw`): ``dx_m``, ``dy_m``
             burger placement error (m), ``grill_offset_m`` (m), ``mu_factor`` (burger-blade
-            friction), ``mass_factor`` (burger mass); ``None`` = the nominal cell.
+            friction), ``mass_factor`` (burger mass), ``sense_dx_m``, ``sense_dy_m`` (the
+            camera's error on the burger's place on the blade, m); ``None`` = the nominal
+            cell.
         cell: Physics and geometry; default the plan's cell (``plan.cell()``, whose
             ``physics`` is the default :class:`~flipkit.config.PhysicsConfig`).
         physics: A :class:`~flipkit.config.PhysicsConfig` replacing ``cell.physics``.
         hold: Time (s) the last desired state is held after the plan.
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
+        command: ``position`` mode's command stream, one of
+            :data:`~flipkit.planning.servo_command.COMMANDS`: ``"compensated"`` (default) sends
+            q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the nominal latency and half a servo period,
+            ``"raw"`` the plan's (q, q̇) as they are. Commands use the plan's nominal servo
+            model; the servo itself follows ``cell.physics``.
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
             rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
@@ -145,13 +167,16 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
             follows the returned plan, which must keep the segments up to then and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
-            runs on (``replan_failure`` says why). The arm waits at rest while a real cell
-            replans; the simulation does not model that pause (nothing moves during it).
+            runs on (``replan_failure`` says why). The arm holds at rest while the replan
+            runs: the simulation pauses the plan for its measured wall time, so the executed
+            duration includes it.
 
     Returns:
         The :class:`Execution`; ``execution.plan`` is the plan finally executed.
     """
     d_ = _check(plan, mode, draw, hold, rate_hz)
+    if command not in COMMANDS:
+        raise InvalidChoiceError("position command", command, COMMANDS)
     from flipkit.model.robot import Robot
 
     cell = cell or plan.cell()
@@ -165,14 +190,20 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     sub = max(1, int(round(1.0 / (rate_hz * m.opt.timestep))))
     dt = sub * m.opt.timestep
 
-    def references(plan):
-        T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments)
+    nominal = plan.cell().physics  # the cell's model of its servo, which commands use
+
+    def references(plan, t_pause=np.inf, pause=0.0):
+        T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments) + pause
         t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
-        q_des, qd_des, u_ff, bounds = _desired(plan, t)
+        q_des, qd_des, u_ff, bounds = _desired(plan, _paused(t, t_pause, pause))
+        bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
+                      b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
         if mode == "position":  # servo-rate samples, arriving latency_s late, zero-order hold
-            ts = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
+            sent = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
                 / ph.servo_rate_hz
-            q_cmd, qd_cmd, _, _ = _desired(plan, ts)
+            lead = command_lead(nominal) if command == "compensated" else 0.0
+            q_s, qd_s, u_s, _ = _desired(plan, _paused(sent + lead, t_pause, pause))
+            q_cmd, qd_cmd = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
         else:
             q_cmd, qd_cmd = q_des, qd_des
         return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
@@ -185,7 +216,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=q_des[0])
     d.qvel[:ARM_JOINTS] = qd_des[0]
     mujoco.mj_forward(m, d)
-    N = len(t) if replan is None else 2 * len(t)  # room for a longer replanned tail
+    N = len(t) if replan is None else 3 * len(t)  # room for the pause and a longer tail
     rec = {k: np.zeros((N, 3)) for k in ("bp", "sp")}
     rec.update({k: np.zeros((N, 3, 3)) for k in ("br", "sr")})
     rec.update({k: np.zeros(N) for k in ("fs", "fg", "fbg")})
@@ -193,7 +224,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = m.geom_bodyid[scene.geoms["burger"]]
     f6 = np.zeros(6)
-    sensed, replan_failure = None, None
+    sensed, replan_failure, replan_time = None, None, None
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
     thick = cell.spatula.thickness
     k = -1
@@ -203,7 +234,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
             mujoco.mj_kinematics(m, d)
             p_b, R_b = scene.blade_pose()
             rel = (d.xpos[burger_body] - p_b) @ R_b
-            sensed = rel[:2]
+            sensed = rel[:2] + [d_["sense_dx_m"], d_["sense_dy_m"]]  # the camera's error
             if np.any(np.abs(sensed) > half) or not 0.0 < rel[2] < bg.thickness + thick:
                 # not on the blade (the scoop missed or pushed it off): nothing to re-plan for;
                 # the verified plan runs on, and the judges see the miss
@@ -211,15 +242,20 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                     f"burger not on the blade after the {SENSE_AFTER[plan.behavior]}: its centre "
                     f"at ({rel[0]:+.3f}, {rel[1]:+.3f}, {rel[2]:+.3f}) m in the blade frame")
             else:
+                started = time.perf_counter()
                 try:  # a failed replan keeps the verified plan under way (and this step runs)
                     new = replan(plan, sensed)
                 except FlipkitError as exc:
                     new, replan_failure = None, str(exc)
+                replan_time = time.perf_counter() - started
             if new is not None and new.status != "solved":
                 new, replan_failure = None, new.failure or "replanned plan not solved"
             if new is not None:
                 plan = new
-                t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
+                # The arm held at rest while the replan ran: the rest of the run starts after
+                # that pause, a whole number of control steps long.
+                pause = dt * np.ceil(replan_time / dt - 1e-9)
+                t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan, t[k], pause)
                 if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
                     raise ConfigError("the replanned run does not extend the executed one")
                 t = t2
@@ -239,7 +275,8 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                     cell.spatula.width, scene.grill_height)
     errors = _errors(robot, t, qa, q_des, bounds)
     return Execution(run, bounds, errors, qa, q_des, ua, qpos, rec["fbg"], mode, scene, plan,
-                     None if sensed is None else [float(v) for v in sensed], replan_failure)
+                     None if sensed is None else [float(v) for v in sensed], replan_failure,
+                     replan_time)
 
 
 def _record(scene: Scene, rec: dict, k: int, burger_body: int, f6: np.ndarray) -> None:

@@ -95,6 +95,72 @@ class Landing(Block):
         return y[:2, 0], np.hstack([J @ dq, J @ dqd]).ravel()
 
 
+class ScenarioLanding(Block):
+    """The landing of the same release under other scenarios: the burger's centre elsewhere on
+    the blade. Each scenario lands within ``r_land`` of ``target`` and upside down.
+
+    A flip planned for one place of the burger on the blade lands where planned only if the
+    burger lies there; the scoop leaves it within a spread (placement, friction). These rows
+    make one joint trajectory land every scenario of that spread on the grill spot.
+
+    Rows per scenario: landing distance from the target (m) ≤ r_land; z of the landed
+    top-face normal ≤ cos(150°).
+
+    Args:
+        layout: Variable layout. release: Release node r. target: Landing spot (x, y) (m).
+        r_land: Allowed distance of every scenario's landing (m).
+        scenarios: Places of the burger's centre on the blade (x, y), blade frame (m), K ≥ 1.
+        thickness, grill_height, gravity: As :class:`Landing`.
+    """
+
+    def __init__(self, layout, release: int, target, r_land: float, scenarios, *,
+                 thickness: float, grill_height: float, gravity):
+        super().__init__("landing_scenarios", layout)
+        pts = np.asarray(scenarios, float).reshape(-1, 2)
+        if not (math.isfinite(r_land) and r_land > 0):
+            raise ConfigError(f"r_land must be a positive distance (m), got {r_land!r}")
+        if pts.shape[0] < 1 or not np.all(np.isfinite(pts)):
+            raise ConfigError("landing scenarios must be finite (x, y) places on the blade")
+        if not 0 < release < layout.N:
+            raise ConfigError(f"release node must be inside the segment, got {release}")
+        self.release = int(release)
+        self.scenarios = [[float(a), float(b)] for a, b in pts]
+        self.pars = [landing_parameters(thickness, grill_height, gravity, target, ob)
+                     for ob in self.scenarios]
+        cols = np.concatenate([layout.iq(release), layout.iqd(release)])
+        for k in range(len(self.scenarios)):
+            self._add(2 * k, 2, cols)
+        self.m = 2 * len(self.scenarios)
+        cos_tilt = math.cos(math.radians(TILT_MIN_DEG))
+        self._finish(-np.inf, np.tile([r_land, cos_tilt], len(self.scenarios)), 1.0)
+
+    def record(self, robot, x) -> list[dict]:
+        """The plan file's ``landing["scenarios"]`` at the solution ``x``."""
+        from flipkit.model.flight import predict_landing
+        from flipkit.transcription.layout import Evaluation
+
+        ev = Evaluation(self.layout, robot, np.asarray(x, float))
+        st = ev.state(self.release)
+        w, _ = robot.angular_velocity_jacobian(*ev.node(self.release)[:2])
+        out = []
+        for ob, par in zip(self.scenarios, self.pars):
+            h, g = par[0], par[1]
+            pred = predict_landing(st.p, st.v, st.R, w, thickness=h,
+                                   grill_height=par[2] - h / 2, gravity=(0.0, 0.0, -g),
+                                   target=par[3:5], on_blade=ob)
+            out.append({"burger_on_blade": list(ob), "r_land": float(self.hi[0]), **pred})
+        return out
+
+    def evaluate(self, ev):
+        x, R, dq, dqd = _release_inputs(ev, self.release)
+        values, jac = [], []
+        for par in self.pars:
+            y, J = (np.asarray(a) for a in landing_function()(x, R, par))
+            values.append(y[:2, 0])
+            jac.append(np.hstack([J[:2] @ dq, J[:2] @ dqd]).ravel())
+        return np.concatenate(values), np.concatenate(jac)
+
+
 class FlightClearance(Block):
     """After the release at node r, the blade plane at nodes r+1..N separates the blade from
     the flying burger by at least ``margin`` (m) (see :func:`~flipkit.model.flight.clearance_function`).

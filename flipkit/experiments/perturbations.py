@@ -1,0 +1,62 @@
+"""How each simulated trial's cell differs from the plan's model: the Table I perturbations."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flipkit.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class Perturbations:
+    """How each trial's real cell differs from the plan's model.
+
+    Attributes:
+        position_sigma: Standard deviation (m) of the Gaussian burger placement error, drawn
+            independently in x and in y. Default 5 mm (a burger put down by hand).
+        grill_offset: Half-width a (m) of the uniform grill-height offset U(−a, a).
+            Default 2 mm.
+        mu_scale: Range (lo, hi) of the uniform factor on the burger–spatula friction
+            coefficient μ (the burger–grill friction is unchanged). Default (0.8, 1.2).
+        mass_scale: Range (lo, hi) of the uniform factor on the burger mass, in MuJoCo and in
+            the arm's payload (not in the feed-forward). Default (0.9, 1.1).
+        sensing_sigma: Standard deviation (m) of the camera's error on the burger's place on
+            the blade, per axis (sense-plan-act only). An active-stereo depth camera (Intel
+            RealSense D400 series datasheet: depth RMS error < 2 % at 2 m) 0.6 m above the
+            blade errs by up to 1.2 cm in depth; seen from above, the burger's (x, y) comes
+            from the image, and a depth error of 1.2 cm moves a point 25° off the optical axis
+            by 5.6 mm sideways. Default 5 mm (ours, from that geometry).
+    """
+
+    position_sigma: float = 0.005
+    grill_offset: float = 0.002
+    mu_scale: tuple = (0.8, 1.2)
+    mass_scale: tuple = (0.9, 1.1)
+    sensing_sigma: float = 0.005
+
+    def __post_init__(self):
+        for name in ("position_sigma", "grill_offset", "sensing_sigma"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+                raise ConfigError(f"{name} must be a non-negative number (m)")
+        for name in ("mu_scale", "mass_scale"):
+            lo, hi = (float(v) for v in getattr(self, name))
+            if not (0 < lo <= hi < np.inf):
+                raise ConfigError(f"{name} must be a range 0 < lo <= hi, got {(lo, hi)}")
+            object.__setattr__(self, name, (lo, hi))
+
+    def draw(self, rng: np.random.Generator) -> dict:
+        """One trial's perturbation: ``dx_m``, ``dy_m``, ``grill_offset_m`` (m),
+        ``mu_factor``, ``mass_factor``, ``sense_dx_m``, ``sense_dy_m`` (m), drawn in this
+        order."""
+        dx, dy = rng.normal(0.0, self.position_sigma, 2)
+        out = {"dx_m": float(dx), "dy_m": float(dy),
+               "grill_offset_m": float(rng.uniform(-self.grill_offset, self.grill_offset)),
+               "mu_factor": float(rng.uniform(*self.mu_scale)),
+               "mass_factor": float(rng.uniform(*self.mass_scale))}
+        sx, sy = rng.normal(0.0, self.sensing_sigma, 2)
+        return {**out, "sense_dx_m": float(sx), "sense_dy_m": float(sy)}
+
+
+__all__ = ["Perturbations"]

@@ -1,0 +1,215 @@
+"""Robust flips: the scoop model, the multi-scenario landing, position commands, and an honest
+sense-plan-act (pause for the replan, a camera with noise)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+from flipkit.config import CellConfig, ScoopUncertainty
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.model.scoop import GRAVITY, ScoopPath, footprint_share
+from flipkit.planning.plan_file import Plan
+from flipkit.planning.servo_command import command_lead, position_command
+from flipkit.planning.verify import verify_plan
+from flipkit.transcription.constraints.flight import ScenarioLanding
+from flipkit.transcription.layout import Evaluation
+from conftest import central_fd
+
+
+# ------------------------------------------------------------------ the scoop model
+def test_footprint_share_of_a_disc():
+    assert footprint_share(0.0, 0.05, -1.0, 0.0) == pytest.approx(0.5)
+    assert footprint_share(0.0, 0.05, -1.0, 1.0) == pytest.approx(1.0)
+    assert footprint_share(0.0, 0.05, 0.06, 1.0) == 0.0
+    # A strip of half-width r/2 about the centre: (2/π)(asin ½ + ½·√¾) of the area.
+    expect = 2 / np.pi * (np.arcsin(0.5) + 0.5 * np.sqrt(0.75))
+    assert footprint_share(0.0, 0.05, -0.025, 0.025) == pytest.approx(expect)
+
+
+def _path(speed: float, duration: float, start: float = -0.3, length: float = 0.16):
+    """A blade sliding flat on the grill at constant ``speed`` (m/s), tip from ``start``."""
+    path = object.__new__(ScoopPath)
+    path.length = length
+    path.t = np.arange(0.0, duration, 2e-4)
+    path.tip = start + speed * path.t
+    path.tip_height = np.zeros_like(path.t)
+    path.speed = np.full_like(path.t, speed)
+    path.heading, path.side = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    path.end = np.array([path.tip[-1] - length / 2, 0.0])
+    return path
+
+
+def test_a_patty_on_a_blade_without_grill_friction_slips_v2_over_2_mu_g():
+    """The tip starts ahead of the patty's front edge: the patty lies wholly on the blade from
+    the start (share 1), so friction accelerates it at μ_b g until it rides: it slips back by
+    v²/(2 μ_b g) relative to the blade."""
+    v, mu = 0.5, 0.5
+    path = _path(v, 0.4, start=0.1, length=0.3)  # long enough to hold it while it slips
+    out = path.outcome(diameter=0.1, mu_blade=mu, mu_grill=0.5, rim=0.005)
+    blade_travel = path.tip[-1] - path.tip[0]
+    slip = v**2 / (2 * mu * GRAVITY)
+    # The patty started at the blade frame x = -(0.1 - 0.15) = 0.05, and ended ``slip`` behind.
+    assert out[0] == pytest.approx(0.05 - slip, abs=2e-4)
+    assert blade_travel > slip  # it did catch up within the run
+
+
+def test_scoop_outcome_moves_with_the_physics():
+    """More grill friction or a faster scoop: the patty sticks later, nearer the blade
+    centre; more blade friction: sooner, nearer the tip."""
+    kw = {"diameter": 0.1, "rim": 0.005}
+    base = _path(0.5, 0.8).outcome(mu_blade=0.5, mu_grill=0.5, **kw)[0]
+    assert _path(0.5, 0.8).outcome(mu_blade=0.5, mu_grill=0.7, **kw)[0] < base
+    assert _path(0.5, 0.8).outcome(mu_blade=0.7, mu_grill=0.5, **kw)[0] > base
+    assert _path(0.8, 0.5).outcome(mu_blade=0.5, mu_grill=0.5, **kw)[0] < base
+    # Ahead of the blade centre, short of the tip (the burger's centre stays on the blade).
+    assert 0.0 < base < 0.08
+    with pytest.raises(ConfigError, match="mu_blade"):
+        _path(0.5, 0.8).outcome(mu_blade=0.0, mu_grill=0.5, **kw)
+
+
+def test_scoop_model_predicts_the_simulated_scoop(flip_plan):
+    """The model, from the plan's scoop alone, against MuJoCo's nominal cell (feed-forward):
+    within 1.5 cm along the blade (the model is not fitted to any trial)."""
+    from flipkit.simulation.execute import execute_plan
+
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    predicted = flip.landing["burger_on_blade"]
+    ex = execute_plan(flip_plan, "feedforward", None)
+    k = np.searchsorted(ex.run.t, ex.bounds["scoop"][1])
+    simulated = ex.run.in_blade_frame()[k]
+    assert simulated[0] > 0.015  # the scoop does leave it well ahead of the centre
+    assert abs(predicted[0] - simulated[0]) < 0.015
+
+
+def test_uncertainty_is_validated():
+    assert ScoopUncertainty().placement == pytest.approx(0.01)
+    with pytest.raises(ConfigError, match="mu_scale"):
+        ScoopUncertainty(mu_scale=(1.1, 1.2))
+    with pytest.raises(ConfigError, match="placement_sigma"):
+        ScoopUncertainty(placement_sigma=float("nan"))
+
+
+# ------------------------------------------------------------------ robust landing
+def test_robust_plan_records_and_verifies_every_scenario(flip_plan, tmp_path):
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    rows = flip.landing["scenarios"]
+    assert len(rows) == 4
+    xs = [r["burger_on_blade"][0] for r in rows]
+    assert min(xs) < flip.landing["burger_on_blade"][0] < max(xs)
+    for r in rows:
+        assert r["offset"] <= r["r_land"] + 1e-6 and r["tilt_deg"] >= 150.0 - 1e-6
+    again = Plan.load(flip_plan.to_json(tmp_path / "p.json"))
+    assert next(s for s in again.segments if s.name == "flip").landing["scenarios"] == rows
+    assert verify_plan(again).ok
+
+
+def test_tampered_scenario_fails_verify(flip_plan):
+    plan = copy.deepcopy(flip_plan)
+    flip = next(s for s in plan.segments if s.name == "flip")
+    flip.landing["scenarios"][0]["r_land"] = 1e-4  # claims a scenario lands within 0.1 mm
+    report = verify_plan(plan)
+    assert not report.ok and report.worst()[0] == "landing_scenarios"
+    plan = copy.deepcopy(flip_plan)
+    flip = next(s for s in plan.segments if s.name == "flip")
+    flip.landing["scenarios"][1]["burger_on_blade"][0] += 0.02  # not where it was planned
+    assert not verify_plan(plan).groups["landing_scenarios"].ok
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_scenario_landing_jacobian_matches_finite_differences(seed):
+    from flipkit.behaviors.segments import build_segment
+    from flipkit.behaviors.targets import pickup_end
+    from flipkit.model.ik import solve_pose
+    from flipkit.planning.planner import models_for
+
+    cell = CellConfig()
+    models = models_for(cell)
+    pb = np.array([0.69, -0.16, 0.072])
+    pose = pickup_end(cell, pb)
+    q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
+    nlp = build_segment("flip", models, q0, np.zeros(6), location=pb, on_blade=(0.03, 0.0),
+                        scenarios=[(0.02, 0.0), (0.045, 0.0), (0.03, -0.01)])
+    block = next(b for b in nlp.blocks if isinstance(b, ScenarioLanding))
+    assert block.m == 6
+    rng = np.random.default_rng(seed)
+    x = nlp.x0 + 0.05 * rng.standard_normal(nlp.n) * (np.arange(nlp.n) < nlp.layout.alpha_start)
+    x[nlp.layout.T_index] = 0.5
+    _, entries = block.evaluate(Evaluation(nlp.layout, nlp.robot, x))
+    J = np.zeros((block.m, nlp.n))
+    np.add.at(J, (block.rows, block.cols), entries)
+    cols = np.unique(block.cols)
+
+    def values(z):
+        y = x.copy()
+        y[cols] = z
+        return block.evaluate(Evaluation(nlp.layout, nlp.robot, y))[0]
+
+    np.testing.assert_allclose(J[:, cols], central_fd(values, x[cols]), atol=1e-6, rtol=1e-6)
+
+
+# ------------------------------------------------------------------ position commands
+def test_compensated_command_gives_the_plan_torque_at_the_plan_state(flip_plan):
+    """Servo law u = g_c(q) + Kp (q_c − q) + Kd (q̇_c − q̇) at q = q_d, q̇ = q̇_d gives u_d."""
+    from flipkit.model.robot import Robot
+    import pinocchio as pin
+
+    cell = flip_plan.cell()
+    ph = cell.physics
+    ctrl = Robot(cell, with_burger=False).model
+    seg = next(s for s in flip_plan.segments if s.name == "flip")
+    q_c, qd_c = position_command(seg.q, seg.qd, seg.u, ctrl, ph)
+    data = ctrl.createData()
+    for k in range(len(seg.t)):
+        u = (pin.computeGeneralizedGravity(ctrl, data, seg.q[k]) + np.asarray(ph.kp)
+             * (q_c[k] - seg.q[k]) + np.asarray(ph.kd) * (qd_c[k] - seg.qd[k]))
+        np.testing.assert_allclose(u, seg.u[k], atol=1e-9)
+    raw = position_command(seg.q, seg.qd, seg.u, ctrl, ph, "raw")
+    np.testing.assert_array_equal(raw[0], seg.q)
+    assert command_lead(ph) == pytest.approx(ph.latency_s + 0.5 / ph.servo_rate_hz)
+    with pytest.raises(InvalidChoiceError, match="compensated"):
+        position_command(seg.q, seg.qd, seg.u, ctrl, ph, "lead")
+
+
+def test_compensated_position_mode_tracks_like_feedforward(flip_plan):
+    from flipkit.simulation.execute import execute_plan
+
+    worst = {}
+    for mode, command in (("feedforward", "compensated"), ("position", "compensated"),
+                          ("position", "raw")):
+        ex = execute_plan(flip_plan, mode, None, command=command)
+        worst[mode, command] = max(e["max_m"] for e in ex.errors.values())
+    assert worst["position", "compensated"] < 1.5 * worst["feedforward", "compensated"]
+    assert worst["position", "raw"] > 2 * worst["position", "compensated"]
+
+
+# ------------------------------------------------------------------ sense-plan-act
+def test_the_arm_holds_while_the_replan_runs_and_the_camera_errs(flip_plan):
+    import time
+
+    from flipkit.simulation.execute import execute_plan
+
+    seen = []
+
+    def slow_replan(plan, on_blade):  # a replan that takes 0.2 s and changes nothing
+        seen.append(np.array(on_blade))
+        time.sleep(0.2)
+        return plan
+
+    plain = execute_plan(flip_plan, "feedforward", None)
+    noisy = {"sense_dx_m": 0.004, "sense_dy_m": -0.003}
+    ex = execute_plan(flip_plan, "feedforward", noisy, replan=slow_replan)
+    assert ex.replan_time_s >= 0.2
+    pause = ex.run.t[-1] - plain.run.t[-1]
+    assert ex.replan_time_s - 1e-3 <= pause <= ex.replan_time_s + 2e-3
+    assert ex.bounds["pickup"][0] == pytest.approx(plain.bounds["pickup"][0] + pause, abs=1e-9)
+    assert ex.bounds["scoop"] == plain.bounds["scoop"]
+    k = np.searchsorted(plain.run.t, plain.bounds["scoop"][1])
+    truth = plain.run.in_blade_frame()[k][:2]
+    np.testing.assert_allclose(seen[0] - truth, [0.004, -0.003], atol=2e-3)
+    # The arm holds still during the pause (it settles by a few mrad on the pressed blade).
+    i0, i1 = np.searchsorted(ex.run.t, [ex.bounds["scoop"][1] + 0.02,
+                                        ex.bounds["pickup"][0] - 0.02])
+    assert np.ptp(ex.q[i0:i1], axis=0).max() < 5e-3
