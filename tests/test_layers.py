@@ -12,7 +12,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "flipkit"
 # Lowest first. A module may import its own layer and the layers below it.
 LAYERS = (
-    ("errors", "provenance"),
+    ("errors", "provenance", "fileio"),
     ("config", ""),  # "" is the package root (flipkit/__init__.py: version, CellConfig)
     ("model",),
     ("transcription",),

@@ -27,7 +27,6 @@ from flipkit.errors import ConfigError, FlipkitError
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 CSV_COLUMNS = (("x", "y", "z"), ("px", "py", "pz"))
-R_LAND_RANGE = (0.001, 0.2)  # m, --r-land
 DESCRIPTION = (
     "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
     "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
@@ -76,7 +75,7 @@ def register(subparsers) -> None:
     f.add_argument("--land", nargs="+", metavar="X",
                    help="landing spot X Y (m) on the grill; default where the burger lies")
     f.add_argument("--r-land", default="0.02", metavar="M",
-                   help="radius (m) of the landing disc about the spot, in [0.001, 0.2] "
+                   help="radius (m) of the landing disc about the spot, in (0, 0.1] "
                         "(default 0.02)")
     atlas_arguments(f)
     common(f)
@@ -179,22 +178,6 @@ def _json_out(args, inputs=()) -> None:
     check_output(args.json, "--json", (".json",), inputs=[*inputs, getattr(args, "atlas", None)])
 
 
-def check_spacing(locations, diameter: float, where: str) -> None:
-    """Refuse two burgers closer than one diameter (m): they would overlap on the grill.
-
-    Raises:
-        ConfigError: One line naming the two rows (from 1) and their distance.
-    """
-    for i, a in enumerate(locations):
-        for j in range(i + 1, len(locations)):
-            b = locations[j]
-            gap = math.hypot(a[0] - b[0], a[1] - b[1])
-            if gap < diameter:
-                raise ConfigError(f"{where}: burgers {i + 1} and {j + 1} are {gap * 1e3:.0f} mm "
-                                  f"apart on the grill; they need one burger diameter "
-                                  f"({diameter * 1e3:.0f} mm)")
-
-
 def read_locations(path) -> list[tuple[float, float, float]]:
     """Burger locations (m) from a CSV with columns x,y,z or px,py,pz (others ignored).
 
@@ -289,11 +272,7 @@ def run_flip(args: argparse.Namespace) -> int:
     cell = CellConfig()
     location = _burger(args.burger, cell)
     land = None if args.land is None else _numbers("--land", args.land, 2)
-    r_land = _numbers("--r-land", args.r_land)[0]
-    if not R_LAND_RANGE[0] <= r_land <= R_LAND_RANGE[1]:
-        raise ConfigError(f"--r-land must be in [{R_LAND_RANGE[0]:g}, {R_LAND_RANGE[1]:g}] m, "
-                          f"got {r_land:g}")
-    options = SegmentOptions(r_land=r_land)
+    options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
     q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, options)
     plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
@@ -362,6 +341,7 @@ def run_batch(args: argparse.Namespace) -> int:
     from flipkit.cli.common import MAX_WORKERS, check_int
     from flipkit.config import CellConfig
     from flipkit.fileio import check_output_dir
+    from flipkit.planning.inputs import check_spacing
 
     _quiet()
     if args.workers is not None:
@@ -370,7 +350,7 @@ def run_batch(args: argparse.Namespace) -> int:
     cell = CellConfig()
     for k, loc in enumerate(locations, 1):
         _on_grill(loc, cell, f"{args.burgers}: burger {k}")
-    check_spacing(locations, cell.burger.diameter, str(args.burgers))
+    check_spacing(locations, cell.burger.diameter, str(args.burgers))  # as schedule does
     check_output_dir(args.out, "--out", inputs=[args.burgers, args.atlas],
                      names=[*(f"burger_{k}.json" for k in range(1, len(locations) + 1)),
                             "summary.csv"])

@@ -3,6 +3,8 @@ limits, each a one-line error naming what is wrong."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from flipkit.config import CellConfig
@@ -41,3 +43,19 @@ def check_joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
         raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
                           f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
     return v
+
+
+def check_spacing(locations, diameter: float, where: str) -> None:
+    """Refuse two burgers closer than one diameter (m): they would overlap on the grill.
+
+    Raises:
+        ConfigError: One line naming the two rows (from 1) and their distance.
+    """
+    for i, a in enumerate(locations):
+        for j in range(i + 1, len(locations)):
+            b = locations[j]
+            gap = math.hypot(a[0] - b[0], a[1] - b[1])
+            if gap < diameter:
+                raise ConfigError(f"{where}: burgers {i + 1} and {j + 1} are {gap * 1e3:.0f} mm "
+                                  f"apart on the grill; they need one burger diameter "
+                                  f"({diameter * 1e3:.0f} mm)")
