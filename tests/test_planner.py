@@ -164,8 +164,8 @@ def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
     assert plan.status == "solved", plan.failure
     scoop = next(s for s in plan.segments if s.name == "scoop")
     assert T_BOUNDS["scoop"][1] < scoop.T <= T_STRETCH * T_BOUNDS["scoop"][1] + 1e-9
-    # Stretched only where needed: near the singularity the turn back, which has 0.8 s
-    # within its bound, may need the longer bound too; the pickup and flip do not.
+    # Stretched only where needed: the pickup and flip are not; the turn back from a robust
+    # flip's end state near the singularity may be.
     others = [s for s in plan.segments if s.name in ("go_to_burger", "pickup", "flip")]
     assert all(s.T <= T_BOUNDS[s.name][1] + 1e-9 for s in others)
     assert verify_plan(plan).ok

@@ -47,7 +47,7 @@ BEHAVIORS = ("translate",) + tg.SUBBEHAVIORS + sv.SERVE_ONLY
 # the 10 chains; 5 turn backs needed more than 1.0 s, 3 scoops more than 0.5 s, 1 flip more
 # than 0.55 s (each then took T_STRETCH × its bound: 3.25–3.75 s).
 T_BOUNDS = {"translate": (0.6, 2.0), "go_to_burger": (0.3, 0.75), "scoop": (0.2, 0.6),
-            "pickup": (0.2, 0.25), "flip": (0.2, 0.6), "turn_back": (0.4, 0.8), **sv.T_BOUNDS}
+            "pickup": (0.2, 0.25), "flip": (0.2, 0.6), "turn_back": (0.4, 1.2), **sv.T_BOUNDS}
 # A segment infeasible within its duration bound is planned once more with the upper bound
 # stretched by T_STRETCH (planning/planner.py): the bounds are a preference for a fast chain,
 # not a physical limit (the joint limits, dynamics and cone are). Measured: the scoop at
