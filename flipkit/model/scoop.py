@@ -27,6 +27,8 @@ the final blade centre.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
@@ -39,25 +41,29 @@ GRAVITY = 9.81  # m/s²
 def footprint_share(centre: float, radius: float, lo: float, hi: float) -> float:
     """Fraction of a disc's area (centre, radius along the axis, m) within lo ≤ x ≤ hi."""
     def below(x):
-        u = float(np.clip((x - centre) / radius, -1.0, 1.0))
-        return (np.arcsin(u) + u * np.sqrt(1.0 - u * u)) / np.pi + 0.5
+        u = min(max((x - centre) / radius, -1.0), 1.0)
+        return (math.asin(u) + u * math.sqrt(1.0 - u * u)) / math.pi + 0.5
     return max(below(hi) - below(lo), 0.0)
+
+
+def _sign(x: float) -> float:
+    return (x > 0) - (x < 0)
 
 
 def _step(xb, vb, vt0, vt1, f, mu_b, mu_g, dt):
     """One step of the patty (position xb, speed vb, m and m/s) under blade speed vt0 → vt1."""
-    g = GRAVITY
+    g, sign = GRAVITY, _sign
     if abs(vb - vt0) < 1e-9 and abs(vb) > 1e-9:  # riding the blade: can friction keep it?
-        need = (vt1 - vt0) / dt + mu_g * g * (1 - f) * np.sign(vb)
+        need = (vt1 - vt0) / dt + mu_g * g * (1 - f) * sign(vb)
         if abs(need) <= mu_b * g * f:
             return xb + vt1 * dt, vt1
     if abs(vb) < 1e-9:  # at rest on the grill: does the blade's drag overcome the grill?
-        push = mu_b * g * f * np.sign(vt0 - vb)
+        push = mu_b * g * f * sign(vt0 - vb)
         if abs(push) <= mu_g * g * (1 - f):
             return xb, 0.0
-        a = push - mu_g * g * (1 - f) * np.sign(push)
+        a = push - mu_g * g * (1 - f) * sign(push)
     else:
-        a = mu_b * g * f * np.sign(vt0 - vb) - mu_g * g * (1 - f) * np.sign(vb)
+        a = mu_b * g * f * sign(vt0 - vb) - mu_g * g * (1 - f) * sign(vb)
     v = vb + a * dt
     if (vb - vt0) * (v - vt1) < 0:  # caught up with the blade within the step
         v = vt1
@@ -116,11 +122,14 @@ class ScoopPath:
                 raise ConfigError(f"scoop model: {name} must be positive, got {v!r}")
         along, aside = (float(v) for v in shift)
         xb, vb, radius, low = along, 0.0, diameter / 2, self.tip_height <= rim
-        for k in range(self.t.size - 1):
-            f = (footprint_share(xb, radius, self.tip[k] - self.length, self.tip[k])
-                 if low[k] else 0.0)
-            xb, vb = _step(xb, vb, self.speed[k], self.speed[k + 1], f, mu_blade, mu_grill,
-                           self.t[k + 1] - self.t[k])
+        t, tip, speed = self.t.tolist(), self.tip.tolist(), self.speed.tolist()
+        length, low = self.length, low.tolist()
+        for k in range(len(t) - 1):
+            f = footprint_share(xb, radius, tip[k] - length, tip[k]) if low[k] else 0.0
+            if f == 0.0 and vb == 0.0:  # off the blade and at rest: nothing moves it
+                continue
+            xb, vb = _step(xb, vb, speed[k], speed[k + 1], f, mu_blade, mu_grill,
+                           t[k + 1] - t[k])
         centre = xb * self.heading + aside * self.side - self.end
         return np.array([centre @ self.heading, centre @ self.side])
 
