@@ -15,8 +15,7 @@ from flipkit.planning.plan_file import Plan
 from flipkit.planning.servo_command import command_lead, position_command
 from flipkit.planning.verify import verify_plan
 from flipkit.transcription.constraints.flight import ScenarioLanding
-from flipkit.transcription.layout import Evaluation
-from conftest import central_fd
+from conftest import check_block_jacobian
 
 
 # ------------------------------------------------------------------ the scoop model
@@ -134,20 +133,7 @@ def test_scenario_landing_jacobian_matches_finite_differences(seed):
                         scenarios=[(0.02, 0.0), (0.045, 0.0), (0.03, -0.01)])
     block = next(b for b in nlp.blocks if isinstance(b, ScenarioLanding))
     assert block.m == 6
-    rng = np.random.default_rng(seed)
-    x = nlp.x0 + 0.05 * rng.standard_normal(nlp.n) * (np.arange(nlp.n) < nlp.layout.alpha_start)
-    x[nlp.layout.T_index] = 0.5
-    _, entries = block.evaluate(Evaluation(nlp.layout, nlp.robot, x))
-    J = np.zeros((block.m, nlp.n))
-    np.add.at(J, (block.rows, block.cols), entries)
-    cols = np.unique(block.cols)
-
-    def values(z):
-        y = x.copy()
-        y[cols] = z
-        return block.evaluate(Evaluation(nlp.layout, nlp.robot, y))[0]
-
-    np.testing.assert_allclose(J[:, cols], central_fd(values, x[cols]), atol=1e-6, rtol=1e-6)
+    check_block_jacobian(nlp, block, seed)
 
 
 # ------------------------------------------------------------------ position commands
@@ -213,3 +199,51 @@ def test_the_arm_holds_while_the_replan_runs_and_the_camera_errs(flip_plan):
     i0, i1 = np.searchsorted(ex.run.t, [ex.bounds["scoop"][1] + 0.02,
                                         ex.bounds["pickup"][0] - 0.02])
     assert np.ptp(ex.q[i0:i1], axis=0).max() < 5e-3
+
+
+def test_a_place_inside_the_scenarios_needs_no_replan(flip_plan):
+    from flipkit.planning.planner import covers, replan_flip
+
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    nominal = flip.landing["burger_on_blade"]
+    assert covers(flip.landing, nominal)
+    xs = [r["burger_on_blade"][0] for r in flip.landing["scenarios"]]
+    assert not covers(flip.landing, (max(xs) + 0.01, nominal[1]))
+    assert not covers({"scenarios": []}, nominal)
+    collinear = {"scenarios": [{"burger_on_blade": [x, 0.0]} for x in (0.0, 0.01, 0.02)]}
+    assert not covers(collinear, (0.01, 0.0))
+    assert replan_flip(flip_plan, nominal) is flip_plan  # no solve: the plan already lands it
+
+
+def test_servo_gains_scale_the_simulated_servo_only(flip_plan):
+    """A stiffer servo than the commands assume tracks differently; the commands (nominal
+    model) are the same, so the run differs only through the servo."""
+    from dataclasses import replace
+
+    from flipkit.config import PHYSICAL_RANGES
+    from flipkit.simulation.execute import execute_plan
+
+    assert PHYSICAL_RANGES["physics.servo_gain_scale"][:2] == (0.5, 2.0)
+    cell = flip_plan.cell()
+    soft = execute_plan(flip_plan, "position", None, hold=0.0,
+                        physics=replace(cell.physics, servo_gain_scale=0.5))
+    nominal = execute_plan(flip_plan, "position", None, hold=0.0)
+    assert soft.errors["flip"]["max_m"] != pytest.approx(nominal.errors["flip"]["max_m"])
+    with pytest.raises(ConfigError, match="servo_gain_scale"):
+        replace(cell.physics, servo_gain_scale=0.0)
+
+
+def test_scenario_landings_are_drawn(flip_plan):
+    import matplotlib.pyplot as plt
+
+    from flipkit.figures import data, draw
+
+    pts = data.scenario_landings([flip_plan])
+    assert pts.shape == (4, 2)
+    fig, ax = plt.subplots()
+    points = {"xy": np.zeros((0, 2)), "predicted": np.zeros((0, 2)),
+              "flipped": np.zeros(0, bool)}
+    draw.plot_landings(ax, flip_plan.cell(), points, [flip_plan.burger["location"][:2]],
+                       scenarios=pts)
+    assert "planned scenarios" in [h.get_label() for h in ax.get_lines()]
+    plt.close(fig)

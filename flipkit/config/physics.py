@@ -82,6 +82,9 @@ class PhysicsConfig:
         kp, kd: Joint PD gains (N m/rad, N m s/rad), the values of
             :data:`flipkit.simulation.tracking.DEFAULT_KP` / ``DEFAULT_KD`` (about critical damping at
             q_home, stated there); UR does not publish its servo gains.
+        servo_gain_scale: Factor on ``kp`` and ``kd`` of the simulated servo: the real gains
+            are unknown, while the commands of :mod:`flipkit.planning.servo_command` are
+            computed with the nominal ones. 1; range 0.5-2 (no source: UR publishes none).
     """
 
     mu_grill: float = 0.5
@@ -100,12 +103,13 @@ class PhysicsConfig:
     latency_s: float = 0.008
     kp: tuple = (2000.0, 2000.0, 1000.0, 300.0, 300.0, 50.0)
     kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
+    servo_gain_scale: float = 1.0
 
     def __post_init__(self):
         for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
                      "bevel_length", "edge_thickness", "mu_blade_grill", "blade_modulus",
                      "blade_dampratio", "blade_tip_mass",
-                     "timestep", "servo_rate_hz"):
+                     "timestep", "servo_rate_hz", "servo_gain_scale"):
             positive(f"physics {name}", getattr(self, name))
         if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
             raise ConfigError(f"physics latency_s must be >= 0 s, got {self.latency_s!r}")
@@ -177,6 +181,7 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
                                "over the Table I scoops"),
     "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
                               "(UR 'Remote Control Via TCP/IP')"),
+    "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
     "physics.latency_s": (0.002, 0.020, _NO_SOURCE + " (UR10 Performance Analysis, DTU 2014, "
                           "measures it; not read)"),
 }

@@ -362,6 +362,14 @@ def landing_points(report: dict, targets_xy) -> dict:
             "trials": sum(e["trials"] for e in report["locations"])}
 
 
+def scenario_landings(plans) -> np.ndarray:
+    """Planned landing points (x, y) (m) of every robust scenario of the flips of ``plans``
+    (``landing["scenarios"]`` of each flip segment), k×2; empty without scenarios."""
+    rows = [row["point"][:2] for plan in plans for seg in plan.segments
+            if seg.name == "flip" and seg.landing for row in seg.landing.get("scenarios", ())]
+    return np.array(rows, float).reshape(-1, 2)
+
+
 def landing_summary(points: dict, tol: float = SUCCESS_TOL) -> dict:
     """Counts and medians of :func:`landing_points`: ``within_tol_xy`` (|Δx|, |Δy| ≤ tol,
     the paper's test), ``within_tol_radius`` (distance ≤ tol), ``flipped``, ``reached``,

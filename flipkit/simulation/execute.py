@@ -210,7 +210,8 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
 
     t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
     t_sense = bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
-    kp, kd, umax = np.asarray(ph.kp), np.asarray(ph.kd), robot.u_max
+    kp, kd = (np.asarray(g) * ph.servo_gain_scale for g in (ph.kp, ph.kd))
+    umax = robot.u_max
 
     pb = np.asarray(plan.burger["location"], float)
     place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=q_des[0])

@@ -137,7 +137,7 @@ def _grill_view(ax, g, xlabel: str, ylabel: str, title: str = "") -> None:
 
 
 def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, title: str = "",
-                  legend: bool = True) -> None:
+                  legend: bool = True, scenarios=None) -> None:
     """Top view of the grill (axes as :func:`plot_grill_map`): each target with a circle of
     ``radius`` (m) about it, the predicted landing points (crosses), the simulated ones
     (filled: flipped by the paper's judge; open: not), a thin line from each prediction to
@@ -148,6 +148,8 @@ def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, titl
         points: :func:`flipkit.figures.data.landing_points`.
         targets_xy: The landing targets (k×2) (m).
         radius: Circle radius (m), the paper's 5 cm.
+        scenarios: Planned landing points (k×2) (m) of the plans' robust scenarios
+            (:func:`flipkit.figures.data.scenario_landings`), drawn as plus signs.
     """
     from matplotlib.patches import Circle, Rectangle
 
@@ -167,6 +169,10 @@ def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, titl
             ax.plot([a[1], b[1]], [a[0], b[0]], color="0.6", lw=0.4, zorder=2)
     ax.plot(pred[:, 1], pred[:, 0], "x", color=DESIRED_COLOR, ms=3.5, mew=0.8, zorder=3,
             label="predicted (plan)")
+    sc = np.asarray([] if scenarios is None else scenarios, float).reshape(-1, 2)
+    if len(sc):
+        ax.plot(sc[:, 1], sc[:, 0], "+", color=DESIRED_COLOR, ms=3, mew=0.5, alpha=0.7,
+                zorder=3, label="planned scenarios")
     ax.plot(xy[ok, 1], xy[ok, 0], "o", color=ACTUAL_COLOR, ms=3, zorder=4,
             label=f"simulated, flipped ({int(ok.sum())})")
     ax.plot(xy[~ok, 1], xy[~ok, 0], "o", mfc="white", mec=ACTUAL_COLOR, ms=3, mew=0.7,
