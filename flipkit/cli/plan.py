@@ -74,9 +74,9 @@ def register(subparsers) -> None:
                         "singularities and 0.2 rad from them")
     f.add_argument("--land", nargs="+", metavar="X",
                    help="landing spot X Y (m) on the grill; default where the burger lies")
-    f.add_argument("--r-land", default="0.02", metavar="M",
+    f.add_argument("--r-land", default=None, metavar="M",
                    help="radius (m) of the landing disc about the spot, in (0, 0.1] "
-                        "(default 0.02)")
+                        "(default: the planner's R_LAND, which the package's atlas serves)")
     atlas_arguments(f)
     common(f)
     f.set_defaults(run=run_flip)
@@ -272,7 +272,8 @@ def run_flip(args: argparse.Namespace) -> int:
     cell = CellConfig()
     location = _burger(args.burger, cell)
     land = None if args.land is None else _numbers("--land", args.land, 2)
-    options = SegmentOptions(r_land=_numbers("--r-land", args.r_land)[0])
+    options = SegmentOptions() if args.r_land is None else SegmentOptions(
+        r_land=_numbers("--r-land", args.r_land)[0])
     q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, options)
     plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,

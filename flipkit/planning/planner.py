@@ -254,7 +254,9 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     simulation) and wait there while this runs. Go to burger, scoop and pickup are kept (the
     pickup's constraints do not depend on where the burger lies); the flip is solved again
     with the release state of a burger at ``on_blade``, to the plan's landing target, then the
-    turn back from its end; the result is checked like any plan.
+    turn back from its end, each SQP started from the plan's own solution of that segment (the
+    burger moved by centimetres on the blade: the old flip is close to the new one); the result
+    is checked like any plan.
 
     A robust plan already lands every place of the burger within the convex hull of its
     scenarios (the landing is close to affine in that place over centimetres, and each corner
@@ -280,9 +282,15 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         return plan
     options = replace(options, r_land=flip.landing["r_land"], cone=plan.cone)
     done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
+    before = {s.name: s for s in plan.segments}
+
+    def own(name, nlp, q, qd):  # the plan's own segment as the warm start
+        s = before[name]
+        return nlp.layout.pack(s.q, s.qd, s.qdd, s.u, s.alpha, s.T)
+
     return _chain(np.asarray(plan.burger["location"], float), done[-1].q[-1], done[-1].qd[-1],
                   done, models_for(cell), cell, solver, np.asarray(flip.landing["target"]),
-                  on_blade, options, t0)
+                  on_blade, options, t0, own)
 
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
