@@ -247,3 +247,23 @@ def test_scenario_landings_are_drawn(flip_plan):
                        scenarios=pts)
     assert "planned scenarios" in [h.get_label() for h in ax.get_lines()]
     plt.close(fig)
+
+
+def test_validate_command_line_takes_the_command_stream(flip_plan_file, tmp_path):
+    import json
+
+    from flipkit.cli import main
+    from flipkit.planning.servo_command import COMMANDS
+
+    out = tmp_path / "v.json"
+    rc = main(["validate", "--plan", str(flip_plan_file), "--trials", "1", "--mode", "position",
+               "--command", "raw", "--workers", "1", "--no-progress", "--json", str(out)])
+    assert rc == 0 and json.loads(out.read_text())["command"] == "raw"
+    import flipkit.cli.validate as cli_validate
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    cli_validate.register(parser.add_subparsers())
+    action = next(a for sub in parser._subparsers._group_actions
+                  for a in sub.choices["validate"]._actions if a.dest == "command")
+    assert tuple(action.choices) == COMMANDS  # the CLI offers exactly the library's streams

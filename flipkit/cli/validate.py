@@ -43,8 +43,12 @@ def register(subparsers) -> None:
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
                         help="joint controller: plan torques + PD (feedforward, default) or "
-                             "the robot's PD position control on servo-rate, delayed desired "
-                             "states with its own gravity compensation (position)")
+                             "the robot's PD position control on servo-rate, delayed commands "
+                             "with its own gravity compensation (position)")
+    parser.add_argument("--command", choices=("compensated", "raw"), default="compensated",
+                        help="position mode's commands: the plan pre-compensated for the servo "
+                             "(compensated, default; docs/robust-flips.md) or the plan's "
+                             "(q, qd) as they are (raw)")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
@@ -94,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     from flipkit.experiments.trials import validate_locations, validate_plan_file
 
     common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
-                  replan=args.replan)
+                  replan=args.replan, command=args.command)
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,

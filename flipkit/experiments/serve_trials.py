@@ -49,7 +49,7 @@ def run_serve_trial(job: dict) -> dict:
     replan = replan_serve if job.get("replan", False) else None
     mode = job.get("mode", "feedforward")
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan)
+                      replan=replan, command=job.get("command", "compensated"))
     run, bounds = ex.run, ex.bounds
     spot = table_spot(ex.plan)
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
@@ -87,7 +87,7 @@ def _failure(scoop, pickup, serve) -> dict | None:
 def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations(), *,
                    executor=None, cache_dir=None, progress: bool = True,
                    rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
-                   replan: bool = False) -> dict:
+                   replan: bool = False, command: str = "compensated") -> dict:
     """Run ``trials`` simulated executions of the serve plan file ``path``.
 
     Returns:
@@ -113,7 +113,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
-                      replan)
+                      replan, command=command)
     results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,
                         desc="trials")
     entry = {"location": plan.burger["location"].tolist(),
@@ -128,7 +128,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
              "rests": [{"trial": r["trial"], **r["rest"], "replan": r["replan"]}
                        for r in results]}
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
-            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan),
+            "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
                         "independent": entry["independent"]}}
