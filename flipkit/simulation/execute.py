@@ -202,8 +202,10 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
             sent = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
                 / ph.servo_rate_hz
             lead = command_lead(nominal) if command == "compensated" else 0.0
+            sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
             q_s, qd_s, u_s, _ = _desired(plan, _paused(sent + lead, t_pause, pause))
-            q_cmd, qd_cmd = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
+            q_cmd, qd_cmd = (c[held] for c in position_command(q_s, qd_s, u_s, robot.model,
+                                                               nominal, command))
         else:
             q_cmd, qd_cmd = q_des, qd_des
         return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
