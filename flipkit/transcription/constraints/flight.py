@@ -20,7 +20,7 @@ import numpy as np
 
 from flipkit.errors import ConfigError
 from flipkit.model.flight import (TILT_MIN_DEG, clearance_function, gravity_magnitude,
-                                  landing_function, landing_parameters)
+                                  landing_function, landing_parameters, predict_landing)
 from flipkit.transcription.constraints.base import Block
 
 
@@ -41,6 +41,28 @@ def _release_state(ev, r: int):
     dq = np.vstack([st.dp_dq, st.dv_dq, st.Jw, dw_dq])
     dqd = np.vstack([np.zeros((3, nq)), st.dv_dqd, np.zeros((3, nq)), st.Jw])
     return np.concatenate([st.p, st.v, np.zeros(3), w]), st.R, dq, dqd
+
+
+def _landing_rows(ev, r: int, pars):
+    """Rows (landing distance, landed normal z) and their Jacobian entries, per
+    :func:`~flipkit.model.flight.landing_parameters` vector of ``pars``, for a release at
+    node r (pattern: each pair of rows dense in (q_r, q̇_r))."""
+    x, R, dq, dqd = _release_inputs(ev, r)
+    values, entries = [], []
+    for par in pars:
+        y, J = (np.asarray(a) for a in landing_function()(x, R, par))
+        values.append(y[:2, 0])
+        entries.append(np.hstack([J[:2] @ dq, J[:2] @ dqd]).ravel())
+    return np.concatenate(values), np.concatenate(entries)
+
+
+def _predictions(ev, robot, r: int, pars) -> list[dict]:
+    """:func:`~flipkit.model.flight.predict_landing` of the release at node r, per ``pars``."""
+    st = ev.state(r)
+    w, _ = robot.angular_velocity_jacobian(*ev.node(r)[:2])
+    return [predict_landing(st.p, st.v, st.R, w, thickness=par[0],
+                            grill_height=par[2] - par[0] / 2, gravity=(0.0, 0.0, -par[1]),
+                            target=par[3:5], on_blade=par[5:7]) for par in pars]
 
 
 class Landing(Block):
@@ -75,24 +97,16 @@ class Landing(Block):
     def record(self, robot, x) -> tuple[dict, dict]:
         """The plan file's ``release`` and ``landing`` records at the solution ``x``."""
         from flipkit.transcription.layout import Evaluation
-        from flipkit.model.flight import predict_landing
 
         ev = Evaluation(self.layout, robot, np.asarray(x, float))
-        st, r = ev.state(self.release), self.release
-        w, _ = robot.angular_velocity_jacobian(*ev.node(r)[:2])
-        h, g = self.par[0], self.par[1]
-        pred = predict_landing(st.p, st.v, st.R, w, thickness=h, grill_height=self.par[2] - h / 2,
-                               gravity=(0.0, 0.0, -g), target=self.par[3:5],
-                               on_blade=self.on_blade)
+        r = self.release
+        pred = _predictions(ev, robot, r, [self.par])[0]
         return ({"node": r, "time": float(self.layout.s[r] * ev.T)},
                 {"target": [float(v) for v in self.par[3:5]], "r_land": float(self.hi[0]),
                  **pred, "burger_on_blade": list(self.on_blade)})
 
     def evaluate(self, ev):
-        x, R, dq, dqd = _release_inputs(ev, self.release)
-        y, J = (np.asarray(a) for a in landing_function()(x, R, self.par))
-        J = J[:2]
-        return y[:2, 0], np.hstack([J @ dq, J @ dqd]).ravel()
+        return _landing_rows(ev, self.release, [self.par])
 
 
 class ScenarioLanding(Block):
@@ -136,29 +150,15 @@ class ScenarioLanding(Block):
 
     def record(self, robot, x) -> list[dict]:
         """The plan file's ``landing["scenarios"]`` at the solution ``x``."""
-        from flipkit.model.flight import predict_landing
         from flipkit.transcription.layout import Evaluation
 
         ev = Evaluation(self.layout, robot, np.asarray(x, float))
-        st = ev.state(self.release)
-        w, _ = robot.angular_velocity_jacobian(*ev.node(self.release)[:2])
-        out = []
-        for ob, par in zip(self.scenarios, self.pars):
-            h, g = par[0], par[1]
-            pred = predict_landing(st.p, st.v, st.R, w, thickness=h,
-                                   grill_height=par[2] - h / 2, gravity=(0.0, 0.0, -g),
-                                   target=par[3:5], on_blade=ob)
-            out.append({"burger_on_blade": list(ob), "r_land": float(self.hi[0]), **pred})
-        return out
+        return [{"burger_on_blade": list(ob), "r_land": float(self.hi[0]), **pred}
+                for ob, pred in zip(self.scenarios, _predictions(ev, robot, self.release,
+                                                                 self.pars))]
 
     def evaluate(self, ev):
-        x, R, dq, dqd = _release_inputs(ev, self.release)
-        values, jac = [], []
-        for par in self.pars:
-            y, J = (np.asarray(a) for a in landing_function()(x, R, par))
-            values.append(y[:2, 0])
-            jac.append(np.hstack([J[:2] @ dq, J[:2] @ dqd]).ravel())
-        return np.concatenate(values), np.concatenate(jac)
+        return _landing_rows(ev, self.release, self.pars)
 
 
 class FlightClearance(Block):
