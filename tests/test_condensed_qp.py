@@ -9,9 +9,9 @@ from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, fl
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.full_qp import QPSubproblem
-from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.condensed_qp import CondensedQP
-from flipkit.solvers.sqp import SQPOptions, solve_sqp
+from flipkit.solvers.sqp import QPOptions, SQPOptions, TerminationOptions, solve_sqp
 
 
 @pytest.fixture(scope="module")
@@ -80,8 +80,8 @@ def test_null_space_dimension_and_basis(segments):
 
 def test_structure_shares_one_compiled_problem(segments):
     nlp = segments["translate"]
-    assert SUBPROBLEMS.get(nlp, "condensed") is SUBPROBLEMS.get(nlp, "condensed")
-    assert SUBPROBLEMS.get(nlp, "condensed").problem.is_dpp()
+    assert DEFAULT_WORKSPACE.get(nlp, "condensed") is DEFAULT_WORKSPACE.get(nlp, "condensed")
+    assert DEFAULT_WORKSPACE.get(nlp, "condensed").problem.is_dpp()
 
 
 def test_warm_start_cuts_iterations(segments):
@@ -116,14 +116,15 @@ def test_sqp_condensed_and_full_space_agree(segments):
                            options=SegmentOptions(arm_clearance=False))
     # converged as tightly as before session 12 (ftol 1e-4): the forms, not the stopping
     # rule, are compared (at the default 1e-3 each stops where its own model's gain is small)
-    a = solve_sqp(smooth, options=SQPOptions(condense=True, ftol=1e-4))
-    b = solve_sqp(smooth, options=SQPOptions(condense=False, ftol=1e-4))
+    tight = TerminationOptions(ftol=1e-4)
+    a = solve_sqp(smooth, options=SQPOptions(tight, qp=QPOptions(condense=True)))
+    b = solve_sqp(smooth, options=SQPOptions(tight, qp=QPOptions(condense=False)))
     assert a.success and b.success
     assert a.objective == pytest.approx(b.objective, rel=1e-4)
     assert a.max_violation <= 1e-6 and b.max_violation <= 1e-6
     nlp = segments["translate"]
-    a = solve_sqp(nlp, options=SQPOptions(condense=True))
-    b = solve_sqp(nlp, options=SQPOptions(condense=False))
+    a = solve_sqp(nlp, options=SQPOptions(qp=QPOptions(condense=True)))
+    b = solve_sqp(nlp, options=SQPOptions(qp=QPOptions(condense=False)))
     assert a.success and b.success
     assert a.objective == pytest.approx(b.objective, rel=5e-3)
 

@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.full_qp import QPSubproblem
 
 
@@ -45,8 +45,8 @@ def _load(qp, nlp, x, grad_scale=1.0, box=0.5):
 def test_shared_structure_shares_one_compiled_problem(setup):
     a, b = setup
     assert a.structure_key == b.structure_key
-    assert SUBPROBLEMS.get(a) is SUBPROBLEMS.get(b)
-    assert SUBPROBLEMS.get(a).problem.is_dpp()
+    assert DEFAULT_WORKSPACE.get(a) is DEFAULT_WORKSPACE.get(b)
+    assert DEFAULT_WORKSPACE.get(a).problem.is_dpp()
 
 
 def test_step_satisfies_linearised_constraints_and_kkt(setup):

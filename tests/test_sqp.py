@@ -8,7 +8,8 @@ from sqp_reference import LOG_PATH, log_rows, run
 
 from flipkit.errors import NoSolutionFound
 from flipkit.solvers.ipopt import solve_ipopt
-from flipkit.solvers.sqp import SQPOptions, solve_sqp
+from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
+from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +57,7 @@ def test_iteration_log_matches_committed_log(reference):
 def test_failure_raises_with_group_and_amount(reference):
     nlp, _ = reference
     with pytest.raises(NoSolutionFound) as err:
-        solve_sqp(nlp, options=SQPOptions(max_iter=2))
+        solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=2)))
     assert err.value.group in nlp.violation_by_group(nlp.x0)
     assert err.value.status == "max_iter" and np.isfinite(err.value.amount)
     assert err.value.problem is nlp and err.value.result.iterations == 2
@@ -99,10 +100,10 @@ def test_locally_infeasible_segment_stops_early_as_infeasible():
     # The condensed restoration holds the linearised equality rows (the end pose among them)
     # and leaves the violation on the task-space bounds that the pose lies outside of.
     assert err.value.status == "infeasible" and err.value.group in ("end_pose", "task_position")
-    assert err.value.result.iterations < SQPOptions().max_iter // 2
+    assert err.value.result.iterations < SQPOptions().termination.max_iter // 2
     assert err.value.amount > 0.1
     elastic = [row["elastic"] for row in err.value.result.log]
-    assert all(elastic[-SQPOptions().stall_iterations:])
+    assert all(elastic[-SQPOptions().termination.stall_iterations:])
 
 
 def test_sequential_solves_repeat_exactly(reference):
@@ -117,6 +118,23 @@ def test_sequential_solves_repeat_exactly(reference):
     assert np.array_equal(again.x, res.x) and again.iterations == res.iterations
 
 
+def test_a_workspace_of_the_callers_own_gives_the_same_solves(reference):
+    """A caller's workspace compiles its own subproblems, leaves the default workspace's
+    alone, and is reset on entry like the default one: after another solve of the same
+    structure in it, the reference solve repeats exactly."""
+    nlp, res = reference
+    from sqp_reference import reference_nlp
+
+    default_qp = DEFAULT_WORKSPACE.get(nlp, "condensed")
+    own = SQPWorkspace()
+    other = reference_nlp()
+    solve_sqp(other, x0=other.x0 + 0.01 * other.x_scale, raise_on_failure=False, workspace=own)
+    again = solve_sqp(nlp, workspace=own)
+    assert np.array_equal(again.x, res.x) and again.iterations == res.iterations
+    assert own.get(nlp, "condensed") is not default_qp
+    assert DEFAULT_WORKSPACE.get(nlp, "condensed") is default_qp
+
+
 def test_no_restoration_from_a_feasible_point():
     """At a feasible iterate the linearisation is feasible (d = 0 satisfies it), so the SQP
     must never fall back to restoration there. Regression: a warm start from the previous
@@ -129,10 +147,10 @@ def test_no_restoration_from_a_feasible_point():
     nlp = build_segment("go_to_burger", models, models.bare.q_home, np.zeros(6),
                         location=(0.677778, -0.17, 0.072))
     best = solve_ipopt(nlp).objective
-    for ftol, rel in ((SQPOptions().ftol, 1e-2), (1e-4, 1e-3)):
+    for ftol, rel in ((SQPOptions().termination.ftol, 1e-2), (1e-4, 1e-3)):
         # the default stops at a predicted gain of 1e-3 of Σu² (measured here: 2.2e-3 above
         # IPOPT); the tighter test of session 11 reaches IPOPT's optimum within 1e-3
-        res = solve_sqp(nlp, options=SQPOptions(ftol=ftol))
+        res = solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(ftol=ftol)))
         feasible_before = [True] + [row["violation"] <= 1e-6 for row in res.log[:-1]]
         assert not any(row["elastic"] for row, ok in zip(res.log, feasible_before) if ok)
         assert res.objective == pytest.approx(best, rel=rel)
@@ -155,12 +173,14 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
     tiny = (np.maximum(lo, -1e-5), np.minimum(hi, 1e-5))
-    wide = (np.maximum(lo, -o.trust_max), np.minimum(hi, o.trust_max))
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, *tiny, 1e-6)
+    big = o.trust_region.radius_max
+    wide = (np.maximum(lo, -big), np.minimum(hi, big))
+    mu, ws = o.trust_region.prox, DEFAULT_WORKSPACE
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, mu, *tiny, 1e-6, workspace=ws)
     assert qp.elastic  # no wide box: restoration
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, *tiny, 1e-6, wide)
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, mu, *tiny, 1e-6, wide, workspace=ws)
     assert not qp.elastic and sol.status == "optimal"
-    assert np.abs(sol.d).max() <= o.trust_max + 1e-6 and np.abs(sol.d).max() > 1e-5
+    assert np.abs(sol.d).max() <= big + 1e-6 and np.abs(sol.d).max() > 1e-5
     assert S._linearised_violation(nlp, p, sol.d) < 1e-3 * float(p.v.sum())
 
 
@@ -178,8 +198,9 @@ def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
     grad = nlp.gradient(p.x) * nlp.obj_scale * D
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.prox, np.maximum(lo, -1e-2),
-                                np.minimum(hi, 1e-2), 1e-6)
+    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.trust_region.prox,
+                                np.maximum(lo, -1e-2), np.minimum(hi, 1e-2), 1e-6,
+                                workspace=DEFAULT_WORKSPACE)
     assert qp.elastic
     lin = S._linearised_violation(nlp, p, sol.d, total=False)
     decrease = S._square_violation(p) - 0.5 * float(lin @ lin)
@@ -257,7 +278,7 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     """The flip's cold guess, clipped to the velocity and acceleration limits, is
     inconsistent by O(1): within the trust box of 1 the condensed restoration QP (equalities
     hard) is infeasible and only the full-space one (every row elastic) gives a step; within
-    ``restoration_trust`` the condensed one does, it holds the linearised equalities, and it
+    ``restoration.radius`` the condensed one does, it holds the linearised equalities, and it
     removes most of the linearised violation."""
     from flipkit.solvers import sqp as S
     from flipkit.solvers.condensed_qp import CondensedQP
@@ -274,27 +295,28 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     def box(radius):
         return np.maximum(lo, -radius), np.minimum(hi, radius)
 
-    args = (nlp, o, p, grad, hess, o.prox, *box(o.trust_max), 1e-4)
-    sol, qp, *_ = S._subproblem(*args)
+    big, ws = o.trust_region.radius_max, DEFAULT_WORKSPACE
+    args = (nlp, o, p, grad, hess, o.trust_region.prox, *box(big), 1e-4)
+    sol, qp, *_ = S._subproblem(*args, workspace=ws)
     assert qp.elastic and isinstance(qp, QPSubproblem)  # the condensed form had no step
-    sol, qp, *_ = S._subproblem(*args, None, o.restoration_trust)
+    sol, qp, *_ = S._subproblem(*args, None, o.restoration.radius, workspace=ws)
     assert qp.elastic and isinstance(qp, CondensedQP) and sol.status == "optimal"
     eq = nlp.c_lo == nlp.c_hi
     lin = p.cs + p.J @ sol.d
     assert np.abs((lin - nlp.c_scale * nlp.c_lo)[eq]).max() < 1e-8
-    assert np.abs(sol.d).max() > o.trust_max  # a step the trust box of 1 could not take
+    assert np.abs(sol.d).max() > big  # a step the trust box of 1 could not take
     assert S._linearised_violation(nlp, p, sol.d) < 0.1 * float(p.v.sum())
 
 
 def test_a_restoration_phase_skips_the_hard_qp_until_the_violation_has_fallen(cold_flip):
     """After an accepted restoration step the SQP stays in restoration — one QP per
-    iteration, no hard attempts — while the violation exceeds ``restoration_exit`` × its value
+    iteration, no hard attempts — while the violation exceeds ``restoration.exit`` × its value
     when the phase began; the log of a cold flip follows that rule row by row, and the flip
     is solved."""
     nlp = cold_flip
     res = solve_sqp(nlp)
     assert res.status == "solved"
-    exit_ = SQPOptions().restoration_exit
+    exit_ = SQPOptions().restoration.exit
     entry, phase_rows = None, 0
     v_prev = float(nlp.scaled_violation(nlp.constraints(nlp.project(nlp.x0))).max())
     for row in res.log:
@@ -322,4 +344,4 @@ def test_a_rejected_step_never_widens_the_trust_box():
     trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=1e-3, trust=0.5, mu=1.0)
     assert trust == pytest.approx(1e-4)  # a short rejected step: a tenth of its length
     trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=1e-9, trust=1e-6, mu=1.0)
-    assert trust == o.trust_min
+    assert trust == o.trust_region.radius_min

@@ -24,7 +24,7 @@ def test_sqp_solves_inside_the_limit(monkeypatch):
     """solve_sqp's loop runs with one BLAS thread (the limit is entered around it)."""
     seen = []
 
-    def probe(nlp, x0, options):
+    def probe(nlp, x0, options, workspace):
         seen.append(_blas_threads())
         raise RuntimeError("stop")
 

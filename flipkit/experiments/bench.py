@@ -41,9 +41,10 @@ from flipkit.model.ik import solve_pose
 from flipkit.planning.atlas import Atlas, default_atlas
 from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
 from flipkit.experiments.sweep import make_executor
-from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
-from flipkit.solvers.sqp import SQPOptions, solve_sqp
+from flipkit.solvers.names import EXACT_RESULT_NAMES, NLP_SOLVERS
+from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
 from flipkit.transcription.ocp_graph import OcpGraph
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
@@ -71,15 +72,17 @@ def machine() -> str:
 
 def warm_up(nlps) -> float:
     """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
-    process) and run one SQP iteration on it, which compiles the condensed hard QP;
-    returns the time (s)."""
+    workspace) and run one SQP iteration on it, which compiles the condensed hard QP;
+    returns the time (s). The workspace is the process's default, which the planner's
+    solves use."""
     t0, seen = time.perf_counter(), set()
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
             for form in ("elastic", "condensed_elastic"):
-                SUBPROBLEMS.get(nlp, form).compile()
-            solve_sqp(nlp, options=SQPOptions(max_iter=1), raise_on_failure=False)
+                DEFAULT_WORKSPACE.get(nlp, form).compile()
+            solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=1)),
+                      raise_on_failure=False, workspace=DEFAULT_WORKSPACE)
     return time.perf_counter() - t0
 
 
@@ -98,7 +101,7 @@ def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
     """FATROP and exact-Hessian IPOPT for each graph, built once per distinct graph
     (:attr:`OcpGraph.key`: the translates differ only in their bounds); build times (s)."""
     solvers, build = {}, {}
-    for name, plugin in (("fatrop", "fatrop"), ("ipopt_exact", "ipopt")):
+    for plugin, name in EXACT_RESULT_NAMES.items():  # fatrop, then ipopt_exact
         for g in graphs:
             key = (plugin, g.key, jit)
             if key not in cache:
@@ -130,7 +133,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
             scaled problem from the same start ``nlp.x0``.
         jit: Compile FATROP's and exact IPOPT's functions to C (CasADi JIT).
     """
-    names = ("sqp", "ipopt") if full else tuple(TRANSLATE_SOLVERS)
+    names = NLP_SOLVERS if full else tuple(TRANSLATE_SOLVERS)
     nlps = _translate_nlps(cell, SegmentOptions(arm_clearance=full))
     print(machine())
     print(f"problem: translate NLP {'with' if full else 'without'} the arm's clearance rows"
@@ -155,7 +158,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
     for k, nlp in enumerate(nlps):
         r = {"segment": f"{k + 1}->{(k + 1) % len(nlps) + 1}"}
         for name in names:
-            if name in ("fatrop", "ipopt_exact"):
+            if name in EXACT_RESULT_NAMES.values():
                 res = exact[(name, id(graphs[k]))].solve(graph=graphs[k])
             else:
                 res = solve_segment(nlp, name)

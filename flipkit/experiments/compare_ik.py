@@ -194,7 +194,7 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
         UnreachableError: A location off the grill (named by its index, from 1).
         InvalidChoiceError: Unknown solver.
     """
-    from flipkit.planning.planner import SOLVERS
+    from flipkit.solvers.names import SOLVERS
 
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)

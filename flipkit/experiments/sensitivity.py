@@ -15,6 +15,7 @@ from __future__ import annotations
 from flipkit.config import PHYSICAL_RANGES
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.trials import STAGES, TRACK_RATE_HZ, Perturbations, run_trial, trial_jobs, trial_key
+from flipkit.simulation.modes import FEEDFORWARD
 
 ENDS = ("low", "high")
 
@@ -44,7 +45,7 @@ def _counts(results: list) -> dict:
 
 
 def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0, *,
-                    mode: str = "feedforward", replan: bool = True,
+                    mode: str = FEEDFORWARD, replan: bool = True,
                     perturbations: Perturbations = Perturbations(),
                     rate_hz: float = TRACK_RATE_HZ, nominal: bool = True, executor=None,
                     cache_dir=None, progress: bool = False) -> dict:

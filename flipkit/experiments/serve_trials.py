@@ -22,6 +22,7 @@ from flipkit.experiments.trials import (HOLD_S, TRACK_RATE_HZ, Perturbations, me
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.serve import table_spot
 from flipkit.simulation.judges import judge_pickup, judge_scoop, judge_serve
+from flipkit.simulation.modes import FEEDFORWARD
 
 SERVE_STAGES = ("scoop", "pickup", "serve")
 
@@ -47,7 +48,7 @@ def run_serve_trial(job: dict) -> dict:
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
     replan = replan_serve if job.get("replan", False) else None
-    mode = job.get("mode", "feedforward")
+    mode = job.get("mode", FEEDFORWARD)
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
                       replan=replan, command=job.get("command", "compensated"))
     run, bounds = ex.run, ex.bounds
@@ -86,7 +87,7 @@ def _failure(scoop, pickup, serve) -> dict | None:
 
 def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations(), *,
                    executor=None, cache_dir=None, progress: bool = True,
-                   rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+                   rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
                    replan: bool = False, command: str = "compensated") -> dict:
     """Run ``trials`` simulated executions of the serve plan file ``path``.
 

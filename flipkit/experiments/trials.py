@@ -28,6 +28,8 @@ from flipkit.config import CellConfig, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.planning.plan_file import Plan
+from flipkit.simulation.modes import FEEDFORWARD, MODES
+from flipkit.solvers.names import SOLVERS
 
 TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
 HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
@@ -116,7 +118,7 @@ def run_trial(job: dict) -> dict:
     Args:
         job: ``plan_text`` (a solved flip plan file's text), ``trial`` (index), ``seed``,
             ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
-            rate, Hz), ``mode`` (:data:`flipkit.simulation.execute.MODES`; default ``"feedforward"``),
+            rate, Hz), ``mode`` (:data:`flipkit.simulation.modes.MODES`; default ``"feedforward"``),
             ``command`` (position mode's command stream,
             :data:`flipkit.planning.servo_command.COMMANDS`; default ``"compensated"``),
             optionally ``replan`` (bool, see :func:`validate`) and ``physics``
@@ -136,7 +138,7 @@ def run_trial(job: dict) -> dict:
     from flipkit.simulation.execute import execute_plan
 
     plan = plan_from_text(job["plan_text"])
-    mode = job.get("mode", "feedforward")
+    mode = job.get("mode", FEEDFORWARD)
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
     cell = plan.cell()
@@ -210,7 +212,7 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
 
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
-               rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+               rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
                replan: bool = False, physics: dict | None = None,
                command: str = "compensated") -> list:
     """The :func:`run_trial` jobs of one plan (``physics``: see :func:`run_trial`; the key
@@ -254,7 +256,7 @@ def plan_location(job: dict) -> dict:
 
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
-             rate_hz: float = TRACK_RATE_HZ, mode: str = "feedforward",
+             rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
              replan: bool = False, command: str = "compensated") -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
@@ -265,7 +267,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         trials: Trials per location (≥ 1). seed: Trial i draws from
             ``np.random.default_rng(seed + i)``.
         perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
-        mode: Joint controller, one of :data:`flipkit.simulation.execute.MODES`.
+        mode: Joint controller, one of :data:`flipkit.simulation.modes.MODES`.
         replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
             and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planner.replan_flip`);
             ``False`` runs the plans open loop.
@@ -277,7 +279,6 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
         "trials", "success": {stage: count}, "independent": {stage: count}}}``.
     """
-    from flipkit.simulation.execute import MODES
     from flipkit.experiments.sweep import run_sweep
 
     if mode not in MODES:
@@ -337,7 +338,6 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
     """
     import tempfile
 
-    from flipkit.planning.planner import SOLVERS
     from flipkit.experiments.sweep import run_sweep
 
     if solver not in SOLVERS:

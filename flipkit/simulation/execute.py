@@ -36,9 +36,9 @@ from flipkit.planning.servo_command import COMMANDS, command_lead, position_comm
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
+from flipkit.simulation.modes import FEEDFORWARD, MODES, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
 
-MODES = ("feedforward", "position")
 HOLD_S = 1.0  # s after the plan: the flipped burger lands
 # The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
 # scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
@@ -132,7 +132,7 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
     return draw
 
 
-def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
+def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None,
                  command: str = "compensated") -> Execution:
@@ -142,7 +142,8 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         plan: A solved flip or serve :class:`~flipkit.planning.plan_file.Plan` (segments
             go_to_burger … turn_back, or go_to_burger … return_home; a serve plan tilts the
             burger off onto the scene's table).
-        mode: ``"feedforward"`` or ``"position"`` (module docstring).
+        mode: One of :data:`~flipkit.simulation.modes.MODES`, ``"feedforward"`` or
+            ``"position"`` (module docstring).
         draw: A perturbation (:meth:`flipkit.experiments.trials.Perturbations.draw`): ``dx_m``, ``dy_m``
             burger placement error (m), ``grill_offset_m`` (m), ``mu_factor`` (burger-blade
             friction), ``mass_factor`` (burger mass), ``sense_dx_m``, ``sense_dy_m`` (the
@@ -198,7 +199,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
         q_des, qd_des, u_ff, bounds = _desired(plan, _paused(t, t_pause, pause))
         bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
                       b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
-        if mode == "position":  # servo-rate samples, arriving latency_s late, zero-order hold
+        if mode == POSITION:  # servo-rate samples, arriving latency_s late, zero-order hold
             sent = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
                 / ph.servo_rate_hz
             lead = command_lead(nominal) if command == "compensated" else 0.0
@@ -263,7 +264,7 @@ def execute_plan(plan, mode: str = "feedforward", draw: dict | None = None, *,
                     raise ConfigError("the replanned run does not extend the executed one")
                 t = t2
         q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
-        ff = u_ff[k] if mode == "feedforward" else pin.computeGeneralizedGravity(
+        ff = u_ff[k] if mode == FEEDFORWARD else pin.computeGeneralizedGravity(
             robot.model, robot.data, q)
         u = np.clip(ff + kp * (q_cmd[k] - q) + kd * (qd_cmd[k] - qd), -umax, umax)
         qa[k], ua[k], qpos[k] = q, u, d.qpos

@@ -1,10 +1,16 @@
-"""Compiled subproblems, one per NLP structure and form, built on first use and reused.
+"""The SQP's workspace: compiled subproblems, one per NLP structure and form, built on first use
+and reused.
 
-Canonicalising a subproblem with cvxpy costs 0.01–0.4 s, so each (structure, form) is
-compiled once per process; its parameters then take each linearisation's values (DPP) and
-OSQP warm-starts. :meth:`SubproblemCache.reset` forgets the OSQP state of a structure's forms,
-so a solve never warm-starts from another NLP's solution (results must not depend on what was
-solved before in the process).
+Canonicalising a subproblem with cvxpy costs 0.01–0.4 s, so a workspace compiles each
+(structure, form) once; its parameters then take each linearisation's values (DPP) and OSQP
+warm-starts. :func:`flipkit.solvers.sqp.solve_sqp` calls :meth:`SQPWorkspace.reset` on entry,
+which forgets the OSQP state of the NLP's structure, so a solve never warm-starts from another
+solve's solution: results do not depend on what the workspace solved before.
+
+A caller may own a workspace (``solve_sqp(nlp, workspace=SQPWorkspace())``); without one,
+``solve_sqp`` uses :data:`DEFAULT_WORKSPACE`, shared by the process, so the compiled
+subproblems are reused from solve to solve. A workspace serves one solve at a time: solves
+running concurrently in threads need one each.
 """
 
 from __future__ import annotations
@@ -15,10 +21,12 @@ from flipkit.solvers.full_qp import QPSubproblem
 from flipkit.solvers.subproblem import Subproblem
 from flipkit.transcription.nlp import NLP
 
+__all__ = ["DEFAULT_WORKSPACE", "FORMS", "SQPWorkspace"]
+
 FORMS = ("full", "elastic", "condensed", "condensed_elastic")
 
 
-class SubproblemCache:
+class SQPWorkspace:
     """Compiled subproblems by (NLP structure key, form); see :data:`FORMS`."""
 
     def __init__(self):
@@ -48,5 +56,6 @@ class SubproblemCache:
                 qp.reset()
 
 
-SUBPROBLEMS = SubproblemCache()
-"""The process's cache, used by :func:`flipkit.solvers.sqp.solve_sqp`."""
+DEFAULT_WORKSPACE = SQPWorkspace()
+"""The process's workspace: :func:`flipkit.solvers.sqp.solve_sqp` uses it when called without
+one."""

@@ -30,11 +30,10 @@ import casadi as ca
 import numpy as np
 
 from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.solvers.names import EXACT_RESULT_NAMES, EXACT_SOLVERS
 from flipkit.transcription.nlp import NLP
 from flipkit.transcription.ocp_graph import OcpGraph
 from flipkit.solvers.result import SolveResult, Status
-
-EXACT_SOLVERS = ("fatrop", "ipopt")
 
 
 @dataclass(frozen=True)
@@ -142,7 +141,7 @@ class ExactSolver:
             status = Status.FATROP_FAILED
         return SolveResult(x=x, status=status, iterations=int(stats.get("iter_count", 0)),
                            wall_time_s=wall, objective=nlp.objective(x), max_violation=violation,
-                           solver="fatrop" if self.name == "fatrop" else "ipopt_exact")
+                           solver=EXACT_RESULT_NAMES[self.name])
 
 
 def solve_exact(nlp: NLP, solver: str = "fatrop", x0=None,

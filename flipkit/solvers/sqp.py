@@ -1,61 +1,78 @@
-"""SQP: Gauss–Newton subproblems (cvxpy + OSQP), exact dynamics projection, ℓ1 merit.
+"""SQP for one segment's NLP: Gauss–Newton subproblems (cvxpy + OSQP), exact projection onto the
+dynamics rows, ℓ1 merit with a line search, and a box trust region.
 
-Model. Each iteration linearises the constraints at Z_k and solves the convex subproblem of
-:mod:`flipkit.solvers.full_qp` — in its condensed form, :mod:`flipkit.solvers.condensed_qp`, by
-default: the 516–528 linearised equality rows are eliminated by a sparse LU, leaving 19–31
-variables with an identity Hessian and only inequality rows for OSQP (measured on the ten
-Table I pickup-and-flip chains: median 11.7 s → 1.6 s per burger). The model: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt
-weight ½μ‖d‖², every linearised row hard, and a box trust region |d|∞ ≤ Δ (scaled units).
-With the dynamics rows u = RNEA(q, q̇, q̈) hard this is the Gauss–Newton model of Σ‖RNEA‖²
-along the linearised constraints: no second derivatives, no quasi-Newton memory. Σu² is
-nearly flat along wrist motions (9 of the 19 eigenvalues of the condensed Hessian below 4e-6, the
-largest 5e-3, measured), which μ regularises: μ is divided by 4 after a full step the
-model predicted well (actual/predicted ≥ ``good_ratio``) and multiplied by 4 when a step had to be
-shortened, within ``prox_range``.
+Settings are :class:`~flipkit.solvers.sqp_options.SQPOptions`, in four groups (``termination``,
+``trust_region``, ``restoration``, ``qp``); lengths are in scaled variable units, J̃ is the
+scaled cost and v the scaled violation. The design, its alternatives and references are in
+``docs/sqp.md``.
 
-Globalisation. Every trial point is *projected* first: u_i := RNEA(q_i, q̇_i, q̈_i), which
-satisfies the dynamics rows exactly (u enters them alone and linearly). Without it the
-merit sees the dynamics rows' second-order error and rejects any step longer than a few
-hundredths of a radian (measured: actual/predicted ≈ −300 at a unit step). A trial point
-Z + a·d, a ∈ {1, ½, …, 1/32}, is accepted when φ = J̃ + ρ‖v‖₁ (v the scaled violation) falls
-by at least η·a·pred, pred the model's decrease; ρ stays above twice the largest QP
-multiplier and large enough for the step to descend on φ. Δ doubles after a full, well
-predicted step that used at least half of it and shrinks to the accepted length otherwise.
+Model. Each iteration linearises the constraints at Z_k and solves a convex QP for the step
+d: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt weight ½μ‖d‖², every
+linearised row hard, and the trust box |d|∞ ≤ Δ. With the dynamics rows u = RNEA(q, q̇, q̈)
+hard this is the Gauss–Newton model of Σ‖RNEA‖² along the linearised constraints: no second
+derivatives, no quasi-Newton memory. With ``qp.condense`` (the default) the QP is solved in
+condensed form (:mod:`flipkit.solvers.condensed_qp`: the linearised equality rows eliminated by
+a sparse LU, OSQP sees a small QP with an identity Hessian and inequality rows only), else in
+full space (:mod:`flipkit.solvers.full_qp`). The compiled QPs belong to a workspace
+(:class:`~flipkit.solvers.compiled.SQPWorkspace`, the caller's or the process's default), reset
+for the NLP's structure on entry so that no solve warm-starts from another. μ regularises the
+directions along which Σu² is nearly flat (wrist motions): it is divided by 4 after a full
+step the model predicted well (actual/predicted ≥ ``trust_region.good_ratio``) and multiplied
+by 4 after a shortened or rejected one, within ``trust_region.prox_range``.
+
+Globalisation. Every trial point is projected first: u_i := RNEA(q_i, q̇_i, q̈_i), which
+satisfies the dynamics rows exactly (u enters them alone and linearly), so the merit does not
+see their second-order error. A trial point Z + a·d, a ∈ {1, ½, …, 2^−``backtracks``}, is
+accepted when φ = J̃ + ρ‖v‖₁ falls by at least η·a·pred, pred the model's decrease; ρ stays
+above twice the largest QP multiplier and large enough for d to descend on φ. A full step
+that raises the violation and falls short of its prediction gets a second-order correction
+(a Newton step holding the QP's active rows) before it is judged. Δ doubles after a full,
+well predicted step that used at least half of it, shrinks to the accepted length after a
+shortened step, and to a tenth of the shorter of Δ and the step after a rejected one.
 
 Subproblem failures. If OSQP runs out of iterations on the hard QP, μ is raised tenfold and
-the QP re-solved (up to three tries); if the linearisation is infeasible, a restoration
-step minimises ½σ‖s‖² + ½μ_r‖d‖² over slacks s: in condensed form, the equality rows hard and
-slacks on the inequality rows, else (equalities and step box incompatible) in full space with
-slacks on every row (:mod:`flipkit.solvers.condensed_qp`, :mod:`flipkit.solvers.full_qp`). A
-restoration step is judged by the violation alone: its trial points must lower ½‖v‖₂² (which
-that QP models, σ = 1) by η·a times the linearised reduction, whatever Σu² does (not ‖v‖₁: the
-ℓ2 step may spread one row's violation over many; judged on φ, a step that removes violation
-by raising Σu² has a negative predicted decrease and was never tried: measured at Table I
-location 2 from a warm start, the trust box then shrank tenfold per iteration at a landing
-violation of 0.0098 until the solve was declared infeasible); when ``stall_iterations``
-restoration steps in a row barely reduce the violation, Z is a stationary point of the
-violation and the solve stops as ``infeasible``. An accepted restoration step opens a
+the QP re-solved (three tries, capped by ``qp.max_iter``); an infeasibility verdict from a warm
+start is confirmed by a cold solve. A hard QP infeasible in a shrunken box is solved in the
+largest box (Δ_max ∩ the variable bounds) and the line search shortens its step. Otherwise a
+restoration step minimises ½σ‖s‖² + ½μ_r‖d‖² over slacks s: in condensed form, the equality
+rows hard and slacks on the inequality rows, else (equalities and box incompatible) in full
+space with slacks on every row; its box is ±``restoration.radius`` while Δ is at its largest.
+A restoration step is judged by the violation alone: its trial points must lower ½‖v‖₂² by
+η·a times the linearised reduction, whatever Σu² does. An accepted restoration step opens a
 restoration phase, as in filter SQP methods: the next steps are restoration steps too, without
-the hard QP's attempts (each an ADMM run to an infeasibility verdict), until the violation is
-down to ``restoration_exit`` times its value when the phase began. The OSQP tolerance follows
-the iterate (inexact SQP): 0.1 × the violation (or, at a feasible iterate, the last predicted
-decrease), within ``qp_eps`` — loose far from a solution, tight near it, where the step must
-resolve residuals below ``tol``.
+the hard QP's attempts, until the max violation is down to ``restoration.exit`` times its
+value when the phase began. The OSQP tolerance follows the iterate (inexact SQP):
+``qp.eps_factor`` × the max violation (at a feasible iterate, × the last predicted decrease),
+clipped to ``qp.eps``; a negative predicted decrease at a feasible iterate means the QP was
+solved too loosely, and it is solved again a hundred times tighter.
 
-Converged: the hard QP's predicted decrease ≤ ``ftol``·J̃ and max scaled violation ≤ ``tol``
-(a stationary point a hair outside gets up to three minimum-norm Newton corrections), or a
-feasible point whose step the line search rejects while predicting at most ``reject_ftol``·J̃.
-``ftol`` = 1e-3 (1e-4 until session 11): past it Σu² creeps down along flat valleys by parts
-in 1e4 per iteration (on pickup ~5e-5; IPOPT needs 130 iterations there too). Measured in
-session 12 on the ten Table I pickup-and-flip chains: from the atlas 280 → 216 SQP
-iterations, ΣΣu² −0.05 %; from cold starts 433 → 374, ΣΣu² +1.0 % (the worst chain +2.9 %); the
-reference translate of ``tests/data`` ends 2.5e-4 above IPOPT's optimum instead of 1.4e-5.
-An exact Lagrangian Hessian (finite differences, condensed space) left the pickup's tail
-unchanged: the steps there are limited by the rows' curvature, not by the model of the cost
-(measured, session 5).
+Stopping rules (``termination``), as checked in each iteration. Every ``solved`` needs the max
+scaled violation ≤ ``tol``.
 
-Why not TrajOpt's penalty trust region: with every equality softened by slacks the
-subproblem is LP-like and OSQP needed 6 000–20 000 ADMM iterations per solve (measured).
+1. Stationary (``solved``): the hard QP predicts a merit decrease ≤ ``ftol``·J̃ (J̃ taken as at
+   least 1e-3). A stationary point a hair outside ``tol`` first gets up to three minimum-norm
+   Newton corrections onto the rows.
+2. Plateau (``solved``, as rule 1, corrections included): the last ``plateau_iterations``
+   iterates were feasible to 100·``tol`` and together lowered Σu² by less than
+   ``plateau_ftol`` (relative). The Gauss–Newton model ignores the rows' curvature: creeping
+   along curved active rows it keeps predicting more than ``ftol``, so this rule watches the
+   actual decrease over a window instead of the predicted one.
+3. Rejected small step (``solved``): at a feasible iterate the line search rejects a hard step
+   whose predicted decrease was at most ``reject_ftol``·J̃. Rule 1 has already taken every
+   prediction ≤ ``ftol``·J̃, so this rule covers (``ftol``, ``reject_ftol``]: gains inside the
+   model's error, where Δ would otherwise shrink tenfold per rejected step until rule 1 held
+   at the same point. It is off when ``reject_ftol`` ≤ ``ftol``.
+4. ``stalled``: a step is rejected with Δ at ``trust_region.radius_min``.
+5. ``infeasible``: ``stall_iterations`` restoration steps, with no better restoration step
+   between them, each cut ½‖v‖₂² by less than ``stall_progress`` (relative): a stationary
+   point of the violation. Only restoration steps count, so it never competes with rules 1–3,
+   which judge hard steps.
+6. ``max_iter``: ``max_iter`` iterations done.
+
+Rules 1–3 answer one question, whether Z is stationary, from three sides: the model's
+prediction (1), the actual progress (2) and the line search's verdict on a small prediction
+(3). ``ftol`` sets where a solve normally ends; ``plateau_ftol`` and ``reject_ftol`` bound the
+tail where the model is less accurate than ``ftol``. Rules 4–6 end solves that failed.
 """
 
 from __future__ import annotations
@@ -68,28 +85,32 @@ import numpy as np
 from flipkit.errors import NoSolutionFound
 from flipkit.solvers.iterate import Iterate, newton_correction
 from flipkit.transcription.nlp import NLP
-from flipkit.solvers.compiled import SUBPROBLEMS
+from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
 from flipkit.solvers.subproblem import QPSolution
 from flipkit.solvers.threads import single_threaded_blas
 from flipkit.solvers.result import SolveResult, Status
-from flipkit.solvers.sqp_options import SQPOptions
+from flipkit.solvers.sqp_options import (QPOptions, RestorationOptions, SQPOptions,
+                                         TerminationOptions, TrustRegionOptions)
 
-__all__ = ["SQPOptions", "SolveResult", "solve_sqp"]
+__all__ = ["DEFAULT_WORKSPACE", "QPOptions", "RestorationOptions", "SQPOptions", "SQPWorkspace",
+           "SolveResult", "TerminationOptions", "TrustRegionOptions", "solve_sqp"]
 
 
 def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
-                eps: float, wide=None, restore=None, restoring: bool = False):
+                eps: float, wide=None, restore=None, restoring: bool = False, *,
+                workspace: SQPWorkspace):
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
     raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
     if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
     trust region), if given; else the restoration QP, in the box ±``restore`` ∩ the variable
     bounds (default the step box). ``restoring``: in the restoration phase, the restoration QP
-    alone. Returns (solution, QP object, μ, tries, ADMM iterations)."""
+    alone. The compiled QPs are ``workspace``'s. Returns (solution, QP object, μ, tries, ADMM
+    iterations)."""
     admm, attempt, sol = 0, -1, None
     for attempt in range(0 if restoring else 3):
-        qp = SUBPROBLEMS.get(nlp, "condensed" if o.condense else "full")
+        qp = workspace.get(nlp, "condensed" if o.qp.condense else "full")
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
-        sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
+        sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
         admm += sol.iterations
         if "infeasible" in sol.status and attempt == 0:
             # A warm start from the previous subproblem's duals can fake an infeasibility
@@ -98,11 +119,11 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
             # 20 Table I chains (cold and from the atlas: the same plans) and cost 5–7 % of
             # their CPU time (measured, session 11).
             qp.cold()
-            sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[attempt])
+            sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
             admm += sol.iterations
         if sol.status == "optimal" or "infeasible" in sol.status:
             break
-        mu = min(10.0 * mu, o.prox_range[1])
+        mu = min(10.0 * mu, o.trust_region.prox_range[1])
     if sol is not None and sol.status == "optimal":
         return sol, qp, mu, attempt + 1, admm
     if wide is not None and not restoring:
@@ -118,7 +139,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         # Table I location 2.)
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide)
         qp.cold()
-        sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[-1])
+        sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[-1])
         admm += sol.iterations
         if sol.status == "optimal":
             return sol, qp, mu, attempt + 2, admm
@@ -128,11 +149,11 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
     if restore is not None:
         box = (np.maximum((nlp.x_lb - p.x) / nlp.x_scale, -restore),
                np.minimum((nlp.x_ub - p.x) / nlp.x_scale, restore))
-    for form in (("condensed_elastic", "elastic") if o.condense else ("elastic",)):
-        qp = SUBPROBLEMS.get(nlp, form)
-        qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration_prox), *box,
-                  o.slack_reg)
-        sol = qp.solve(eps=eps, max_iter=o.qp_max_iter[0] if form != "elastic" else None)
+    for form in (("condensed_elastic", "elastic") if o.qp.condense else ("elastic",)):
+        qp = workspace.get(nlp, form)
+        qp.update(nlp, p.cs, p.jac, 0 * grad, np.full(nlp.n, o.restoration.prox), *box,
+                  o.restoration.slack_reg)
+        sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[0] if form != "elastic" else None)
         admm += sol.iterations
         if sol.status == "optimal":
             break
@@ -145,7 +166,7 @@ def _line_search(o: SQPOptions, p: Iterate, d, pred: float, merit, point, correc
     restoration step) from p along d, with a second-order correction of a poorly predicted,
     infeasible full step. Returns (trial, step, ratio, accepted)."""
     step, ratio, trial = 1.0, 0.0, None
-    for _ in range(o.backtracks + 1):
+    for _ in range(o.trust_region.backtracks + 1):
         trial = point(p.x + step * d)
         if step == 1.0 and trial.v.sum() > p.v.sum() and merit(p) - merit(trial) < 0.75 * pred:
             # Second-order correction: the full step's curvature error on the rows (cone,
@@ -156,7 +177,7 @@ def _line_search(o: SQPOptions, p: Iterate, d, pred: float, merit, point, correc
                 trial = soc
         actual = merit(p) - merit(trial)
         ratio = actual / (step * pred)
-        if actual >= o.eta * step * pred:
+        if actual >= o.trust_region.eta * step * pred:
             return trial, step, ratio, True
         step *= 0.5
     return trial, step, ratio, False
@@ -168,20 +189,21 @@ def _adapt(o: SQPOptions, accepted: bool, step: float, ratio: float, d_len: floa
     step had to be shortened or was rejected; Δ doubled after a full, well predicted step
     that used at least half of it, shrunk to the accepted length, or to a tenth of the
     rejected one."""
-    good = accepted and step == 1.0 and ratio >= o.good_ratio
+    t = o.trust_region
+    good = accepted and step == 1.0 and ratio >= t.good_ratio
     if good:
-        mu = max(mu / 4.0, o.prox_range[0])
+        mu = max(mu / 4.0, t.prox_range[0])
     elif not accepted or step < 1.0:
-        mu = min(mu * 4.0, o.prox_range[1])
+        mu = min(mu * 4.0, t.prox_range[1])
     if good and d_len >= 0.5 * trust:
-        trust = min(2.0 * trust, o.trust_max)
+        trust = min(2.0 * trust, t.radius_max)
     elif accepted and step < 1.0:
-        trust = max(step * d_len, o.trust_min)
+        trust = max(step * d_len, t.radius_min)
     elif not accepted:  # never wider than before: a rejected step from the largest box
         # (wide, longer than Δ) once reset Δ to a tenth of its own length, the same Δ at the
         # same point each time: 85 identical iterations to max_iter (measured, a flip from
         # the atlas at (0.87, −0.42); then the cold fallback solved it)
-        trust = max(0.1 * min(d_len, trust), o.trust_min) if d_len > 0 else 0.1 * trust
+        trust = max(0.1 * min(d_len, trust), t.radius_min) if d_len > 0 else 0.1 * trust
     return trust, mu
 
 
@@ -211,54 +233,68 @@ def _descent_model(nlp: NLP, p: Iterate, sol: QPSolution, grad, hess, rho: float
     return rho, p.merit(rho) - (p.f + model_f + rho * lin_v)
 
 
-def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_failure=True
-              ) -> SolveResult:
-    """Solve ``nlp`` from ``x0`` (default ``nlp.x0``), BLAS on one thread
-    (:mod:`flipkit.solvers.threads`).
+def solve_sqp(nlp: NLP, x0=None, options: SQPOptions = SQPOptions(), raise_on_failure=True,
+              *, workspace: SQPWorkspace | None = None) -> SolveResult:
+    """Solve ``nlp`` from ``x0``, BLAS on one thread (:mod:`flipkit.solvers.threads`).
+
+    Args:
+        nlp: The NLP.
+        x0: Start point, unscaled (default ``nlp.x0``).
+        options: The settings (:class:`~flipkit.solvers.sqp_options.SQPOptions`).
+        raise_on_failure: Raise :class:`NoSolutionFound` unless solved; False returns the
+            result whatever its status.
+        workspace: The compiled subproblems to solve with, owned by the caller (one solve at
+            a time per workspace); default :data:`~flipkit.solvers.compiled.DEFAULT_WORKSPACE`,
+            the process's. Its state for ``nlp``'s structure is reset on entry, so the
+            result does not depend on what the workspace solved before.
+
+    Returns:
+        The result: final point, status, iterations, log.
 
     Raises:
         NoSolutionFound: Not converged to a feasible point (carries the NLP, status, the
             worst constraint group and its violation, and the result).
     """
     with single_threaded_blas():
-        result = _solve(nlp, x0, options)
+        result = _solve(nlp, x0, options, DEFAULT_WORKSPACE if workspace is None else workspace)
     if result.status != Status.SOLVED and raise_on_failure:
         group, amount = nlp.worst_group(result.x)
         raise NoSolutionFound(nlp, result.status, group, amount, result)
     return result
 
 
-def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
+def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveResult:
     """The SQP loop of :func:`solve_sqp`; returns the result whatever its status."""
     t0 = time.perf_counter()
-    SUBPROBLEMS.reset(nlp)  # no warm start from another NLP's solve in this process
+    workspace.reset(nlp)  # no warm start from another solve in this workspace
     o, D = options, nlp.x_scale
+    stop, tr = o.termination, o.trust_region
     Jscale = nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     point = lambda x: Iterate(nlp, nlp.project(x), Jscale)  # noqa: E731  (x unscaled)
     correct = lambda q: point(q.x + D * newton_correction(nlp, q))  # noqa: E731
     p = point(nlp.x0 if x0 is None else x0)
-    rho, trust, mu, tighten = o.rho_min, o.trust0, o.prox, 1.0
+    rho, trust, mu, tighten = tr.rho_min, tr.radius0, tr.prox, 1.0
     log, qp_iters, status, it, pred, stalls = [], 0, Status.MAX_ITER, 0, np.inf, 0
     entry = None  # the violation where the restoration phase began (None: not in it)
     if not (np.all(np.isfinite(p.c)) and np.all(np.isfinite(p.jac))):  # no model to start from
         return SolveResult(x=p.x, status=Status.INVALID_NUMBER_DETECTED, iterations=0,
                            wall_time_s=time.perf_counter() - t0, objective=nlp.objective(p.x),
                            max_violation=math.inf, log=log, qp_iterations=0)
-    while it < o.max_iter:
+    while it < stop.max_iter:
         it += 1
         grad = nlp.gradient(p.x) * nlp.obj_scale * D
         d_lo = np.maximum((nlp.x_lb - p.x) / D, -trust)
         d_hi = np.minimum((nlp.x_ub - p.x) / D, trust)
-        theta = p.v_max if p.v_max > o.tol else pred  # resolve the violation, else the decrease
-        eps = float(np.clip(o.qp_eps_factor * theta * tighten, *o.qp_eps))
-        wide = (np.maximum((nlp.x_lb - p.x) / D, -o.trust_max),
-                np.minimum((nlp.x_ub - p.x) / D, o.trust_max)) if trust < o.trust_max else None
-        restore = None if wide is not None else o.restoration_trust  # Δ at its largest
-        restoring = entry is not None and p.v_max > o.restoration_exit * entry
+        theta = p.v_max if p.v_max > stop.tol else pred  # resolve the violation, else the decrease
+        eps = float(np.clip(o.qp.eps_factor * theta * tighten, *o.qp.eps))
+        wide = (np.maximum((nlp.x_lb - p.x) / D, -tr.radius_max),
+                np.minimum((nlp.x_ub - p.x) / D, tr.radius_max)) if trust < tr.radius_max else None
+        restore = None if wide is not None else o.restoration.radius  # Δ at its largest
+        restoring = entry is not None and p.v_max > o.restoration.exit * entry
         v_before = p.v_max
         sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide,
-                                               restore, restoring)
+                                               restore, restoring, workspace=workspace)
         qp_iters += admm
         hard = not qp.elastic
         rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)
@@ -267,18 +303,18 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
         # loosely (d = 0 does better): not a stationary point — solve it again, tighter.
         # (Measured: the full-space form stopped a translate at Σu² 0.15 % above the
         # condensed form's solution, on pred = −3e-5 at an eps of 4e-6.)
-        inexact = hard and pred < 0 and p.v_max <= o.tol and eps > o.qp_eps[0]
+        inexact = hard and pred < 0 and p.v_max <= stop.tol and eps > o.qp.eps[0]
         tighten = 0.01 * tighten if inexact else 1.0
-        stationary = hard and not inexact and pred <= o.ftol * max(p.f, 1e-3)
-        recent = log[-o.plateau_iterations:]
+        stationary = hard and not inexact and pred <= stop.ftol * max(p.f, 1e-3)
+        recent = log[-stop.plateau_iterations:]
         stationary = stationary or (  # a plateau: feasible to 100 tol, Σu² no longer falling
-            hard and len(recent) == o.plateau_iterations
-            and all(r["violation"] <= 100 * o.tol for r in recent)
+            hard and len(recent) == stop.plateau_iterations
+            and all(r["violation"] <= 100 * stop.tol for r in recent)
             and recent[0]["objective"] - nlp.objective(p.x)
-            < o.plateau_ftol * recent[0]["objective"])
+            < stop.plateau_ftol * recent[0]["objective"])
         side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi) if hard else None  # active rows
         held = lambda q: point(q.x + D * newton_correction(nlp, q, side))  # noqa: E731
-        if stationary and p.v_max > o.tol:
+        if stationary and p.v_max > stop.tol:
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows, first holding
             # the subproblem's active rows at their bounds, as the line search's correction
@@ -292,9 +328,9 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
                 if q.v.sum() >= p.v.sum():
                     break
                 p = q
-                if p.v_max <= o.tol:
+                if p.v_max <= stop.tol:
                     break
-        if stationary and p.v_max <= o.tol:
+        if stationary and p.v_max <= stop.tol:
             status = Status.SOLVED
         elif sol.status in ("optimal", "optimal_inaccurate") and (pred > 0 or not hard):
             if hard:
@@ -306,16 +342,16 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
                 trial, step, ratio, accepted = _line_search(o, p, D * sol.d, decrease, merit,
                                                             point, held)
         d_len = float(np.abs(sol.d).max(initial=0.0))
-        if (hard and not accepted and status != Status.SOLVED and p.v_max <= o.tol
-                and 0 < pred <= o.reject_ftol * max(p.f, 1e-3)):
+        if (hard and not accepted and status != Status.SOLVED and p.v_max <= stop.tol
+                and 0 < pred <= stop.reject_ftol * max(p.f, 1e-3)):
             status = Status.SOLVED  # feasible, and the model's small gain is not real
         if status != Status.SOLVED and not inexact:
             trust, mu = _adapt(o, accepted, step, ratio, d_len, trust, mu)
         if not hard:  # restoration: count the steps that barely reduce the violation
             gain = _square_violation(p) - _square_violation(trial) if accepted else 0.0
-            stalls = stalls + 1 if gain < o.stall_progress * _square_violation(p) else 0
+            stalls = stalls + 1 if gain < stop.stall_progress * _square_violation(p) else 0
         # The restoration phase: entered by an accepted restoration step, left when the
-        # violation is down to restoration_exit × its value at entry (or a step is rejected).
+        # violation is down to restoration.exit × its value at entry (or a step is rejected).
         entry = (entry if entry is not None else v_before) if accepted and not hard else None
         if accepted:
             p = trial
@@ -326,10 +362,10 @@ def _solve(nlp: NLP, x0, options: SQPOptions) -> SolveResult:
                     "polished": sol.polished, "elastic": qp.elastic})
         if status == Status.SOLVED:
             break
-        if trust <= o.trust_min and not accepted:
+        if trust <= tr.radius_min and not accepted:
             status = Status.STALLED
             break
-        if stalls >= o.stall_iterations:
+        if stalls >= stop.stall_iterations:
             status = Status.INFEASIBLE
             break
     return SolveResult(x=p.x, status=status, iterations=it, wall_time_s=time.perf_counter() - t0,

@@ -1,0 +1,35 @@
+"""Solver and execution-mode names are defined once (flipkit.solvers.names,
+flipkit.simulation.modes); every other list of them must agree."""
+
+from flipkit.simulation.modes import FEEDFORWARD, MODES, POSITION
+from flipkit.solvers.names import EXACT_RESULT_NAMES, EXACT_SOLVERS, NLP_SOLVERS, SOLVERS
+
+
+def test_solver_names():
+    assert SOLVERS == ("sqp", "ipopt", "auto")
+    assert NLP_SOLVERS == SOLVERS[:2]
+    assert tuple(EXACT_RESULT_NAMES) == EXACT_SOLVERS
+    assert not set(EXACT_RESULT_NAMES.values()) & set(NLP_SOLVERS)  # results tell them apart
+
+
+def test_the_planner_and_the_command_line_accept_the_same_solvers():
+    from flipkit.cli.common import SOLVER_CHOICES
+    from flipkit.planning.chain import SOLVERS as PLANNER_SOLVERS
+
+    assert PLANNER_SOLVERS == SOLVER_CHOICES == SOLVERS
+
+
+def test_exact_solver_names():
+    from flipkit.experiments.bench import TRANSLATE_SOLVERS
+    from flipkit.solvers import exact
+
+    assert exact.EXACT_SOLVERS is EXACT_SOLVERS
+    assert set(TRANSLATE_SOLVERS) == {*NLP_SOLVERS, *EXACT_RESULT_NAMES.values()}
+
+
+def test_execution_modes():
+    from flipkit.cli.animate import MODES as CLI_MODES
+    from flipkit.simulation import execute
+
+    assert MODES == (FEEDFORWARD, POSITION) == ("feedforward", "position")
+    assert execute.MODES is MODES and CLI_MODES == MODES
