@@ -22,7 +22,8 @@ History of the committed log:
 import json
 from pathlib import Path
 
-from flipkit.behaviors.segments import Models, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.sqp import solve_sqp
@@ -34,7 +35,7 @@ START, GOAL = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)
 def reference_nlp():
     models = Models(CellConfig())
     q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
-    return build_segment("translate", models, q_start, goal=flat_pose(GOAL))
+    return transcribe("translate", models, q_start, goal=flat_pose(GOAL))
 
 
 def run():

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import SegmentOptions
 from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import AtlasError
@@ -30,7 +31,7 @@ def _atlas(entry, locations=None, shift=None):
     locations = [entry["location"]] if locations is None else locations
     shift = [0.0] * len(locations) if shift is None else shift
     sols = {}
-    for name in tg.SUBBEHAVIORS:
+    for name in FLIP_NAMES:
         x = np.array(entry["x"][name])
         rows = []
         for s in shift:
@@ -47,7 +48,7 @@ def test_file_round_trip(entry, tmp_path):
     atlas = _atlas(entry)
     back = Atlas.load(atlas.save(tmp_path / "a.npz"), CellConfig(), SegmentOptions())
     assert len(back) == 1 and back.meta["grid"] == [1, 1]
-    for name in tg.SUBBEHAVIORS:  # stored as float32: a guess needs no more
+    for name in FLIP_NAMES:  # stored as float32: a guess needs no more
         np.testing.assert_allclose(back.solutions[name], atlas.solutions[name], rtol=1e-6,
                                    atol=1e-6)
     assert back.structure == atlas.structure
@@ -70,7 +71,8 @@ def test_stale_or_broken_atlas_is_refused(entry, tmp_path):
 
 
 def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
-    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import transcribe
 
     class _NLP:  # the layout, bounds and structure key guess() reads
         def __init__(self, nlp):
@@ -80,7 +82,7 @@ def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
     models = Models(CellConfig())
     p = tg.pickup_end(CellConfig(), LOC)
     from flipkit.model.ik import solve_pose
-    nlp = _NLP(build_segment("flip", models, solve_pose(models.loaded, p.p, p.o), np.zeros(6),
+    nlp = _NLP(transcribe("flip", models, solve_pose(models.loaded, p.p, p.o), np.zeros(6),
                              location=LOC))
     a, b, c = (0.70, -0.10, LOC[2]), (0.74, -0.10, LOC[2]), (0.72, -0.14, LOC[2])
     atlas = _atlas(entry, [a, b, c], shift=[0.0, 0.2, 3 * BRANCH_TOL])
@@ -154,7 +156,8 @@ def test_anchored_guess_starts_at_the_segment_start_and_keeps_the_turn_back_end(
     start state: node 0 is (q_start, q̇_start) exactly, u = RNEA at every node, the flip's
     path is shifted whole, the turn back's offset fades out so it still ends at rest where the
     neighbour ended; a start that is the neighbour's own returns its solution unchanged."""
-    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.planning.atlas import anchored_guess
 
     models = Models(CellConfig())
@@ -162,7 +165,7 @@ def test_anchored_guess_starts_at_the_segment_start_and_keeps_the_turn_back_end(
     for name, how in (("flip", "shift"), ("turn_back", "blend")):
         x = np.array(entry["x"][name])
         q0 = x[: 21 * 4 * 6].reshape(21, 4, 6)[0]
-        nlp = build_segment(name, models, q0[0], q0[1], location=LOC)
+        nlp = transcribe(name, models, q0[0], q0[1], location=LOC)
         L, robot = nlp.layout, nlp.robot
         nodes0 = L.nodes(x)
         np.testing.assert_array_equal(anchored_guess(nlp, x, q0[0], q0[1], how), x)

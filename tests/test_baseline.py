@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
 from flipkit.baseline import (REASONS, PlacoTracker, Thresholds, classify_segment, plan_segment,
                               run_baseline)
@@ -42,12 +43,12 @@ def edge_heights(cell, p, R):
 
 
 def test_all_five_subbehaviours_run_within_budget(benign):
-    assert [s.subbehavior for s in benign.segments] == list(tg.SUBBEHAVIORS)
+    assert [s.subbehavior for s in benign.segments] == list(FLIP_NAMES)
     assert len(benign.trajectories) == len(benign.tracks) == 5
     for seg, traj in zip(benign.segments, benign.trajectories):
         assert seg.ee_time_s < 1.0 and seg.ik_time_s < 1.0  # paper Sec. I: EE opt < 1 s
         assert np.diff(traj.t).max() <= 1 / RATE + 1e-12 and traj.t[-1] == traj.T
-    assert set(benign.time_s) == set(tg.SUBBEHAVIORS)
+    assert set(benign.time_s) == set(FLIP_NAMES)
 
 
 def test_endpoints_and_continuity(benign, cell, bare):

@@ -10,8 +10,10 @@ from conftest import central_fd
 from test_plan import models  # noqa: F401  (fixture)
 from test_plan import translate_plan
 
-from flipkit.behaviors.segments import (AT_GRILL, TOOL_SHAPES, Models, build_segment,
-                                        clearance_excluded)
+from flipkit.behaviors.clearance import TOOL_SHAPES
+from flipkit.behaviors.library import SUBBEHAVIORS
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig, TaskLimits
 from flipkit.config.space import BACK_WALL, CellBox, SpaceConfig
 from flipkit.errors import ConfigError
@@ -137,7 +139,7 @@ def test_block_jacobian_matches_finite_differences(models, shapes):
     q = np.array(_random_configurations(robot, 8, L.n_nodes))
     x = L.pack(q, rng.normal(size=q.shape), rng.normal(size=q.shape), rng.normal(size=q.shape),
                rng.normal(size=(6, 7)), 0.5)
-    block = ArmClearance(L, shapes, range(1, L.n_nodes), lambda i: clearance_excluded("flip", i, 20))
+    block = ArmClearance(L, shapes, range(1, L.n_nodes), lambda i: SUBBEHAVIORS["flip"].exempt(i, 20))
     vals, jac = block.evaluate(Evaluation(L, robot, x))
     assert block.m == 20 and np.all(vals <= CAP) and np.any(vals < 0.02)
     J = np.zeros((block.m, L.n))
@@ -179,13 +181,13 @@ def test_segments_exempt_only_the_tool_at_the_grill(models):
     """Scoop-like segments exempt the tool end from the grill; the flip from its first quarter
     on holds it; the other links keep the margin everywhere, the table and wall always."""
     tool = {(s, "grill") for s in TOOL_SHAPES}
-    for name in AT_GRILL:
-        assert clearance_excluded(name, 20, 20) == tool
+    for name in ("go_to_burger", "scoop", "pickup"):
+        assert SUBBEHAVIORS[name].exempt(20, 20) == tool
     for name in ("flip", "carry"):  # both start where the pickup ends
-        assert clearance_excluded(name, 4, 20) == tool and clearance_excluded(name, 5, 20) == set()
+        assert SUBBEHAVIORS[name].exempt(4, 20) == tool and SUBBEHAVIORS[name].exempt(5, 20) == set()
     for name in ("translate", "turn_back"):
-        assert clearance_excluded(name, 1, 20) == set()
-    nlp = build_segment("translate", models, models.bare.q_home,
+        assert SUBBEHAVIORS[name].exempt(1, 20) == set()
+    nlp = transcribe("translate", models, models.bare.q_home,
                         goal=translate_plan(models).segments[0].goal)
     block = next(b for b in nlp.blocks if b.name == "arm_clearance")
     assert block.m == 20 and all(len(p) == 27 for p in block.pairs)
@@ -203,7 +205,7 @@ def test_a_hood_over_the_elbow_is_seen_by_the_block(models):
                    (elbow[0] + 0.3, elbow[1] + 0.3, elbow[2] + 0.3))
     cell = replace(models.cell, space=SpaceConfig(walls=(BACK_WALL, hood)))
     hooded = Models(cell)
-    nlp = build_segment("translate", hooded, seg.q[0], goal=seg.goal)
+    nlp = transcribe("translate", hooded, seg.q[0], goal=seg.goal)
     block = next(b for b in nlp.blocks if b.name == "arm_clearance")
     L = nlp.layout
     x = L.pack(seg.q, seg.qd, seg.qdd, seg.u, np.zeros((6, 7)), seg.T)

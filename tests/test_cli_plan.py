@@ -8,12 +8,12 @@ import sys
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.cli import main
 from flipkit.cli.plan import read_locations
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
 from flipkit.planning.plan_file import Plan
-from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.verify import verify_plan
 
 
@@ -113,14 +113,14 @@ def test_flip_plan_is_solved_continuous_and_verified(flip_file):
     assert rc == 0
     plan = Plan.load(path)
     assert plan.status == "solved" and verify_plan(plan).ok
-    assert [s.name for s in plan.segments] == list(SUBBEHAVIORS)
+    assert [s.name for s in plan.segments] == list(FLIP_NAMES)
     q_home = plan.robot["q_home"]
     np.testing.assert_allclose(plan.segments[0].q[0], q_home, atol=1e-12)
     np.testing.assert_allclose(plan.segments[-1].q[-1], q_home, atol=1e-6)
     for a, b in zip(plan.segments, plan.segments[1:]):
         np.testing.assert_allclose(a.q[-1], b.q[0], atol=1e-9)
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
-    flip = plan.segments[SUBBEHAVIORS.index("flip")]
+    flip = plan.segments[FLIP_NAMES.index("flip")]
     assert flip.cone_nodes == list(range(15))  # up to the release node
 
 

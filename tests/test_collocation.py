@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import Models, build_segment, flat_pose
 from flipkit.transcription.layout import Evaluation, Layout
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.transcription.constraints import BezierOutput, HermiteSimpson
@@ -63,13 +64,13 @@ def test_bezier_output_zero_on_its_own_polynomial(models):
 def _nlp_cases(models):
     cell = models.cell
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
-    yield build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    yield transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
     pb = TABLE1_LOCATIONS[5]
     p = tg.pickup_end(cell, pb)
-    yield build_segment("flip", models, solve_pose(models.loaded, p.p, p.o), np.full(6, 0.1),
+    yield transcribe("flip", models, solve_pose(models.loaded, p.p, p.o), np.full(6, 0.1),
                         location=pb)
     r = tg.scoop_ready(cell, pb)
-    yield build_segment("scoop", models, solve_pose(models.bare, r.p, r.o), location=pb)
+    yield transcribe("scoop", models, solve_pose(models.bare, r.p, r.o), location=pb)
 
 
 def test_nlp_jacobian_matches_finite_differences(models):
@@ -90,9 +91,9 @@ def test_nlp_jacobian_matches_finite_differences(models):
 
 def test_segment_validation(models):
     with pytest.raises(InvalidChoiceError, match="'translate'"):
-        build_segment("jump", models, models.bare.q_home)
+        transcribe("jump", models, models.bare.q_home)
     with pytest.raises(ConfigError, match="burger location"):
-        build_segment("scoop", models, models.bare.q_home)
+        transcribe("scoop", models, models.bare.q_home)
 
 
 def test_interpolant_rows_are_the_executed_cubic(models):
@@ -153,8 +154,8 @@ def test_cached_patterns_equal_freshly_filled_ones_and_are_read_only(models):
 
     q0 = models.bare.q_home
     base._PATTERNS.clear()
-    fresh = build_segment("go_to_burger", models, q0, location=TABLE1_LOCATIONS[0])
-    cached = build_segment("go_to_burger", models, q0, location=TABLE1_LOCATIONS[3])
+    fresh = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[0])
+    cached = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[3])
     assert len(base._PATTERNS) > 0
     np.testing.assert_array_equal(fresh.jac_rows, cached.jac_rows)
     np.testing.assert_array_equal(fresh.jac_cols, cached.jac_cols)

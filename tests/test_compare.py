@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.baseline import REASONS
 from flipkit.baseline.classify import FAILURE_CLASSES
 from flipkit.cli import main
@@ -15,7 +16,6 @@ from flipkit.experiments.compare_ik import compare_ik, plan_filename
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.planning.plan_file import Plan
 from flipkit.experiments.sweep import make_executor
-from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.verify import verify_plan
 
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
@@ -47,14 +47,14 @@ def test_output_schema(run):
         assert entry[method]["status"] in ("solved", "failed")
     assert entry["collocation"]["time_s"] > 0
     assert entry["ee_ik"]["time_s"] > 0 and set(entry["ee_ik"]["time_breakdown_s"]) <= set(
-        SUBBEHAVIORS)
+        FLIP_NAMES)
     assert entry["ee_ik"]["class"] in FAILURE_CLASSES + (None,)
     s = doc["summary"]
     assert s["locations"] == 1 and set(s["success_fraction"]) == {"collocation", "ee_ik"}
     assert set(s["ik_failure_reasons"]) == set(REASONS)
     assert set(s["ik_failure_classes"]) == set(FAILURE_CLASSES)
     segs = entry["ee_ik"]["segments"]  # every subbehaviour run, the first failure among them
-    assert [g["subbehavior"] for g in segs] == list(SUBBEHAVIORS)[:len(segs)]
+    assert [g["subbehavior"] for g in segs] == list(FLIP_NAMES)[:len(segs)]
     first = next(g for g in segs if g["status"] != "solved")
     assert first["subbehavior"] == entry["ee_ik"]["subbehavior"]
     assert first["class"] == entry["ee_ik"]["class"]
@@ -63,8 +63,8 @@ def test_output_schema(run):
     assert s["ik_worst_classes"][worst] == 1 and sum(s["ik_worst_classes"].values()) == 1
     judge = entry["collocation"]["judge"]
     assert judge["status"] in ("solved", "failed") and sum(s["collocation_judge"].values()) == 1
-    assert set(s["median_time_s"]["collocation"]) == set(SUBBEHAVIORS) | {"total"}
-    assert set(s["median_time_s"]["ee_ik"]) == set(SUBBEHAVIORS)
+    assert set(s["median_time_s"]["collocation"]) == set(FLIP_NAMES) | {"total"}
+    assert set(s["median_time_s"]["ee_ik"]) == set(FLIP_NAMES)
 
 
 def test_collocation_plan_passes_verify(run):
@@ -103,7 +103,7 @@ def test_ee_ik_failure_has_a_reason_from_the_tuple(run):
     doc = run[0]
     e = doc["locations"][0]["ee_ik"]
     assert e["status"] == "failed"
-    assert e["reason"] in REASONS and e["subbehavior"] in SUBBEHAVIORS
+    assert e["reason"] in REASONS and e["subbehavior"] in FLIP_NAMES
     assert isinstance(e["amount"], float)
     assert doc["summary"]["ik_failure_reasons"][e["reason"]] == 1
 

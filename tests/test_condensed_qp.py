@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.full_qp import QPSubproblem
@@ -18,11 +20,11 @@ from flipkit.solvers.sqp import QPOptions, SQPOptions, TerminationOptions, solve
 def segments():
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
-    translate = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
-    scoop_start = build_segment("go_to_burger", models, models.bare.q_home, None,
+    translate = transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    scoop_start = transcribe("go_to_burger", models, models.bare.q_home, None,
                                 location=TABLE1_LOCATIONS[3])
     end = scoop_start.layout.nodes(scoop_start.x0)[-1]
-    scoop = build_segment("scoop", models, end[0], end[1], location=TABLE1_LOCATIONS[3])
+    scoop = transcribe("scoop", models, end[0], end[1], location=TABLE1_LOCATIONS[3])
     return {"translate": translate, "scoop": scoop}
 
 
@@ -112,7 +114,7 @@ def test_sqp_condensed_and_full_space_agree(segments):
     iterations to objectives 1.5e-3 apart (session 7)."""
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
-    smooth = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)),
+    smooth = transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)),
                            options=SegmentOptions(arm_clearance=False))
     # converged as tightly as before session 12 (ftol 1e-4): the forms, not the stopping
     # rule, are compared (at the default 1e-3 each stops where its own model's gain is small)
@@ -136,7 +138,7 @@ def test_infeasible_linearisation_is_reported_not_raised():
     models = Models(CellConfig())
     q, qd = models.bare.q_home, None
     for name in ("go_to_burger", "scoop", "pickup", "flip"):
-        nlp = build_segment(name, models, q, qd, location=TABLE1_LOCATIONS[1])
+        nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
         end = nlp.layout.nodes(nlp.x0)[-1]
         q, qd = end[0], end[1]
     c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)

@@ -22,8 +22,8 @@ Q = [-1.228896160236147, -1.177177784762914, 2.0203128696152595, -0.088159253476
 
 SCRIPT = f"""
 import numpy as np
+from flipkit.behaviors.models import Models
 from flipkit.config import CellConfig
-from flipkit.behaviors.segments import Models
 cell = CellConfig()
 models = Models(cell)
 S = models.shapes

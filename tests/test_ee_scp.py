@@ -7,13 +7,14 @@ import math
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
+from flipkit.behaviors.options import MU_SAFETY, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
+from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline import run_baseline
 from flipkit.baseline.ee_opt import EEState, orientation_profile
 from flipkit.baseline.ee_scp import (PROBE_FRACTION, SAMPLES, Task, _problem, plan_segment_scp,
                                      scp_at_duration, search_duration)
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS,
-                                        grill_floor)
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.contact import specific_force
@@ -40,7 +41,7 @@ def setup(cell):
 def chain(cell, setup):
     _, home, start = setup
     out = {}
-    for name in tg.SUBBEHAVIORS:
+    for name in FLIP_NAMES:
         out[name] = plan_segment_scp(name, cell, BENIGN, start, home=home, rate=RATE)
         start = out[name].end_state()
     out["start"] = setup[2]
@@ -66,9 +67,9 @@ def test_chain_is_continuous_and_meets_its_endpoints(chain, cell, setup):
     robot, home, _ = setup
     pb = np.array(BENIGN)
     prev = chain["start"]
-    for name in tg.SUBBEHAVIORS:
+    for name in FLIP_NAMES:
         tr = chain[name]
-        lo, hi = T_BOUNDS[name]
+        lo, hi = SUBBEHAVIORS[name].duration
         assert lo - 1e-12 <= tr.T <= hi + 1e-12, name
         assert np.allclose(tr.p[0], prev.p, atol=1e-6) and np.allclose(tr.v[0], prev.v, atol=1e-5)
         assert np.allclose(tr.o[0], prev.o, atol=1e-6) and np.allclose(tr.od[0], prev.w, atol=1e-5)
@@ -90,11 +91,11 @@ def test_task_constraints_hold_at_fine_samples(chain, cell):
     edges = np.array([[sp.length / 2, 0, 0], [-sp.length / 2, 0, 0],
                       [0, sp.width / 2, 0], [0, -sp.width / 2, 0]]).T
     lim = cell.limits
-    for name in tg.SUBBEHAVIORS:
+    for name in FLIP_NAMES:
         tr = chain[name]
         s = tr.t / tr.T
         heights = tr.p[:, 2:3] + tr.R[:, 2] @ edges
-        floor = np.interp(s, np.linspace(0, 1, SAMPLES), grill_floor(name, cell, SAMPLES - 1))
+        floor = np.interp(s, np.linspace(0, 1, SAMPLES), blade_floor(name, cell, SAMPLES - 1))
         if name == "go_to_burger":  # the floor drops to the press only at the last sample
             floor[s < 1 - 1e-9] = hg
             floor[s > 1 - 1 / (SAMPLES - 1)] = hg - SCOOP_PRESS - SCOOP_TIP_BAND
@@ -143,7 +144,7 @@ def test_orientation_and_duration_are_free(chain, cell):
     task = Task("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
     again = scp_at_duration(task, flip.T, flip.coeffs, flip.o_coeffs, 0.05)
     assert math.isfinite(again["objective"]) and again["objective"] <= flip.objective * 1.05
-    lo, hi = T_BOUNDS["flip"]
+    lo, hi = SUBBEHAVIORS["flip"].duration
     if flip.durations_tried == 2:  # the probe cost more: no shorter flip does better there
         probe = scp_at_duration(task, hi - PROBE_FRACTION * (hi - lo), flip.coeffs,
                                 flip.o_coeffs, 0.05)

@@ -2,7 +2,9 @@
 
 import pytest
 
-from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
@@ -16,7 +18,7 @@ def translate(cell):
     """The first translate of bench (key point 1 to 2), without the arm's clearance rows."""
     models = Models(cell)
     q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
-    return build_segment("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
+    return transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
                          options=SegmentOptions(arm_clearance=False))
 
 
@@ -52,7 +54,7 @@ def test_unknown_solver(translate):
 def test_other_graph_refused(cell, translate, graph):
     """A solver built for one graph does not solve another one's NLP."""
     models = Models(cell)
-    pickup = OcpGraph(build_segment("pickup", models, models.bare.q_home,
+    pickup = OcpGraph(transcribe("pickup", models, models.bare.q_home,
                                     location=TABLE1_LOCATIONS[1],
                                     options=SegmentOptions(arm_clearance=False)))
     with pytest.raises(ConfigError, match="differs"):

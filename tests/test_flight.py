@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 from conftest import central_fd, check_block_jacobian
 
-from flipkit.behaviors.segments import R_LAND, SegmentOptions, build_segment
+from flipkit.behaviors.options import R_LAND, SegmentOptions
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.transcription.layout import Evaluation
 from flipkit.config import CellConfig
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.errors import ConfigError, UnreachableError
 from flipkit.model.flight import predict_landing
-from flipkit.planning.planner import models_for
+from flipkit.behaviors.models import models_for
 from flipkit.planning.verify import verify_plan
 from flipkit.planning.verify_flight import recompute_landing
 
@@ -63,7 +64,7 @@ def flip_nlp():
     pb = np.array([0.69, -0.16, 0.072])
     pose = pickup_end(cell, pb)
     q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
-    return build_segment("flip", models, q0, np.zeros(6), location=pb)
+    return transcribe("flip", models, q0, np.zeros(6), location=pb)
 
 
 @pytest.mark.parametrize("block_type", [Landing, FlightClearance])
@@ -126,7 +127,7 @@ def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
     cell = CellConfig()
     nlp0 = flip_nlp
     q0, qd0 = nlp0.x0[nlp0.layout.iq(0)], nlp0.x0[nlp0.layout.iqd(0)]
-    nlp = build_segment("flip", models_for(cell), q0, qd0, location=(0.69, -0.16, 0.072),
+    nlp = transcribe("flip", models_for(cell), q0, qd0, location=(0.69, -0.16, 0.072),
                         on_blade=(0.05, 0.01))
     cone = next(b for b in nlp.blocks if b.name == "cone")
     x = nlp.x0.copy()

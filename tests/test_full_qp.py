@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors.segments import Models, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE
@@ -19,8 +20,8 @@ from flipkit.solvers.full_qp import QPSubproblem
 def setup():
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
-    a = build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
-    b = build_segment("translate", models, qs, goal=flat_pose((0.70, -0.1, 0.16)))
+    a = transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    b = transcribe("translate", models, qs, goal=flat_pose((0.70, -0.1, 0.16)))
     return a, b
 
 

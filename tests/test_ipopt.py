@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors.segments import Models, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import NoSolutionFound
 from flipkit.model.ik import solve_pose
@@ -19,7 +20,7 @@ from flipkit.solvers.sqp import SolveResult
 def translate_nlp():
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
-    return build_segment("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
+    return transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import NoSymbolicFormError
 from flipkit.model.ik import solve_pose
@@ -22,7 +24,7 @@ def models(cell):
 @pytest.fixture(scope="module")
 def translate(models):
     q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
-    nlp = build_segment("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
+    nlp = transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
                         options=NO_CLEARANCE)
     return nlp, OcpGraph(nlp)
 
@@ -30,7 +32,7 @@ def translate(models):
 @pytest.fixture(scope="module")
 def pickup(models):
     """A moving-end segment: braking margin, cone, tip and orientation rows."""
-    nlp = build_segment("pickup", models, models.bare.q_home, location=TABLE1_LOCATIONS[1],
+    nlp = transcribe("pickup", models, models.bare.q_home, location=TABLE1_LOCATIONS[1],
                         options=NO_CLEARANCE)
     return nlp, OcpGraph(nlp)
 
@@ -97,7 +99,7 @@ def test_stage_structure(translate):
 
 def test_clearance_rows_have_no_symbolic_form(models):
     q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
-    nlp = build_segment("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)))
+    nlp = transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)))
     assert "arm_clearance" in nlp.block_slices
     with pytest.raises(NoSymbolicFormError, match="arm_clearance"):
         OcpGraph(nlp)
@@ -107,7 +109,7 @@ def test_key_shared_by_translates_only(models, translate, pickup):
     """Two translates between other poses differ only in their bounds: one built solver serves
     both (bench relies on it); a pickup's graph is another."""
     q0 = solve_pose(models.loaded, (0.45, 0.74, 0.19), (0, 0, 0))
-    other = OcpGraph(build_segment("translate", models, q0, goal=flat_pose((0.32, 0.62, 0.20)),
+    other = OcpGraph(transcribe("translate", models, q0, goal=flat_pose((0.32, 0.62, 0.20)),
                                    options=NO_CLEARANCE))
     assert other.key == translate[1].key != pickup[1].key
     assert not np.array_equal(other.lbg, translate[1].lbg)

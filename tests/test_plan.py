@@ -10,8 +10,10 @@ import json
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import SUBBEHAVIORS
+from flipkit.behaviors.models import Models
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import CARRIES_BURGER, T_BOUNDS, Models, build_segment, flat_pose
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, PlanFileError
 from flipkit.model.ik import solve_pose
@@ -62,14 +64,14 @@ def chain_plan(models, approach=False):
     ready, scoop, pick = (f(cell, LOCATION) for f in (tg.scoop_ready, tg.scoop_end, tg.pickup_end))
     if approach:
         q_ready = solve_pose(r, ready.p, ready.o, r.q_home, tol=1e-22)
-        segments = [cubic_segment("go_to_burger", r.q_home, q_ready, T_BOUNDS["go_to_burger"][1],
+        segments = [cubic_segment("go_to_burger", r.q_home, q_ready, SUBBEHAVIORS["go_to_burger"].duration[1],
                                   models.bare)]
     else:
         q_scoop = solve_pose(r, scoop.p, scoop.o, r.q_home, tol=1e-22)
         q_pick = solve_pose(r, pick.p, pick.o, q_scoop, tol=1e-22)
         legs = (("scoop", q_scoop, q_scoop), ("pickup", q_scoop, q_pick),
                 ("turn_back", q_pick, r.q_home))
-        segments = [cubic_segment(name, qa, qb, T_BOUNDS[name][1], models.for_segment(name))
+        segments = [cubic_segment(name, qa, qb, SUBBEHAVIORS[name].duration[1], models.for_segment(name))
                     for name, qa, qb in legs]
     return Plan.from_segments("flip", cell, segments, location=LOCATION)
 
@@ -110,7 +112,7 @@ def test_cell_is_rebuilt_from_the_file(models, plan_file):
     assert cell.burger == ref.burger and cell.grill.height == ref.grill.height
     assert cell.robot.urdf_path == ref.robot.urdf_path and cell.gravity == ref.gravity
     robot = Plan.load(plan_file).robot_for("pickup", cell)
-    assert len(robot.payload) == 2 and CARRIES_BURGER["pickup"]
+    assert len(robot.payload) == 2 and SUBBEHAVIORS["pickup"].carries_burger
 
 
 def test_payload_that_does_not_match_the_cell_is_rejected(models):
@@ -122,7 +124,7 @@ def test_payload_that_does_not_match_the_cell_is_rejected(models):
 
 def test_segment_from_a_collocation_solution(models):
     goal = flat_pose((0.70, -0.10, 0.25))
-    nlp = build_segment("translate", models, models.bare.q_home, goal=goal)
+    nlp = transcribe("translate", models, models.bare.q_home, goal=goal)
     result = SolveResult(x=nlp.x0, status="max_iter", iterations=3, wall_time_s=0.5,
                          objective=nlp.objective(nlp.x0), max_violation=0.1)
     seg = Segment.from_solution(nlp, result)

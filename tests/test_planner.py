@@ -10,8 +10,10 @@ from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.planner import (format_summary, models_for, plan_batch, plan_flip, plan_translate,
-                             solve_segment, summary_table)
+from flipkit.behaviors.models import models_for
+from flipkit.planning.chain import solve_segment
+from flipkit.planning.planner import (format_summary, plan_batch, plan_flip, plan_translate,
+                                      summary_table)
 from flipkit.solvers.sqp import SolveResult
 from flipkit.planning.verify import verify_plan
 
@@ -143,12 +145,12 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
 
     monkeypatch.setattr(sqp_module, "solve_sqp", failing_sqp)
     models = models_for(CellConfig())
-    from flipkit.behaviors.segments import build_segment, flat_pose
+    from flipkit.behaviors.transcribe import flat_pose, transcribe
     from flipkit.model.ik import solve_pose
 
-    nlp = build_segment("translate", models, solve_pose(models.loaded, GRILL_A, (0, 0, 0)),
+    nlp = transcribe("translate", models, solve_pose(models.loaded, GRILL_A, (0, 0, 0)),
                         goal=flat_pose(GRILL_B))
-    res = planner.solve_segment(nlp, "auto")
+    res = solve_segment(nlp, "auto")
     assert calls == ["sqp"] and res.success and res.solver == "ipopt"
     assert res.wall_time_s > 1.5  # both attempts are counted
 
@@ -156,29 +158,31 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
 def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
     """The scoop at (0.630, −0.347) — wrist 2 near its singularity — has no solution within
     0.6 s; the planner tries once more with the bound × T_STRETCH and the plan verifies."""
-    from flipkit.behaviors.segments import T_BOUNDS, T_STRETCH
+    from flipkit.behaviors.library import SUBBEHAVIORS
+    from flipkit.behaviors.options import T_STRETCH
     from flipkit.planning.planner import plan_flip
     from flipkit.planning.verify import verify_plan
 
     plan = plan_flip((0.629686, -0.347136, 0.072))
     assert plan.status == "solved", plan.failure
     scoop = next(s for s in plan.segments if s.name == "scoop")
-    assert T_BOUNDS["scoop"][1] < scoop.T <= T_STRETCH * T_BOUNDS["scoop"][1] + 1e-9
+    assert SUBBEHAVIORS["scoop"].duration[1] < scoop.T <= T_STRETCH * SUBBEHAVIORS["scoop"].duration[1] + 1e-9
     # Stretched only where needed: the pickup and flip are not; the turn back from a robust
     # flip's end state near the singularity may be.
     others = [s for s in plan.segments if s.name in ("go_to_burger", "pickup", "flip")]
-    assert all(s.T <= T_BOUNDS[s.name][1] + 1e-9 for s in others)
+    assert all(s.T <= SUBBEHAVIORS[s.name].duration[1] + 1e-9 for s in others)
     assert verify_plan(plan).ok
 
 
 def test_a_duration_beyond_the_stretched_bound_fails_verify(models):
     from test_plan import translate_plan
 
-    from flipkit.behaviors.segments import T_BOUNDS, T_STRETCH
+    from flipkit.behaviors.library import SUBBEHAVIORS
+    from flipkit.behaviors.options import T_STRETCH
     from flipkit.planning.verify import verify_plan
 
-    ok = translate_plan(models, durations=(T_STRETCH * T_BOUNDS["translate"][1] - 0.01,))
-    bad = translate_plan(models, durations=(T_STRETCH * T_BOUNDS["translate"][1] + 0.01,))
+    ok = translate_plan(models, durations=(T_STRETCH * SUBBEHAVIORS["translate"].duration[1] - 0.01,))
+    bad = translate_plan(models, durations=(T_STRETCH * SUBBEHAVIORS["translate"].duration[1] + 0.01,))
     assert verify_plan(ok).groups["time_grid"].ok
     assert not verify_plan(bad).groups["time_grid"].ok
 
@@ -188,7 +192,7 @@ def test_a_warm_start_found_infeasible_tries_the_stretched_bound_before_the_cold
     """solve_stretched: when the SQP from the warm start ends ``infeasible`` within the bound,
     the stretched bound is solved next; the cold solve within the bound comes only if that
     fails too. Any other warm failure gets the cold solve first, as before."""
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.solvers.result import Status
 
     def run(warm_status, stretched_ok):

@@ -8,15 +8,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit import figures
-from flipkit.behaviors import targets
-from flipkit.behaviors.segments import build_segment, flat_pose
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
-from flipkit.planning.planner import models_for
+from flipkit.behaviors.models import models_for
 from flipkit.figures import data
 from flipkit.figures import draw
 from flipkit.figures import runs
@@ -39,8 +39,8 @@ def guess_plan():
     cell = CellConfig()
     models = models_for(cell)
     q, qd, segments = models.bare.q_home, None, []
-    for name in targets.SUBBEHAVIORS:
-        nlp = build_segment(name, models, q, qd, location=TABLE1_LOCATIONS[1])
+    for name in FLIP_NAMES:
+        nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
         segments.append(Segment.from_solution(nlp, _result(nlp)))
         nodes = nlp.layout.nodes(nlp.x0)
         q, qd = nodes[-1, 0], nodes[-1, 1]
@@ -53,7 +53,7 @@ def translate_nlp():
     models = models_for(cell)
     robot = models.for_segment("translate")
     q0 = solve_pose(robot, (0.65, -0.30, 0.15), (0.0, 0.0, 0.0), robot.q_home)
-    return build_segment("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)))
+    return transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)))
 
 
 # ---------------------------------------------------------------- data: plan series, contact
@@ -62,10 +62,10 @@ def test_plan_series_lays_segments_end_to_end(guess_plan):
     T = [seg.T for seg in guess_plan.segments]
     assert np.all(np.diff(s.t) > 0) and s.t[0] == 0.0
     assert np.allclose(s.boundaries, np.concatenate([[0.0], np.cumsum(T)]))
-    assert s.names == list(targets.SUBBEHAVIORS)
+    assert s.names == list(FLIP_NAMES)
     assert s.t.size == 21 + 4 * 20 and s.q.shape == (s.t.size, 6)
     assert np.isclose(s.t[-1], sum(T))
-    assert list(s.durations) == list(targets.SUBBEHAVIORS)
+    assert list(s.durations) == list(FLIP_NAMES)
     # the first node of every later segment is dropped: each node appears once
     assert np.array_equal(np.bincount(s.segment), [21, 20, 20, 20, 20])
 

@@ -5,7 +5,7 @@ and a replan that cannot be solved (the verified original then runs on)."""
 import numpy as np
 import pytest
 
-from flipkit.behaviors.segments import SegmentOptions
+from flipkit.behaviors.options import SegmentOptions
 from flipkit.simulation.judges import LANDING_TOL, judge_flip, judge_scoop
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.simulation.execute import execute_plan

@@ -119,17 +119,17 @@ def test_tampered_scenario_fails_verify(flip_plan):
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_scenario_landing_jacobian_matches_finite_differences(seed):
-    from flipkit.behaviors.segments import build_segment
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.behaviors.targets import pickup_end
     from flipkit.model.ik import solve_pose
-    from flipkit.planning.planner import models_for
+    from flipkit.behaviors.models import models_for
 
     cell = CellConfig()
     models = models_for(cell)
     pb = np.array([0.69, -0.16, 0.072])
     pose = pickup_end(cell, pb)
     q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
-    nlp = build_segment("flip", models, q0, np.zeros(6), location=pb, on_blade=(0.03, 0.0),
+    nlp = transcribe("flip", models, q0, np.zeros(6), location=pb, on_blade=(0.03, 0.0),
                         scenarios=[(0.02, 0.0), (0.045, 0.0), (0.03, -0.01)])
     block = next(b for b in nlp.blocks if isinstance(b, ScenarioLanding))
     assert block.m == 6

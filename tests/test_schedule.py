@@ -1,6 +1,6 @@
 """The cook-window scheduler (issue 13, item 3): the cook order CSV and its errors, table
 spots, the earliest-deadline-first policy with injected fixed-duration planners (ordering,
-lateness, slack, threading of configurations, failures), the missing serve planner, and the
+lateness, slack, threading of configurations, failures), a missing planner, and the
 real flip planner end to end through ``flipkit schedule --flip-only``."""
 
 import json
@@ -12,7 +12,8 @@ import pytest
 
 from flipkit import cli
 from flipkit.config import CellConfig
-from flipkit.planning import cook, motions, planner
+from flipkit.errors import InvalidChoiceError
+from flipkit.planning import cook, motions
 from flipkit.planning.cook import CookBurger, CookOrderError, check_cook, read_cook_csv
 from flipkit.planning.motions import MissingPlannerError, PlannedMotion
 from flipkit.planning.schedule import schedule_cook
@@ -188,12 +189,10 @@ def test_timeline_json_fields():
 
 
 # ---------------------------------------------------------------- the planners
-def test_serve_needs_plan_serve(monkeypatch):
-    monkeypatch.delattr(planner, "plan_serve", raising=False)
-    with pytest.raises(MissingPlannerError, match="flipkit.planning.planner.plan_serve"):
-        motions.default_planners(("flip", "serve"))
-    assert motions.available_kinds() == ("flip",)
+def test_a_kind_without_a_planner_is_refused():
     assert set(motions.default_planners(("flip",))) == {"flip"}
+    with pytest.raises(InvalidChoiceError, match="'stir'"):
+        motions.default_planners(("flip", "stir"))
     with pytest.raises(MissingPlannerError, match="'serve'"):
         schedule_cook(order([0]), {"flip": Fixed().planners()["flip"]}, np.zeros(6))
 
@@ -208,7 +207,7 @@ def test_serve_planner_calls_plan_serve_from_the_start_configuration(monkeypatch
                                            ("pickup", 0.3), ("carry", 1.0)])]
         return SimpleNamespace(status="solved", segments=seg, behavior="serve")
 
-    monkeypatch.setattr(planner, "plan_serve", fake_plan_serve, raising=False)
+    monkeypatch.setattr(motions, "plan_serve", fake_plan_serve)
     serve = motions.default_planners(("flip", "serve"), CELL, "sqp")["serve"]
     pm = serve(motions.MotionJob("serve", "b1", (0.7, -0.2, 0.072), (0.4, 0.6)), np.ones(6))
     assert seen["burger"] == (0.7, -0.2, 0.072) and seen["spot"] == (0.4, 0.6)
@@ -268,17 +267,6 @@ def test_same_spot_is_fine_once_the_first_burger_is_gone(tmp_path):
     assert [b.burger for b in read_cook_csv(path, CELL)] == ["b1", "b2"]
     with pytest.raises(CookOrderError):
         check_cook([CookBurger("a", 0, 0.7, -0.2), CookBurger("b", 149, 0.7, -0.25)], CELL)
-
-
-def test_missing_plan_serve_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
-    monkeypatch.delattr(planner, "plan_serve", raising=False)
-    path = tmp_path / "order.csv"
-    path.write_text("burger,t_drop,x,y\nb1,0,0.69,-0.16\n")
-    out = tmp_path / "t.json"
-    assert cli.main(["schedule", str(path), "--json", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "flipkit.planning.planner.plan_serve" in err
-    assert not out.exists()
 
 
 # ---------------------------------------------------------------- real plan_flip, end to end

@@ -11,13 +11,14 @@ import numpy as np
 import pytest
 from conftest import central_fd
 
+from flipkit.behaviors.library import SERVE_NAMES
 from flipkit.behaviors import serve as sv
 from flipkit.cli import main
 from flipkit.config import TableConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.orientation import rpy
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.planner import plan_serve
+from flipkit.planning.serve import plan_serve
 from flipkit.planning.serve import replan_serve, table_spot
 from flipkit.planning.verify import verify_plan
 from flipkit.simulation.judges import SERVE_TOL, judge_serve
@@ -99,7 +100,7 @@ def test_tip_point_jacobian_matches_finite_differences(robot, cell):
 # ---------------------------------------------------------------- planner and verify
 def test_serve_plan_is_solved_verified_and_chained(plan):
     names = [s.name for s in plan.segments]
-    assert names == list(sv.SERVE_SUBBEHAVIORS) and plan.behavior == "serve"
+    assert names == list(SERVE_NAMES) and plan.behavior == "serve"
     report = verify_plan(plan)
     assert report.ok, report.table()
     for a, b in zip(plan.segments, plan.segments[1:]):
@@ -259,7 +260,8 @@ def test_return_home_guess_makes_the_withdrawal():
     """Return home's initial guess slides the blade back in its own plane before heading
     home: the withdrawal rows are met to a few millimetres (a joint path straight home
     missed them by 0.4, scaled), and it ends at q_home at rest."""
-    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.config import CellConfig
     from flipkit.model.ik import solve_pose
 
@@ -270,7 +272,7 @@ def test_return_home_guess_makes_the_withdrawal():
     spot = table_spots(cell)[0]
     end = sv.place_end(cell, spot, (0.0, 0.0))
     q0 = solve_pose(models.bare, end.p, end.o, models.bare.q_home)
-    nlp = build_segment("return_home", models, q0, np.zeros(6), spot=spot)
+    nlp = transcribe("return_home", models, q0, np.zeros(6), spot=spot)
     groups = nlp.violation_by_group(nlp.x0)
     assert groups["withdraw"] < 0.02 and groups["withdraw_attitude"] < 0.02
     nodes = nlp.layout.nodes(nlp.x0)

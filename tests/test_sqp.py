@@ -88,13 +88,14 @@ def test_locally_infeasible_segment_stops_early_as_infeasible():
     task-space bounds it lies outside of."""
     from sqp_reference import START
 
-    from flipkit.behaviors.segments import Models, build_segment, flat_pose
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import flat_pose, transcribe
     from flipkit.config import CellConfig
     from flipkit.model.ik import solve_pose
 
     models = Models(CellConfig())
     q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
-    nlp = build_segment("translate", models, q_start, goal=flat_pose((0.75, 0.0, -0.5)))
+    nlp = transcribe("translate", models, q_start, goal=flat_pose((0.75, 0.0, -0.5)))
     with pytest.raises(NoSolutionFound) as err:
         solve_sqp(nlp)
     # The condensed restoration holds the linearised equality rows (the end pose among them)
@@ -140,11 +141,12 @@ def test_no_restoration_from_a_feasible_point():
     must never fall back to restoration there. Regression: a warm start from the previous
     subproblem's duals made OSQP report a false infeasibility certificate at this go-to-
     burger segment, and the solve stalled at J = 15 838 instead of reaching 13 678."""
-    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.config import CellConfig
 
     models = Models(CellConfig())
-    nlp = build_segment("go_to_burger", models, models.bare.q_home, np.zeros(6),
+    nlp = transcribe("go_to_burger", models, models.bare.q_home, np.zeros(6),
                         location=(0.677778, -0.17, 0.072))
     best = solve_ipopt(nlp).objective
     for ftol, rel in ((SQPOptions().termination.ftol, 1e-2), (1e-4, 1e-3)):
@@ -264,14 +266,15 @@ def test_points_that_cannot_be_evaluated_are_never_taken(reference):
 def cold_flip():
     """The flip segment of Table I location 7 from its cold initial guess, built from the end
     state of the pickup that plan_flip solves there."""
-    from flipkit.behaviors.segments import Models, build_segment
+    from flipkit.behaviors.models import Models
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.config import TABLE1_LOCATIONS, CellConfig
     from flipkit.planning.planner import plan_flip
 
     cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
     pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
                   if s.name == "pickup")
-    return build_segment("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    return transcribe("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
 
 
 def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_flip):

@@ -4,10 +4,10 @@ IPOPT from the same start where the SQP fails), each solved, continuous, verifie
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.planning.planner import plan_flip
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.verify import verify_plan
 
 
@@ -17,11 +17,11 @@ def test_table1_location_plans_and_verifies(index):
     assert plan.status == "solved", [(s.name, s.solver.status) for s in plan.segments]
     report = verify_plan(plan)
     assert report.ok, report.worst()
-    assert [s.name for s in plan.segments] == list(SUBBEHAVIORS)
+    assert [s.name for s in plan.segments] == list(FLIP_NAMES)
     for a, b in zip(plan.segments, plan.segments[1:]):  # chained by (29)
         np.testing.assert_allclose(a.q[-1], b.q[0], atol=1e-9)
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
-    flip = plan.segments[SUBBEHAVIORS.index("flip")]
+    flip = plan.segments[FLIP_NAMES.index("flip")]
     assert flip.cone_nodes == list(range(15))  # the paper's 0.6 N, extended to the release
     assert flip.landing["offset"] <= flip.landing["r_land"] + 1e-6
     assert all(s.solver.name in ("sqp", "ipopt") for s in plan.segments)
@@ -36,7 +36,7 @@ def _scoop_brakes_within_friction_under_the_burger(plan):
 
     cell = plan.cell()
     robot, cone = Robot(cell, with_burger=False), make_cone(plan.cone, cell.burger.mu, cell.gravity)
-    scoop = plan.segments[SUBBEHAVIORS.index("scoop")]
+    scoop = plan.segments[FLIP_NAMES.index("scoop")]
     pb, half = np.asarray(plan.burger["location"]), cell.spatula.length / 2
     assert scoop.cone_nodes == tg.scoop_cone_nodes(cell, len(scoop.t) - 1)
     for i, q in enumerate(scoop.q):

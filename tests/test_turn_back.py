@@ -13,7 +13,9 @@ import pytest
 from conftest import central_fd
 from test_plan import models  # noqa: F401  (fixture)
 
-from flipkit.behaviors.segments import T_BOUNDS, T_STRETCH, build_segment, clearance_excluded
+from flipkit.behaviors.library import SUBBEHAVIORS
+from flipkit.behaviors.options import T_STRETCH
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.errors import ConfigError
 from flipkit.transcription.constraints.clearance import CAP, CoastingClearance
 from flipkit.transcription.layout import Evaluation, Layout
@@ -32,8 +34,8 @@ def test_coasting_row_is_the_distance_ahead_with_its_jacobian(models):
     qd = rng.normal(scale=0.1, size=q.shape)
     qd[-1] = [-0.03, 2.13, 0.02, -3.17, -1.65, -2.58]
     x = L.pack(q, qd, np.zeros_like(q), np.zeros_like(q), rng.normal(size=(6, 7)), 0.6)
-    tau = T_BOUNDS["turn_back"][1] / L.N
-    block = CoastingClearance(L, shapes, L.N, tau, clearance_excluded("flip", L.N, L.N), 0.02)
+    tau = SUBBEHAVIORS["turn_back"].duration[1] / L.N
+    block = CoastingClearance(L, shapes, L.N, tau, SUBBEHAVIORS["flip"].exempt(L.N, L.N), 0.02)
     vals, jac = block.evaluate(Evaluation(L, robot, x))
     pairs = np.array([(k, b) for k in range(len(shapes.names))
                       for b in range(len(shapes.box_names))])
@@ -55,18 +57,18 @@ def test_only_the_flip_has_the_coasting_row(models):
     """At the flip's last node, with the turn back's first node interval at its longest; not
     in the turn back, nor without the arm clearance (the exact-derivative solvers' problem)."""
     from flipkit.behaviors import targets as tg
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.model.ik import solve_pose
 
     robot = models.bare
     pose = tg.pickup_end(models.cell, np.asarray(FAR_GRILL))
     q = solve_pose(models.loaded, pose.p, pose.o, robot.q_home)
-    flip = build_segment("flip", models, q, location=FAR_GRILL)
+    flip = transcribe("flip", models, q, location=FAR_GRILL)
     rows = [b for b in flip.blocks if b.name == "coasting_clearance"]
     assert len(rows) == 1 and rows[0].node == flip.layout.N
-    assert rows[0].tau == pytest.approx(T_BOUNDS["turn_back"][1] / flip.layout.N)
-    back = build_segment("turn_back", models, q, location=FAR_GRILL)
-    bare = build_segment("flip", models, q, location=FAR_GRILL,
+    assert rows[0].tau == pytest.approx(SUBBEHAVIORS["turn_back"].duration[1] / flip.layout.N)
+    back = transcribe("turn_back", models, q, location=FAR_GRILL)
+    bare = transcribe("flip", models, q, location=FAR_GRILL,
                          options=SegmentOptions(arm_clearance=False))
     assert not [b for nlp in (back, bare) for b in nlp.blocks if b.name == "coasting_clearance"]
 
@@ -75,7 +77,8 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     """The whole chain at a far-grill location with the SQP alone: every segment solved by
     the SQP, the turn back within 40 iterations and within its (possibly stretched) bound,
     and the plan verified; the flip ends where coasting keeps the margin."""
-    from flipkit.planning.planner import models_for, plan_flip
+    from flipkit.behaviors.models import models_for
+    from flipkit.planning.planner import plan_flip
     from flipkit.config import CellConfig
 
     plan = plan_flip(FAR_GRILL, solver="sqp")
@@ -85,11 +88,11 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     assert names[-1] == "turn_back"
     tb = plan.segments[-1]
     assert tb.solver.name == "sqp" and tb.solver.iterations <= 40
-    assert tb.T <= T_STRETCH * T_BOUNDS["turn_back"][1] + 1e-9
+    assert tb.T <= T_STRETCH * SUBBEHAVIORS["turn_back"].duration[1] + 1e-9
     flip = plan.segments[names.index("flip")]
     shapes = models_for(CellConfig()).shapes
     pairs = np.array([(k, b) for k in range(len(shapes.names))
                       for b in range(len(shapes.box_names))])
-    tau = T_BOUNDS["turn_back"][1] / (len(flip.t) - 1)
+    tau = SUBBEHAVIORS["turn_back"].duration[1] / (len(flip.t) - 1)
     d = shapes.nearest(flip.q[-1] + tau * flip.qd[-1], pairs, CAP)[0]
     assert d >= 0.02 - 1e-6

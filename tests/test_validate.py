@@ -6,10 +6,10 @@ import json
 import numpy as np
 import pytest
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
-from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.experiments.trials import STAGES, Perturbations, run_trial, track_plan, trial_jobs
 
 LOCATION = TABLE1_LOCATIONS[5]  # where conftest's flip_plan is planned
@@ -45,7 +45,7 @@ def test_schema(result):
         assert 0 <= f["trial"] < TRIALS and f["stage"] in STAGES
         assert isinstance(f["amount"], float) and isinstance(f["reason"], str)
     for table in (entry["tracking"], result["tracking"]):
-        assert list(table) == list(SUBBEHAVIORS)
+        assert list(table) == list(FLIP_NAMES)
         for err in table.values():
             assert 0 < err["rms_m"] <= err["max_m"] < 0.01  # PD tracking: below 1 cm
     assert result["summary"]["trials"] == TRIALS
@@ -87,7 +87,7 @@ def test_tracked_poses_follow_the_plan(plan_file):
     t, p, R, bounds, errors = track_plan(plan)
     assert np.all(np.diff(t) > 0) and t[0] == 0.0
     assert t[-1] == pytest.approx(sum(s.T for s in plan.segments), abs=2e-3)
-    assert list(bounds) == list(SUBBEHAVIORS) and p.shape == (t.size, 3)
+    assert list(bounds) == list(FLIP_NAMES) and p.shape == (t.size, 3)
     assert R.shape == (t.size, 3, 3)
 
 

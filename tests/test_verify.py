@@ -7,12 +7,12 @@ import pytest
 from test_plan import models  # noqa: F401  (fixture)
 from test_plan import LOCATION, chain_plan, cubic_segment, translate_plan
 
+from flipkit.behaviors.library import SUBBEHAVIORS
+from flipkit.behaviors.options import SCOOP_PRESS
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import T_BOUNDS
 from flipkit.cli import main
 from flipkit.errors import ConfigError, VerificationError
 from flipkit.planning.plan_file import Plan
-from flipkit.behaviors.segments import SCOOP_PRESS
 from flipkit.planning.verify import GROUPS, INTERPOLANT_TOL, verify_plan
 from flipkit.transcription.constraints.interpolant import ACC_SCALE, VEL_SCALE
 from flipkit.model.ik import solve_pose
@@ -206,7 +206,7 @@ def test_subbehaviour_endpoints_follow_the_burger_location(models, chain):
 
 def test_a_flip_that_does_not_flip_fails_its_path_constraints(models, chain):
     q = chain.segments[1].q[-1]  # pickup end, blade up: normal and height outside eq. (26)
-    seg = cubic_segment("flip", q, q, T_BOUNDS["flip"][1], models.loaded)
+    seg = cubic_segment("flip", q, q, SUBBEHAVIORS["flip"].duration[1], models.loaded)
     plan = Plan.from_segments("flip", models.cell, [seg], location=chain.burger["location"])
     report = _fails(plan, "behavior_path")
     assert report.groups["behavior_path"].violation == pytest.approx(1.8, abs=0.01)  # n_z 1 vs -0.8

@@ -7,7 +7,7 @@ Two end-effector optimisations (``ee``):
 
 * ``scp`` (default, issue 14): position, orientation and duration free
   (:mod:`.ee_scp`, sequential convex programming over the rpy Bezier; the duration by a
-  golden-section search within collocation's bounds :data:`~flipkit.behaviors.segments.T_BOUNDS`),
+  golden-section search within collocation's bounds the specs' ``duration``),
   with collocation's task-space endpoint constraints, friction cone and flip landing.
 * ``fixed``: the earlier single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep
   profile to a fixed flip end orientation, the durations :data:`BASELINE_T` (s) — the upper
@@ -27,8 +27,9 @@ import time
 
 import numpy as np
 
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.models import Models
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import Models
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound, UnreachableError
 from flipkit.model.ik import solve_pose
@@ -94,7 +95,7 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     tracker = (AnalyticTracker(robot) if ik == "analytic" else
                PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits))
     result = BaselineResult(tuple(float(x) for x in pb), [])
-    for name in tg.SUBBEHAVIORS:
+    for name in FLIP_NAMES:
         tic = time.perf_counter()
         try:
             if ee == "scp":

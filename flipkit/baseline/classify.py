@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from flipkit.behaviors.segments import SCOOP_PRESS, SCOOP_TIP_BAND
+from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
 
@@ -179,7 +179,7 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
     a_ratio, ak, aj = _worst_ratio(qdd, robot.qdd_max)
     u_ratio, uk, uj = _worst_ratio(u, robot.u_max)
     # the scoop commands the tip SCOOP_PRESS into the grill (±SCOOP_TIP_BAND), for both methods'
-    # plans alike: the blade may go that deep where it is pressed (behaviors.segments.grill_floor:
+    # plans alike: the blade may go that deep where it is pressed (behaviors.transcribe.blade_floor:
     # the go-to-burger's end, the scoop, the pickup's start)
     depth = th.grill_margin + (SCOOP_PRESS + SCOOP_TIP_BAND if name in PRESSED else 0.0)
     floor = cell.grill.height - depth

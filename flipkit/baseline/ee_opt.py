@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
 from flipkit.model.bezier import Bezier
 from flipkit.config import CellConfig
@@ -168,7 +169,7 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
     """Optimise the spatula trajectory of subbehaviour ``name``.
 
     Args:
-        name: One of :data:`flipkit.behaviors.targets.SUBBEHAVIORS`.
+        name: One of :data:`flipkit.behaviors.library.FLIP_NAMES`.
         cell: Cell configuration (spatula, burger μ, grill, task limits, gravity).
         location: Burger location p^b (m).
         start: Start state (the previous subbehaviour's end, or the pose at q_start at rest).
@@ -180,8 +181,8 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
     Raises:
         NoSolutionFound: The QP is infeasible.
     """
-    if name not in tg.SUBBEHAVIORS:
-        raise InvalidChoiceError("subbehaviour", name, tg.SUBBEHAVIORS)
+    if name not in FLIP_NAMES:
+        raise InvalidChoiceError("subbehaviour", name, FLIP_NAMES)
     if not (np.isfinite(T) and T > 0 and np.isfinite(rate) and rate > 0):
         raise ConfigError(f"duration and rate must be positive, got T={T!r}, rate={rate!r}")
     if int(degree) != degree or degree < 5:

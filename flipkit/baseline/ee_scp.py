@@ -8,13 +8,13 @@ condition of the carried object (the friction cone of the specific contact force
 f = Rᵀ(a − g), eq. 5, with collocation's friction safety factor μ × 0.8) and the task's
 endpoint conditions; the joints enter only afterwards, through inverse kinematics. What it
 adds so that the comparison with joint-space collocation is fair: the task-space constraints
-of collocation's segments (:func:`flipkit.behaviors.segments.build_segment`) — endpoint
+of collocation's segments (:func:`flipkit.behaviors.transcribe.transcribe`) — endpoint
 poses and rest, the position/velocity/acceleration box and pitch range (eq. 4), the blade's
 edges above the grill (the scoop's press included), the scoop's tip band, lateral band and
 attitude band, the flip's end-normal box, x-axis box at every sample, end-height band, cone
 up to the release at 0.7 T and the ballistic landing within r_land of the pickup spot, top
 face ≥ 150° from up — and a duration free within the same bounds
-(:data:`flipkit.behaviors.segments.T_BOUNDS`). Not kept: the flip's flight clearance and the
+(the specs' ``duration``). Not kept: the flip's flight clearance and the
 arm's space limits (joint-space quantities the task-space method cannot see).
 
 Method. p(s) and the rpy angles o(s) are Bezier polynomials of degree 7 in s = t/T; their
@@ -52,12 +52,13 @@ import time
 import cvxpy as cp
 import numpy as np
 
+from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
+from flipkit.behaviors.options import MU_SAFETY, RELEASE_FRACTION, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
+from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
 from flipkit.baseline.scp_problem import ORIENTATION_WEIGHT, REST, SCPProblem
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.guesses import flip_guess_pose
-from flipkit.behaviors.segments import (MU_SAFETY, R_LAND, RELEASE_FRACTION, SCOOP_PRESS,
-                                        SCOOP_TIP_BAND, T_BOUNDS, grill_floor)
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
 from flipkit.model.bezier import Bezier
@@ -107,7 +108,7 @@ class Task:
                      "pickup": tg.pickup_end(cell, pb), "turn_back": home}.get(name)
         self.guess_goal = self.goal or flip_guess_pose(cell, pb)
         n = SAMPLES
-        self.floor = grill_floor(name, cell, n - 1)
+        self.floor = blade_floor(name, cell, n - 1)
         self.p_lo = np.array(cell.limits.p_min, float)
         if name in ("go_to_burger", "scoop", "pickup"):
             self.p_lo[2] -= SCOOP_PRESS + SCOOP_TIP_BAND
@@ -315,7 +316,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
     """Optimise position, orientation and duration of subbehaviour ``name`` in task space.
 
     Args:
-        name: One of :data:`flipkit.behaviors.targets.SUBBEHAVIORS`.
+        name: One of :data:`flipkit.behaviors.library.FLIP_NAMES`.
         cell: Cell configuration.
         location: Burger location p^b (m).
         start: Start state (position, velocity, rpy and rpy rate; the previous subbehaviour's
@@ -332,13 +333,13 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
         NoSolutionFound: No duration within the bounds gives a feasible SCP solution.
         ConfigError: Bad start state, rate or bounds, or ``turn_back`` without ``home``.
     """
-    if name not in tg.SUBBEHAVIORS:
-        raise InvalidChoiceError("subbehaviour", name, tg.SUBBEHAVIORS)
+    if name not in FLIP_NAMES:
+        raise InvalidChoiceError("subbehaviour", name, FLIP_NAMES)
     if name == "turn_back" and home is None:
         raise ConfigError("turn_back needs the home pose")
     if not (np.isfinite(rate) and rate > 0):
         raise ConfigError(f"rate must be a positive number of Hz, got {rate!r}")
-    lo, hi = T_BOUNDS[name] if T_bounds is None else (float(T_bounds[0]), float(T_bounds[1]))
+    lo, hi = SUBBEHAVIORS[name].duration if T_bounds is None else (float(T_bounds[0]), float(T_bounds[1]))
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
         raise ConfigError(f"duration bounds must satisfy 0 < lo <= hi, got {(lo, hi)}")
     for field_name in ("p", "v", "o", "w"):

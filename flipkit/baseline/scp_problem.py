@@ -18,9 +18,8 @@ import math
 import cvxpy as cp
 import numpy as np
 
+from flipkit.behaviors.options import R_LAND, SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND, SCOOP_TIP_BAND
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import (R_LAND, SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND,
-                                        SCOOP_TIP_BAND)
 from flipkit.model.bezier import Bezier
 from flipkit.model.flight import TILT_MIN_DEG
 from flipkit.model.orientation import rpy_matrix, rpy_matrix_derivatives

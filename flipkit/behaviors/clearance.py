@@ -4,6 +4,8 @@ grill"), and why the tool end is exempt where it works."""
 
 from __future__ import annotations
 
+from flipkit.config.task import FLIP_END_ALLOWANCE, FLIP_TOOL_FRACTION  # noqa: F401
+
 # Space limits (issue 13; paper Sec. I: "operate within the boundaries of the walls and grill"):
 # every shape of the arm keeps cell.space.margin from every box of the cell, except the tool end
 # and the grill while the tool works on the grill. Going to the burger ends with the blade's tip
@@ -24,7 +26,7 @@ from __future__ import annotations
 # (0.84, −0.22): node 1, 0.06 s in, 1–4 mm short with shoulder, elbow and wrist 1 braking at
 # the 20 rad/s² limit). So the flip also holds the configuration it would reach coasting for
 # the turn back's first node interval, q_N + (T_max/N) q̇_N, to the margin
-# (segments.build_segment, CoastingClearance): the turn back then keeps the margin at node 1
+# (the spec's ``coast_into``, CoastingClearance): the turn back then keeps the margin at node 1
 # without braking, and brakes clear after it (needs ≥ v/(2τ) ≈ 10 m/s² at 1.2 m/s).
 # The serve's carry starts at the same pickup end as the flip and lifts the tool end clear in
 # its first quarter the same way (measured at (0.835, 0.10): the pickup ends with wrist 2
@@ -35,19 +37,21 @@ from __future__ import annotations
 # there as it works on the grill above, so the same tool shapes are exempt from the table (the
 # blade's height over the table is the place's own pivot constraint).
 TOOL_SHAPES = ("blade", "handle", "ee", "wrist_3", "wrist_2")  # ee: the URDF's ee_link box
-AT_GRILL = ("go_to_burger", "scoop", "pickup")
-AT_TABLE = ("place", "return_home")
-FLIP_TOOL_FRACTION = 0.25
-FROM_PICKUP = ("flip", "carry")  # start where the pickup ends: tool exempt from the grill at first
-FLIP_END_ALLOWANCE = 0.03  # m, our choice: ≈ 0.9 m/s × the turn back's first node (0.06 s) / 2
+_TOOL_AT_GRILL = frozenset((s, "grill") for s in TOOL_SHAPES)
+_TOOL_AT_TABLE = frozenset((s, "table") for s in TOOL_SHAPES)
 
 
-def clearance_excluded(name: str, node: int, N: int) -> frozenset:
-    """(shape, box) pairs segment ``name`` does not hold to the margin at ``node`` of 0..N
-    (see TOOL_SHAPES)."""
-    tool = frozenset((s, "grill") for s in TOOL_SHAPES)
-    if name in AT_GRILL or (name in FROM_PICKUP and node < FLIP_TOOL_FRACTION * N):
-        return tool
-    if name in AT_TABLE:
-        return frozenset((s, "table") for s in TOOL_SHAPES)
-    return frozenset()
+def tool_at_grill(node: int, N: int) -> frozenset:
+    """Go to burger, scoop, pickup: the tool end works on the grill at every node."""
+    return _TOOL_AT_GRILL
+
+
+def tool_leaves_grill(node: int, N: int) -> frozenset:
+    """Flip, carry: they start where the pickup ends; the tool end is exempt from the grill
+    until node FLIP_TOOL_FRACTION · N."""
+    return _TOOL_AT_GRILL if node < FLIP_TOOL_FRACTION * N else frozenset()
+
+
+def tool_at_table(node: int, N: int) -> frozenset:
+    """Place, return home: the tool end works on the table."""
+    return _TOOL_AT_TABLE

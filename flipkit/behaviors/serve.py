@@ -56,27 +56,14 @@ import numpy as np
 
 from flipkit.behaviors.targets import Pose
 from flipkit.config import CellConfig
+from flipkit.config.task import (BURGER_CLEARANCE, CARRY_CLEARANCE, PIVOT_BAND,  # noqa: F401
+                                 PLACE_CONE_FRACTION, PLACE_PITCH, PLACE_TIP_GAP,
+                                 WITHDRAW_ANGLE_BAND, WITHDRAW_BAND, WITHDRAW_DISTANCE,
+                                 WITHDRAW_NODES)
 from flipkit.errors import UnreachableError
 from flipkit.model.orientation import rpy
 from flipkit.model.robot import skew
 from flipkit.transcription.constraints.kinematic import KinematicBlock, Quantity
-
-SERVE_SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "carry", "place", "return_home")
-SERVE_ONLY = SERVE_SUBBEHAVIORS[3:]
-PLACE_PITCH = 0.70  # rad, tip down at the end of the place (tan 0.70 = 0.84 > μ's range 0.2–0.8)
-PLACE_TIP_GAP = 0.005  # m, blade tip above the table at the end of the place
-PLACE_CONE_FRACTION = 0.7  # the cone holds on place nodes i ≤ 0.7 N
-PIVOT_BAND = 0.003  # m, the tip within this of its final point while the blade tilts about it
-CARRY_CLEARANCE = 0.06  # m, the carry ends with the blade centre this far above the place pose
-WITHDRAW_NODES = 8  # return_home nodes 1..8 withdraw the blade in its own plane
-WITHDRAW_DISTANCE = 0.14  # m, back along −x of the blade by node 8: l − 2 cm of overlap
-BURGER_CLEARANCE = 0.01  # m, blade edges above the placed burger's top after the withdrawal
-WITHDRAW_BAND = 0.005  # m, off the blade's start plane / start line while withdrawing
-WITHDRAW_ANGLE_BAND = 0.05  # rad, rpy about the place end's while withdrawing
-# Duration bounds (s): Σu² drives T to the upper bound. The carry covers up to ~1 m under the
-# cone (planned μ 0.4: ≤ 3.9 m/s² sideways); the return unrolls the heading back to q_home's.
-T_BOUNDS = {"carry": (0.6, 1.6), "place": (0.3, 0.8), "return_home": (0.5, 1.5)}
-CARRIES_BURGER = {"carry": True, "place": True, "return_home": False}
 
 
 def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
@@ -143,13 +130,17 @@ def carry_end(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> Pose:
     return Pose((p[0], p[1], p[2] + CARRY_CLEARANCE), (0.0, 0.0, heading(spot)))
 
 
-def table_floor(name: str, cell: CellConfig, N: int) -> np.ndarray:
-    """Lowest blade edge height (m) at nodes 0..N of a serve-only segment: the table's top
-    (the blade never goes below it; the grill is lower), and after the withdrawal the placed
-    burger's top plus :data:`BURGER_CLEARANCE`."""
-    floor = np.full(N + 1, max(cell.table.height, cell.grill.height))
-    if name == "return_home":
-        floor[WITHDRAW_NODES + 1:] = cell.table.height + cell.burger.thickness + BURGER_CLEARANCE
+def table_floor(cell: CellConfig, N: int) -> np.ndarray:
+    """Lowest blade edge height (m) at nodes 0..N of the carry and place: the table's top
+    (the blade never goes below it; the grill is lower)."""
+    return np.full(N + 1, max(cell.table.height, cell.grill.height))
+
+
+def withdrawn_floor(cell: CellConfig, N: int) -> np.ndarray:
+    """Return home's floor (m): the table's top, and after the withdrawal the placed burger's
+    top plus :data:`BURGER_CLEARANCE`."""
+    floor = table_floor(cell, N)
+    floor[WITHDRAW_NODES + 1:] = cell.table.height + cell.burger.thickness + BURGER_CLEARANCE
     return floor
 
 
@@ -195,23 +186,33 @@ def withdraw_bounds(N: int) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def serve_blocks(name: str, L, robot, q_start, spot, on_blade=(0.0, 0.0)
-                 ) -> tuple[list, Pose | None]:
-    """Path blocks of a serve-only segment and its end pose (None for return_home)."""
-    if name == "carry":
-        return [], carry_end(robot.cell, spot, on_blade)
-    if name == "place":
-        end = place_end(robot.cell, spot, on_blade)
-        tip, b = tip_point(robot.cell, end), PIVOT_BAND
-        ctx = {"length": robot.cell.spatula.length}
-        return [KinematicBlock("place_pivot", L, TipPoint(), pivot_nodes(L.N), tip - b,
-                               tip + b, ctx=ctx)], end
-    st = robot.placement(q_start)
+def place_pivot(ctx) -> list:
+    """The place's pivot: the tip within PIVOT_BAND of its final point from node ⌈0.7 N⌉ on."""
+    end = place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point())
+    tip, b = tip_point(ctx.cell, end), PIVOT_BAND
+    return [KinematicBlock("place_pivot", ctx.layout, TipPoint(), pivot_nodes(ctx.layout.N),
+                           tip - b, tip + b, ctx={"length": ctx.cell.spatula.length})]
+
+
+def withdrawal(ctx) -> list:
+    """Return home's first WITHDRAW_NODES nodes: the blade slides back in its own plane,
+    attitude kept (:func:`withdraw_bounds`)."""
+    st = ctx.robot.placement(ctx.q_start)
     nodes = range(1, WITHDRAW_NODES + 1)
-    lo, hi = withdraw_bounds(L.N)
+    lo, hi = withdraw_bounds(ctx.layout.N)
     o0, band = rpy(st.rotation), WITHDRAW_ANGLE_BAND
-    return [KinematicBlock("withdraw", L, InStartFrame(st.rotation, st.translation), nodes, lo, hi),
-            KinematicBlock("withdraw_attitude", L, "rpy", nodes, o0 - band, o0 + band)], None
+    return [KinematicBlock("withdraw", ctx.layout, InStartFrame(st.rotation, st.translation),
+                           nodes, lo, hi),
+            KinematicBlock("withdraw_attitude", ctx.layout, "rpy", nodes, o0 - band, o0 + band)]
+
+
+def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
+    """The ``placing`` record of the carry and place segments: the table ``spot`` (x, y) (m),
+    ``on_blade`` (x, y) (m, blade frame) where the burger was planned to sit, the blade's
+    ``heading`` and ``pitch`` at the place's end (rad) (:func:`place_end`)."""
+    end = place_end(cell, spot, on_blade)
+    return {"spot": [float(v) for v in spot], "on_blade": [float(v) for v in on_blade],
+            "heading": float(end.o[2]), "pitch": float(end.o[1])}
 
 
 def reach(robot, pose: Pose, seeds=()) -> np.ndarray:
@@ -230,17 +231,3 @@ def reach(robot, pose: Pose, seeds=()) -> np.ndarray:
     raise error
 
 
-def cone_nodes(name: str, N: int) -> list[int]:
-    """Nodes where a serve-only segment enforces the friction cone."""
-    if name == "carry":
-        return list(range(N + 1))
-    if name == "place":
-        return [i for i in range(N + 1) if i <= PLACE_CONE_FRACTION * N + 1e-9]
-    return []
-
-
-__all__ = ["SERVE_SUBBEHAVIORS", "SERVE_ONLY", "PLACE_PITCH", "PLACE_TIP_GAP", "rest_offset",
-           "predicted_rest", "WITHDRAW_NODES", "WITHDRAW_DISTANCE",
-           "PLACE_CONE_FRACTION", "T_BOUNDS", "CARRIES_BURGER", "check_table_spot", "heading",
-           "place_end", "carry_end", "table_floor", "InStartFrame", "withdraw_bounds",
-           "serve_blocks", "cone_nodes", "TipPoint", "tip_point", "pivot_nodes", "reach"]

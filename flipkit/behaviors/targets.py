@@ -1,5 +1,6 @@
 """Task-space targets of the subbehaviours (paper Sec. IV.C, eqs. 22–27), shared by the
-joint-space collocation and the end-effector-space baseline.
+joint-space collocation and the end-effector-space baseline. The values they use (the
+scoop's pitch, the pickup's offset, the flip's end set, ...) are :mod:`flipkit.config.task`'s.
 """
 
 from __future__ import annotations
@@ -10,22 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from flipkit.config import CellConfig
+from flipkit.config.task import (FLIP_CONE_FRACTION, FLIP_HEIGHT_BAND,  # noqa: F401
+                                 FLIP_NORMAL_BOUNDS, FLIP_XAXIS_BOUNDS, PICKUP_OFFSET,
+                                 PICKUP_PITCH, SCOOP_PITCH, SCOOP_PRESS, SCOOP_START_MARGIN)
 from flipkit.errors import UnreachableError
-
-SCOOP_PITCH = 0.314  # o_y* (rad), eq. (22)
-SCOOP_PRESS = 0.003  # m: the scoop presses the blade this far into the grill (flipkit's choice)
-# m: the scoop starts with the tip this far before the burger's near edge (the paper: at it,
-# eq. 23). The burger lies where it was put within a 5 mm standard deviation (the Table I
-# trials' placement error); coming down at the edge itself, the blade landed on the burger's
-# rim in 7 of 10 trials at (0.70, 0.10) (measured), so the tip comes down 3 σ before it.
-SCOOP_START_MARGIN = 0.015
-PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, eq. (25)
-PICKUP_PITCH = -0.05  # rad, eq. (25)
-FLIP_CONE_FRACTION = 0.6  # cone on nodes i <= 0.6 N, eq. (26)
-FLIP_NORMAL_BOUNDS = ((-0.5, -0.5, -1.0), (0.0, 0.5, -0.8))  # F_n(q_N), eq. (26)
-FLIP_XAXIS_BOUNDS = ((0.6, -1.0, -1.0), (1.0, 1.0, 1.0))  # R(q_i) x̂, eq. (26)
-FLIP_HEIGHT_BAND = (0.1, 0.4)  # h_g + band on p_z(q_N) (m), eq. (26)
-SUBBEHAVIORS = ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
 
 
 @dataclass(frozen=True)

@@ -65,7 +65,7 @@ def run_build(args: argparse.Namespace) -> int:
 
 def run_info(args: argparse.Namespace) -> int:
     """One paragraph about an atlas, and whether it serves today's default options."""
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.config import CellConfig
     from flipkit.planning.atlas import Atlas, default_path, options_hash
 

@@ -162,7 +162,7 @@ def _start_q(values, cell):
         return None
     from flipkit.model.singular import check_start
     from flipkit.planning.inputs import check_joint_vector
-    from flipkit.planning.planner import models_for
+    from flipkit.behaviors.models import models_for
 
     q = _numbers("--start-q", values, 6)
     robot = models_for(cell).for_segment("go_to_burger")
@@ -262,7 +262,7 @@ def run_translate(args: argparse.Namespace) -> int:
 
 def run_flip(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.planning.planner import plan_flip
 
     from flipkit.config import CellConfig
@@ -307,9 +307,9 @@ def _atlas(args: argparse.Namespace, options):
 
 def run_serve(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
-    from flipkit.planning.planner import plan_serve
+    from flipkit.planning.serve import plan_serve
 
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.behaviors.serve import check_table_spot
     from flipkit.config import CellConfig
     from flipkit.errors import UnreachableError
@@ -335,7 +335,7 @@ def run_serve(args: argparse.Namespace) -> int:
 
 def run_batch(args: argparse.Namespace) -> int:
     """Plan the batch, write every plan and summary.csv, print the table."""
-    from flipkit.behaviors.segments import SegmentOptions
+    from flipkit.behaviors.options import SegmentOptions
     from flipkit.fileio import write_text
     from flipkit.planning.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
 

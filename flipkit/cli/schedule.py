@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     burgers = read_cook_csv(args.burgers, cell, serve=not args.flip_only)
     kinds = ("flip",) if args.flip_only else ("flip", "serve")
     atlas = None if args.no_atlas else default_atlas(cell)
-    planners = default_planners(kinds, cell, args.solver, atlas)  # MissingPlannerError first
+    planners = default_planners(kinds, cell, args.solver, atlas)
     timeline_path = Path(args.json)
     plans = Path(args.plans) if args.plans else timeline_path.with_name(
         timeline_path.stem + "_plans")

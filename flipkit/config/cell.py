@@ -18,7 +18,7 @@ from flipkit.config.space import CellBox, SpaceConfig, cell_boxes
 from flipkit.config.urdf import default_urdf, resolve_urdf
 from flipkit.errors import ConfigError
 
-GRAVITY = (0.0, 0.0, -9.81)  # m/s², world z up (DESIGN.md conventions)
+GRAVITY = (0.0, 0.0, -9.81)  # m/s², world z up (docs/conventions.md)
 
 
 def _identity() -> tuple:
@@ -35,7 +35,7 @@ class RobotConfig:
             (the paper's arm is an unnamed 6-DOF industrial arm; the UR10 matches its reach).
         tool_frame: Frame the spatula is mounted on (``tool0``, the ROS-Industrial flange).
         base_in_world: 4x4 homogeneous transform of the robot base in the world (identity:
-            DESIGN.md, world = robot base frame).
+            docs/conventions.md: world = robot base frame).
         q_home: Home configuration (rad): spatula flat and level, radially in front of the
             above the grill at (0.62, -0.20, 0.30) m, o = 0, elbow up (our choice; found by
             IK, checked in tests/test_config.py).

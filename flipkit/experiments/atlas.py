@@ -18,8 +18,9 @@ import time
 
 import numpy as np
 
-from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 from flipkit.experiments.sweep import grill_grid, make_executor, run_sweep
@@ -32,7 +33,8 @@ DEFAULT_GRID = (5, 7)  # 35 locations, 5.6 cm × 9.4 cm apart over the grill are
 def solve_entry(item) -> dict:
     """Plan the chain at one location (sweep worker): ``{"location", "status", "failure",
     "x": {segment: Z}, "structure": {segment: key}, "wall_s", "iterations"}``."""
-    from flipkit.planning.planner import models_for, plan_flip
+    from flipkit.behaviors.models import models_for
+    from flipkit.planning.planner import plan_flip
 
     location, cell, options = item
     plan = plan_flip(location, cell=cell, options=options, solver="sqp")
@@ -45,7 +47,7 @@ def solve_entry(item) -> dict:
     for seg in plan.segments:
         q0 = seg.q[0] if q is None else q
         landing = seg.landing or {}  # a robust flip's scenario rows are part of its NLP
-        nlp = build_segment(seg.name, models, q0, seg.qd[0] if qd is None else qd,
+        nlp = transcribe(seg.name, models, q0, seg.qd[0] if qd is None else qd,
                             location=location, options=options,
                             on_blade=landing.get("burger_on_blade", (0.0, 0.0)),
                             scenarios=[r["burger_on_blade"] for r in landing.get("scenarios", [])])
@@ -96,7 +98,7 @@ def build_atlas(cell: CellConfig | None = None, options: SegmentOptions = Segmen
             "median_iterations": float(np.median([r["iterations"] for r in solved])),
             "flipkit_commit": git_commit(), "format": FORMAT}
     return Atlas([r["location"] for r in solved],
-                 {name: np.array([r["x"][name] for r in solved]) for name in tg.SUBBEHAVIORS},
+                 {name: np.array([r["x"][name] for r in solved]) for name in FLIP_NAMES},
                  structure, meta)
 
 

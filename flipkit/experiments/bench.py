@@ -34,12 +34,15 @@ import warnings
 
 import numpy as np
 
-from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import T_BOUNDS, SegmentOptions, build_segment, flat_pose
+from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.planning.atlas import Atlas, default_atlas
-from flipkit.planning.planner import models_for, plan_batch, plan_flip, solve_segment
+from flipkit.behaviors.models import models_for
+from flipkit.planning.chain import solve_segment
+from flipkit.planning.planner import plan_batch, plan_flip
 from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
@@ -117,7 +120,7 @@ def _translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
     pts, nlps = TRANSLATE_KEY_POINTS, []
     for k, a in enumerate(pts):
         q0 = solve_pose(robot, a, (0.0, 0.0, 0.0), robot.q_home)
-        nlps.append(build_segment("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)]),
+        nlps.append(transcribe("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)]),
                                   options=options))
     return nlps
 
@@ -192,7 +195,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         print(f"{'':<6}{TRANSLATE_SOLVERS[name]:<14}{m['time_s']:8.3f}{m['iterations']:5.0f}"
               f"{m['ms_per_iteration']:7.0f}{m['max_abs_rel_objective_diff_vs_sqp']:10.1e}"
               f"{m['solved']:>7d}/{len(rows)}")
-    print(f"T = executed duration (s), bounds {T_BOUNDS['translate']} s; dJ = (J − J_SQP)/J_SQP "
+    print(f"T = executed duration (s), bounds {SUBBEHAVIORS['translate'].duration} s; dJ = (J − J_SQP)/J_SQP "
           "over the segments both solved, ms/it = median time per iteration, "
           "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
           "solver calls alone (FATROP's and exact IPOPT's without building their graphs)")
@@ -228,8 +231,8 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     return the rows."""
     models, locs = models_for(cell), TABLE1_LOCATIONS[:n_locations]
     q, qd, structures = models.bare.q_home, None, []
-    for name in tg.SUBBEHAVIORS:  # one NLP per structure, along the initial guesses
-        nlp = build_segment(name, models, q, qd, location=TABLE1_LOCATIONS[1])
+    for name in FLIP_NAMES:  # one NLP per structure, along the initial guesses
+        nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
         structures.append(nlp)
         x = nlp.layout.nodes(nlp.x0)
         q, qd = x[-1, 0], x[-1, 1]

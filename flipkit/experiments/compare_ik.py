@@ -21,6 +21,7 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
 from flipkit.baseline.classify import FAILURE_CLASSES, REASONS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
@@ -154,20 +155,20 @@ def summarize(records: list) -> dict:
         c = r["collocation"]
         if c["status"] != "solved":
             head = (c["reason"] or "").split(":")[0]
-            stops[head if head in tg.SUBBEHAVIORS else "other"] += 1
+            stops[head if head in FLIP_NAMES else "other"] += 1
     coll = {s: _median(r["collocation"][_PRIVATE].get(s) for r in records)
-            for s in tg.SUBBEHAVIORS}
+            for s in FLIP_NAMES}
     coll["total"] = _median(r["collocation"]["time_s"] for r in records)
     ee = {s: {part: _median(r["ee_ik"]["time_breakdown_s"].get(s, {}).get(part)
                             for r in records)
-              for part in ("ee", "ik")} for s in tg.SUBBEHAVIORS}
+              for part in ("ee", "ik")} for s in FLIP_NAMES}
     return {"locations": n, "success_fraction": frac,
             "ik_failure_reasons": {k: reasons.get(k, 0) for k in REASONS},
             "ik_failure_classes": {k: classes.get(k, 0) for k in FAILURE_CLASSES},
             "ik_worst_classes": {k: worst.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "collocation_judge": {k: judged.get(k, 0) for k in ("solved",) + FAILURE_CLASSES},
             "ik_failure_subbehaviors": {s: sum(r["ee_ik"]["subbehavior"] == s for r in records)
-                                        for s in tg.SUBBEHAVIORS},
+                                        for s in FLIP_NAMES},
             "collocation_failures": dict(sorted(stops.items())),
             "median_time_s": {"collocation": coll, "ee_ik": ee}}
 
@@ -230,7 +231,7 @@ def format_summary(summary: dict) -> str:
     lines.append("collocation plans under the same judge: " + ", ".join(
         f"{k} {v}" for k, v in summary["collocation_judge"].items() if v))
     fmt = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
-    for s in tg.SUBBEHAVIORS:
+    for s in FLIP_NAMES:
         lines.append(f"  {s:<13} collocation {fmt(t['collocation'][s]):>7} s   EE "
                      f"{fmt(t['ee_ik'][s]['ee']):>7} s + IK {fmt(t['ee_ik'][s]['ik']):>7} s")
     return "\n".join(lines)

@@ -87,11 +87,12 @@ def config_constants() -> dict:
     hand): friction coefficients (burger-blade ``mu``, burger-grill ``grill_mu`` of the
     simulated cell), the scoop's commanded press into the grill and its band (mm), the
     flip's landing radius (mm), release fraction and node and minimum landing tilt (deg), acceleration limit, burger and spatula
-    sizes, grill height, nodes per segment, and the duration bounds T_BOUNDS (s) of every
+    sizes, grill height, nodes per segment, and the duration bounds (s) of every
     segment with their sum over pickup-and-flip."""
     from flipkit.behaviors import targets as tg
-    from flipkit.behaviors.segments import (FLIGHT_MARGIN, MU_SAFETY, R_LAND, RELEASE_FRACTION, SCOOP_PRESS,
-                            SCOOP_TIP_BAND, T_BOUNDS, SegmentOptions)
+    from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
+    from flipkit.behaviors.options import (FLIGHT_MARGIN, MU_SAFETY, R_LAND, RELEASE_FRACTION,
+                                           SCOOP_PRESS, SCOOP_TIP_BAND, SegmentOptions)
     from flipkit.config import CellConfig
     from flipkit.model.flight import TILT_MIN_DEG
 
@@ -109,9 +110,10 @@ def config_constants() -> dict:
            "spatula_length_m": cell.spatula.length, "spatula_width_m": cell.spatula.width,
            "grill_height_m": cell.grill.height, "nodes": SegmentOptions().N + 1,
            "segment_intervals": SegmentOptions().N}
-    for name, (lo, hi) in T_BOUNDS.items():
+    for name, spec in SUBBEHAVIORS.items():
+        lo, hi = spec.duration
         out[f"T_{name}_min_s"], out[f"T_{name}_max_s"] = lo, hi
-    out["T_pickup_and_flip_max_s"] = round(sum(T_BOUNDS[n][1] for n in tg.SUBBEHAVIORS), 9)
+    out["T_pickup_and_flip_max_s"] = round(sum(SUBBEHAVIORS[n].duration[1] for n in FLIP_NAMES), 9)
     return out
 
 

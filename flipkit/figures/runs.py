@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
@@ -135,17 +136,16 @@ def _warm_sqp(cell: CellConfig, location) -> float:
     """One SQP iteration on each of the five segment structures, once per process: cvxpy's
     one-off compile of each QP (~2 s per structure) is set-up, not solve time (as in
     :mod:`flipkit.experiments.bench`). Returns the time spent (s)."""
-    from flipkit.behaviors import targets as tg
-    from flipkit.behaviors.segments import build_segment
+    from flipkit.behaviors.transcribe import transcribe
     from flipkit.experiments.bench import warm_up
-    from flipkit.planning.planner import models_for
+    from flipkit.behaviors.models import models_for
 
     if cell in _WARMED:
         return 0.0
     models = models_for(cell)
     q, qd, nlps = models.bare.q_home, None, []
-    for name in tg.SUBBEHAVIORS:  # the structures along the initial guesses
-        nlp = build_segment(name, models, q, qd, location=location)
+    for name in FLIP_NAMES:  # the structures along the initial guesses
+        nlp = transcribe(name, models, q, qd, location=location)
         nlps.append(nlp)
         nodes = nlp.layout.nodes(nlp.x0)
         q, qd = nodes[-1, 0], nodes[-1, 1]

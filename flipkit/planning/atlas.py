@@ -28,22 +28,21 @@ from pathlib import Path
 
 import numpy as np
 
-from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import SegmentOptions
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 
 FORMAT = "flipkit-atlas/1"
 # Segments the planners seed from the atlas.
-SEEDED = ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
+SEEDED = FLIP_NAMES  # the atlas holds every segment of the pickup-and-flip
 # Segments seeded by their neighbours' joint paths *anchored* at the segment's actual start
 # state, then refitted (:func:`anchored_guess`), rather than by the interpolated vector itself.
 # The flip and the turn back start where the previous segment of *this* chain ended, which an
-# interpolated solution misses. Measured (session 7): from the interpolated vector the SQP
-# declared the flip infeasible after 8–12 iterations (2–3 s) at Table I locations 2 and 6; its
-# landing, cone and coasting rows are strongly curved, and a weighted mean of neighbours' flips
-# satisfies none of them. Anchored (session 8, nearest entry, Table I): every flip solved, in
-# 11–25 iterations and 0.6–1.7 s, against 16–45 iterations and 1.6–4.8 s cold.
+# interpolated solution misses: the flip's landing, cone and coasting rows are strongly curved,
+# and a weighted mean of neighbours' flips satisfies none of them, where a neighbour's flip
+# anchored at the actual start is close to a solution (docs/history.md has the measurements).
 # "shift": q(t) = q_atlas(t) + (q_start − q_atlas(0)) (the flip's free end moves with its
 # start); "blend": the offset fades out by a smoothstep (the turn back ends at q_home).
 ANCHORED = {"flip": "shift", "turn_back": "blend"}
@@ -92,7 +91,7 @@ class Atlas:
         self.locations = np.asarray(locations, float).reshape(-1, 3)
         self.solutions = {k: np.asarray(v, float) for k, v in solutions.items()}
         self.structure, self.meta = dict(structure), dict(meta)
-        for name in tg.SUBBEHAVIORS:
+        for name in FLIP_NAMES:
             if name not in self.solutions or name not in self.structure:
                 raise AtlasError(f"atlas has no {name!r} solutions; segments: "
                                  f"{', '.join(sorted(self.solutions))}")
@@ -181,9 +180,8 @@ class Atlas:
         d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
         # An entry whose duration lies outside this NLP's bounds was solved with the bound
         # stretched (the planner's retry, ×1.5): clipped to the bound it violates every
-        # defect row, so it seeds nothing. Measured (session 11): two of the 35 scoops of the
-        # package's atlas (T = 0.9 s, bound 0.6 s) had the scoop declared infeasible after 9
-        # iterations, then solved cold, at their own grid locations.
+        # defect row, so it seeds nothing (an SQP started there declares the segment
+        # infeasible).
         i = nlp.layout.T_index
         inside = (X[:, i] >= nlp.x_lb[i] - 1e-6) & (X[:, i] <= nlp.x_ub[i] + 1e-6)
         d = np.where(inside, d, np.inf) if inside.any() else d
@@ -200,6 +198,24 @@ class Atlas:
         if start is None or name not in ANCHORED:
             return x
         return anchored_guess(nlp, x, start[0], start[1], ANCHORED[name])
+
+
+def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
+    """Raise :class:`~flipkit.errors.AtlasError` if ``atlas`` (or ``None``) was built for
+    other planning options or another cell."""
+    if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
+        raise AtlasError("stale atlas: built for other planning options or another cell; "
+                         "rebuild it with `flipkit atlas build`")
+
+
+def seeding(atlas, location):
+    """A :meth:`~flipkit.planning.chain.Planner.chain` ``guess`` from ``atlas`` for the
+    burger at ``location``: the atlas's interpolated solution for the segments it holds
+    (:data:`SEEDED`); ``None`` without an atlas."""
+    if atlas is None:
+        return None
+    return lambda name, nlp, q, qd: (atlas.guess(name, location, nlp, (q, qd))
+                                     if name in SEEDED else None)
 
 
 def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
@@ -222,4 +238,4 @@ def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
     return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end=how == "blend")
 
 
-__all__ = ["ANCHORED", "Atlas", "FORMAT", "SEEDED", "anchored_guess", "default_atlas", "default_path", "options_hash"]
+__all__ = ["ANCHORED", "Atlas", "FORMAT", "SEEDED", "anchored_guess", "check_atlas", "seeding", "default_atlas", "default_path", "options_hash"]

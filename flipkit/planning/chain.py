@@ -1,9 +1,7 @@
 """Solving a chain of segments: one segment with a solver, one with its duration bound
-stretched if need be, and the whole chain of a behaviour, each segment from the previous
-one's final state (eq. 29), checked at the end (:func:`~flipkit.planning.verify.verify_plan`).
-
-The loop behind every planner entry point of :mod:`flipkit.planning.planner` and
-:mod:`flipkit.planning.serve`.
+stretched if need be, and the whole chain of any behaviour (:class:`Planner`), each segment
+from the previous one's final state (eq. 29), checked at the end
+(:func:`~flipkit.planning.verify.verify_plan`).
 """
 
 from __future__ import annotations
@@ -13,15 +11,18 @@ from dataclasses import replace
 
 import numpy as np
 
-from flipkit.behaviors.segments import SegmentOptions
+from flipkit.behaviors import library
+from flipkit.behaviors.models import models_for
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.spec import Behavior, Task
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError, FlipkitError, InvalidChoiceError, SolverError
 from flipkit.planning.plan_file import Plan
 from flipkit.planning.segment import Segment
 from flipkit.planning.verify import verify_plan
+from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
-
-SOLVERS = ("sqp", "ipopt", "auto")
 
 
 def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
@@ -81,7 +82,7 @@ def solver_failure(name: str, nlp, result) -> str:
 def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
     """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
     duration bound, build and solve it once more with the bound stretched (SegmentOptions
-    ``stretch``, :data:`~flipkit.behaviors.segments.T_STRETCH`). Returns (nlp, result): the
+    ``stretch``, :data:`~flipkit.behaviors.options.T_STRETCH`). Returns (nlp, result): the
     stretched one if it succeeded, else the first.
 
     ``guess(nlp) -> x0`` (optional) seeds a first SQP solve (a warm start, e.g. from an
@@ -131,59 +132,91 @@ def _counting(result: SolveResult, before: SolveResult) -> SolveResult:
     return result
 
 
-def chain_segments(behavior: str, names, build, q, qd, done: list, cell: CellConfig,
-                   solver: str, options: SegmentOptions, t0: float, location,
-                   decorate=None, guess=None) -> Plan:
-    """Solve the segments ``names`` after those ``done`` (already solved), each from the
-    previous one's final (q, q̇) (eq. 29), and verify the chain: the one loop behind
-    :func:`plan_flip`, :func:`replan_flip` and the serve planners.
+class Planner:
+    """Chains the segments of any behaviour and checks the plan.
+
+    Each segment is solved from the previous one's final state (eq. 29), with its duration
+    bound stretched once where it is infeasible within it (for behaviours that allow it),
+    and the chain is verified at the end (:func:`finish_plan`).
 
     Args:
-        behavior: The plan's behaviour (``flip``, ``serve``).
-        names: All the behaviour's segment names in order; those after ``len(done)`` are solved.
-        build: ``build(name, q, qd, options) -> NLP``.
-        q, qd: Start state of the first segment to solve (rad, rad/s).
-        done: Segments kept from an earlier plan. cell, solver, options: As the planners.
-        t0: ``time.perf_counter()`` when planning began (the plan's wall time counts from it).
-        location: The burger's location p^b (m), recorded in the plan.
-        decorate: Optional ``decorate(name, segment)`` adding records to a solved segment.
-        guess: Optional ``guess(name, nlp, q, qd) -> x0`` warm-starting each segment's solve
-            from its start state (q, qd) (:func:`solve_stretched`).
-
-    Returns:
-        The verified plan; on a segment failure the chain stops there and ``plan.failure``
-        names the segment, its worst constraint group and the violation.
+        cell: The cell (default :class:`~flipkit.config.CellConfig`).
+        solver: One of :data:`SOLVERS`.
+        options: Transcription options.
 
     Raises:
-        FlipkitError: The first segment to solve cannot be built (e.g. its initial guess),
-            with nothing solved before it. AtlasError: ``guess`` refuses (a stale atlas).
+        InvalidChoiceError: Unknown solver.
     """
-    segments, failure = list(done), None
-    for name in list(names)[len(done):]:
-        try:
-            nlp, result = solve_stretched(lambda o: build(name, q, qd, o), options, solver,
-                                          None if guess is None else
-                                          (lambda nlp, name=name, q=q, qd=qd:
-                                           guess(name, nlp, q, qd)))
-        except AtlasError:
-            raise
-        except FlipkitError as exc:
-            if not segments:
+
+    def __init__(self, cell: CellConfig | None = None, *, solver: str = "auto",
+                 options: SegmentOptions = SegmentOptions()):
+        if solver not in SOLVERS:
+            raise InvalidChoiceError("solver", solver, SOLVERS)
+        self.cell = cell or CellConfig()
+        self.solver, self.options = solver, options
+        self.models = models_for(self.cell)
+
+    def chain(self, behavior: Behavior | str, task: Task, q, qd, *, done=(), guess=None,
+              t0: float | None = None) -> Plan:
+        """Solve the behaviour's segments after those ``done`` (already solved), from (q, q̇).
+
+        Args:
+            behavior: A :class:`~flipkit.behaviors.spec.Behavior` or its name.
+            task: What it is for; a segment's spec may refine it for the segments after it
+                (``after_solve``: the scoop predicts where the burger lies on the blade).
+            q, qd: Start state of the first segment to solve (rad, rad/s).
+            done: Segments kept from an earlier plan, in order.
+            guess: Optional ``guess(name, nlp, q, qd) -> x0`` warm-starting each segment's
+                solve (:func:`solve_stretched`).
+            t0: ``time.perf_counter()`` when planning began (the plan's wall time counts
+                from it); default now.
+
+        Returns:
+            The verified plan; on a segment failure the chain stops there and
+            ``plan.failure`` names the segment, its worst constraint group and the violation.
+
+        Raises:
+            FlipkitError: The first segment to solve cannot be built (e.g. its initial
+                guess), with nothing solved before it. AtlasError: ``guess`` refuses (a
+                stale atlas).
+        """
+        t0 = time.perf_counter() if t0 is None else t0
+        behavior = library.behavior(behavior) if isinstance(behavior, str) else behavior
+        segments, failure = list(done), None
+        for spec in behavior.steps[len(segments):]:
+            try:
+                nlp, result = self._solve(spec, task, q, qd, behavior.stretch, guess)
+            except AtlasError:
                 raise
-            failure = f"{name}: cannot build the initial guess ({exc})"
-            break
-        seg = Segment.from_solution(nlp, result)
-        if decorate is not None:
-            decorate(name, seg)
-        segments.append(seg)
-        if not result.success:
-            failure = solver_failure(name, nlp, result)
-            break
-        q, qd = seg.q[-1], seg.qd[-1]
-    plan = Plan.from_segments(behavior, cell, segments, location=location, cone=options.cone,
-                              status="failed")
-    return finish_plan(plan, failure, t0, cell)
+            except FlipkitError as exc:
+                if not segments:
+                    raise
+                failure = f"{spec.name}: cannot build the initial guess ({exc})"
+                break
+            seg = Segment.from_solution(nlp, result)
+            if spec.record is not None:
+                spec.record(seg, task, self.models)
+            segments.append(seg)
+            if not result.success:
+                failure = solver_failure(spec.name, nlp, result)
+                break
+            if spec.after_solve is not None:
+                task = spec.after_solve(seg, task, self.models, self.options)
+            q, qd = seg.q[-1], seg.qd[-1]
+        plan = Plan.from_segments(behavior.name, self.cell, segments, location=task.location,
+                                  cone=self.options.cone, status="failed")
+        return finish_plan(plan, failure, t0, self.cell)
+
+    def _solve(self, spec, task: Task, q, qd, stretch: bool, guess):
+        def build(options):
+            return transcribe(spec, self.models, q, qd, options=options, task=task)
+
+        if not stretch:
+            nlp = build(self.options)
+            return nlp, solve_segment(nlp, self.solver)
+        seed = None if guess is None else (lambda nlp: guess(spec.name, nlp, q, qd))
+        return solve_stretched(build, self.options, self.solver, seed)
 
 
-__all__ = ["SOLVERS", "chain_segments", "finish_plan", "solve_segment", "solve_stretched",
+__all__ = ["SOLVERS", "Planner", "finish_plan", "solve_segment", "solve_stretched",
            "solver_failure"]

@@ -1,5 +1,6 @@
-"""Checks of the planner's inputs: positions in the task area and joint vectors in their
-limits, each a one-line error naming what is wrong."""
+"""Checks of the planner's inputs: positions in the task area, joint vectors in their
+limits, start states, the burger's place on the blade; each a one-line error naming what is
+wrong."""
 
 from __future__ import annotations
 
@@ -59,3 +60,23 @@ def check_spacing(locations, diameter: float, where: str) -> None:
                 raise ConfigError(f"{where}: burgers {i + 1} and {j + 1} are {gap * 1e3:.0f} mm "
                                   f"apart on the grill; they need one burger diameter "
                                   f"({diameter * 1e3:.0f} mm)")
+
+
+def check_start(robot, q_start=None, qd_start=None) -> tuple[np.ndarray, np.ndarray]:
+    """The start state (q, q̇) (rad, rad/s) within the joint limits; defaults q_home at rest."""
+    q = robot.q_home.copy() if q_start is None else check_joint_vector(
+        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
+    qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
+        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    return q, qd
+
+
+def check_on_blade(on_blade, cell: CellConfig) -> np.ndarray:
+    """(x, y) (m) of the burger's centre in the blade frame, on the blade, or ConfigError."""
+    xy = np.asarray(on_blade, dtype=float).ravel()
+    sp = cell.spatula
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or abs(xy[0]) > sp.length / 2 or abs(
+            xy[1]) > sp.width / 2:
+        raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
+                          f", ±{sp.width / 2} m, got {on_blade!r}")
+    return xy

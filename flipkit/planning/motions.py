@@ -3,10 +3,9 @@
 The scheduler (:mod:`flipkit.planning.schedule`) does not call a planner directly: it is
 given a mapping from motion kind (``"flip"``, ``"serve"``) to a :class:`MotionPlanner`, a
 function ``(job, q_start) -> PlannedMotion``. :func:`default_planners` wires in the real
-ones: :func:`~flipkit.planning.planner.plan_flip` for ``"flip"``, and
-``flipkit.planning.planner.plan_serve`` for ``"serve"`` when that function exists — when
-it does not, asking for serves raises :class:`MissingPlannerError`; no serve motion is
-ever made up. Tests inject planners with fixed durations.
+ones: :func:`~flipkit.planning.planner.plan_flip` for ``"flip"`` and
+:func:`~flipkit.planning.serve.plan_serve` for ``"serve"``. Tests inject planners with fixed
+durations.
 """
 
 from __future__ import annotations
@@ -18,15 +17,15 @@ from typing import Callable, Mapping, Protocol
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.errors import FlipkitError
+from flipkit.errors import FlipkitError, InvalidChoiceError
+from flipkit.planning.planner import plan_flip
+from flipkit.planning.serve import plan_serve
 
 KINDS = ("flip", "serve")
-REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
-SERVE_PLANNER = "flipkit.planning.planner.plan_serve"
 
 
 class MissingPlannerError(FlipkitError):
-    """A motion kind the schedule needs has no planner (e.g. ``plan_serve`` not built)."""
+    """A motion kind the schedule needs has no planner in the mapping it was given."""
 
 
 @dataclass(frozen=True)
@@ -121,8 +120,6 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
                  ) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planner.plan_flip` from ``q_start``, landing
     where the burger was picked up (its default), warm-started from ``atlas`` if given."""
-    from flipkit.planning.planner import plan_flip
-
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         p = plan_flip(job.location, q_start, cell=cell, solver=solver, atlas=atlas)
@@ -133,47 +130,16 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
 
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                   ) -> MotionPlanner:
-    """The real serve: ``flipkit.planning.planner.plan_serve(burger, table_spot,
-    q_start=..., cell=..., solver=...)`` (``cell`` and ``solver`` passed where its signature
-    takes them).
-
-    ``atlas`` (a pickup-and-flip atlas) warm-starts the serve's go to burger, scoop and
-    pickup, where ``plan_serve`` takes it.
-
-    Raises:
-        MissingPlannerError: ``plan_serve`` does not exist in :mod:`flipkit.planning.planner`.
-    """
-    from flipkit.planning import planner
-
-    plan_serve = getattr(planner, "plan_serve", None)
-    if plan_serve is None:
-        raise MissingPlannerError(f"serving needs {SERVE_PLANNER}, which this flipkit does "
-                                  "not have yet (issue 13, item 1); --flip-only plans the "
-                                  "flips alone")
-
-    import inspect
-
-    params = inspect.signature(plan_serve).parameters
-    takes_all = any(p.kind is p.VAR_KEYWORD for p in params.values())
-    extra = {k: v for k, v in (("cell", cell), ("solver", solver), ("atlas", atlas))
-             if (takes_all or k in params) and (k != "atlas" or v is not None)}
-    if cell is not None and cell != CellConfig() and "cell" not in extra:
-        raise MissingPlannerError(f"{SERVE_PLANNER} takes no cell; it cannot plan in a "
-                                  "non-default cell")
-
+    """The real serve: :func:`~flipkit.planning.serve.plan_serve` from ``q_start`` to the
+    job's table spot; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to burger, scoop
+    and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_serve(job.location, job.table_spot, q_start=q_start, **extra)
+        p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell, solver=solver,
+                       atlas=atlas)
         return from_plan(p, "serve", time.perf_counter() - t0)
 
     return plan
-
-
-def available_kinds() -> tuple[str, ...]:
-    """The motion kinds whose real planner exists in this flipkit."""
-    from flipkit.planning import planner
-
-    return KINDS if hasattr(planner, "plan_serve") else ("flip",)
 
 
 def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = "auto",
@@ -181,11 +147,8 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
     """The real planners of ``kinds`` (flips warm-started from ``atlas`` if given).
 
     Raises:
-        MissingPlannerError: A kind without a planner (``serve`` before ``plan_serve``).
         InvalidChoiceError: An unknown kind.
     """
-    from flipkit.errors import InvalidChoiceError
-
     makers: dict[str, Callable[..., MotionPlanner]] = {"flip": flip_planner,
                                                        "serve": serve_planner}
     out = {}
@@ -196,6 +159,5 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
     return out
 
 
-__all__ = ["KINDS", "REST_TOL", "SERVE_PLANNER", "MissingPlannerError", "MotionJob", "MotionPlanner",
-           "PlannedMotion", "available_kinds", "default_planners", "flip_planner",
-           "from_plan", "serve_planner"]
+__all__ = ["KINDS", "MissingPlannerError", "MotionJob", "MotionPlanner", "PlannedMotion",
+           "default_planners", "flip_planner", "from_plan", "serve_planner"]

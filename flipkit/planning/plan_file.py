@@ -1,5 +1,5 @@
 """The plan file ``flipkit-plan/2`` (JSON): a planned trajectory with everything needed to
-check or execute it without the objects that made it (DESIGN.md, "Plan file").
+check or execute it without the objects that made it (``docs/plan-format.md``).
 
 :class:`Plan` and :class:`Segment` mirror the file key for key. Constructors validate their
 arguments and raise :class:`~flipkit.errors.ConfigError` naming the field;
@@ -8,8 +8,8 @@ wrong shape, non-finite number, unknown name) into a one-line
 :class:`~flipkit.errors.PlanFileError` naming the file and the key path, e.g.
 ``plan.json: segments[2].q: expected shape (21, 6), got (20, 6)``.
 
-The format is documented in ``docs/plan-format.md`` (JSON Schema beside it). Beyond
-DESIGN.md's seed: ``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a
+The format is documented in ``docs/plan-format.md`` (JSON Schema beside it). Among its
+fields: ``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a
 ``translate`` segment (optional) — and, on a flip segment, ``release`` (node, time) and the
 predicted ``landing`` (target, r_land, point, offset, tilt_deg, time_of_flight), checked by
 :mod:`flipkit.planning.verify`.
@@ -25,14 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
+from flipkit.behaviors.library import BEHAVIORS, SUBBEHAVIORS
 from flipkit import __version__
-from flipkit.behaviors.segments import CARRIES_BURGER
 from flipkit.config import BurgerConfig, CellConfig, GrillConfig, RobotConfig, SpatulaConfig
 from flipkit.model.contact import CONE_FORMS
 from flipkit.errors import ConfigError, PlanFileError
 from flipkit.fileio import OutputPathError, write_text
-from flipkit.behaviors.serve import SERVE_SUBBEHAVIORS
-from flipkit.behaviors.targets import SUBBEHAVIORS
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text, dumps)
 from flipkit.planning.segment import SEGMENT_KEYS, Segment, default_payload
@@ -41,7 +39,7 @@ from flipkit.provenance import git_commit
 from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, urdf_sha256
 
 from flipkit.planning.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
-PLAN_BEHAVIORS = ("translate", "flip", "serve")
+PLAN_BEHAVIORS = tuple(BEHAVIORS)  # translate, flip, serve
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
 
@@ -82,7 +80,7 @@ _BURGER_KEYS = ("location", "diameter", "thickness", "mass", "mu")
 
 @dataclass
 class Plan:
-    """A plan file in memory; attribute names and nesting are the file's (DESIGN.md).
+    """A plan file in memory; attribute names and nesting are the file's (``docs/plan-format.md``).
 
     Attributes:
         behavior: ``translate``, ``flip`` or ``serve``. status: ``solved`` or ``failed``.
@@ -188,8 +186,7 @@ class Plan:
                 raise ConfigError(f"segments[{k}].q: {seg.q.shape[1]} joints, "
                                   f"robot.q_home has {nq}")
             names.append(seg.name)
-        allowed = {"translate": ("translate",), "flip": SUBBEHAVIORS,
-                   "serve": SERVE_SUBBEHAVIORS}[self.behavior]
+        allowed = BEHAVIORS[self.behavior].names
         order = [allowed.index(n) if n in allowed else -1 for n in names]
         if -1 in order or (self.behavior != "translate" and order != sorted(set(order))):
             raise ConfigError(f"segments: names {names} do not fit behavior {self.behavior!r} "
@@ -277,7 +274,7 @@ class Plan:
 
         if isinstance(segment, str):
             seg = next((s for s in self.segments if s.name == segment), None)
-            if seg is None and segment not in CARRIES_BURGER:
+            if seg is None and segment not in SUBBEHAVIORS:
                 raise PlanFileError(f"segments: no segment {segment!r} in this plan "
                                     f"({', '.join(s.name for s in self.segments)})")
             payload = seg.payload if seg is not None else default_payload(segment)
@@ -348,7 +345,7 @@ class Plan:
         """Read and validate a plan file: key by key, then against the documented JSON Schema
         (``flipkit/data/plan-format.schema.json``, :func:`check_schema`). A
         ``flipkit-plan/1`` file (before per-segment payloads and portable URDF names) is read
-        too: each segment then carries the bodies its behaviour carries (CARRIES_BURGER).
+        too: each segment then carries the bodies its behaviour carries (the spec's ``carries_burger``).
 
         Raises:
             PlanFileError: Missing or unreadable file, not JSON, or not ``flipkit-plan/1``

@@ -1,8 +1,9 @@
 """Planning front end: translate, pickup-and-flip and batches of burgers, checked plans.
 
-Each entry point builds the segment NLPs (:mod:`flipkit.behaviors.segments`), solves them with the
-SQP or IPOPT (:func:`solve_segment`), wraps them in a :class:`~flipkit.planning.plan_file.Plan` and runs
-the independent check :func:`~flipkit.planning.verify.verify_plan`. A plan's ``status`` is
+Each entry point chains a behaviour's segments with a :class:`~flipkit.planning.chain.Planner`
+(specs of :mod:`flipkit.behaviors.library`, solved with the SQP or IPOPT), wraps them in a
+:class:`~flipkit.planning.plan_file.Plan` and runs the independent check
+:func:`~flipkit.planning.verify.verify_plan`. A plan's ``status`` is
 ``"solved"`` only if every segment's solver converged *and* the check passes; otherwise it
 is ``"failed"`` and the attribute ``plan.failure`` (not written to the file) holds a one-line
 reason, e.g. ``"pickup: cone violated by 3.2e-04 (sqp: stalled)"``. Every plan returned also
@@ -21,35 +22,22 @@ from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import Delaunay, QhullError
+from tqdm import tqdm
 
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import Models, SegmentOptions, build_segment, flat_pose
-from flipkit.config import CellConfig, ScoopUncertainty
-from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoiceError,
-                            UnreachableError)
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.spec import Task
+from flipkit.behaviors.transcribe import flat_pose
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
-from flipkit.model.scoop import ScoopPath
-from flipkit.planning.inputs import check_joint_vector, check_position
+from flipkit.planning.atlas import check_atlas, seeding
+from flipkit.planning.chain import Planner
+from flipkit.planning.inputs import check_joint_vector, check_on_blade, check_position, check_start
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.segment import Segment
-from flipkit.planning import chain
-from flipkit.planning.atlas import SEEDED, options_hash
-from flipkit.planning.chain import (SOLVERS, chain_segments, finish_plan, solve_segment,  # noqa: F401
-                                    solver_failure)
 
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
-_MODELS: dict = {}
-
-
-def models_for(cell: CellConfig) -> Models:
-    """The :class:`~flipkit.behaviors.segments.Models` of ``cell``, built once per cell and cached."""
-    try:
-        models = _MODELS.get(cell)
-    except TypeError:  # unhashable (lists inside the config): build without caching
-        return Models(cell)
-    if models is None:
-        models = _MODELS[cell] = Models(cell)
-    return models
+REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
 
 
 def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "auto",
@@ -75,11 +63,9 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
         ConfigError: Malformed input. UnreachableError: A position outside the task area or
             out of reach. InvalidChoiceError: Unknown solver.
     """
-    t0, cell = time.perf_counter(), cell or CellConfig()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
-    models = models_for(cell)
-    robot = models.for_segment("translate")
+    t0 = time.perf_counter()
+    planner = Planner(cell, solver=solver, options=options)
+    cell, robot = planner.cell, planner.models.loaded
     p_goal = check_position("translate goal", goal, cell)
     if not np.isfinite(yaw):
         raise ConfigError(f"yaw must be finite (rad), got {yaw!r}")
@@ -100,22 +86,17 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
                                   "the start position; give one of them")
     try:
         solve_pose(robot, p_goal, (0.0, 0.0, yaw), q0)  # reachability, clear message
-        nlp = build_segment("translate", models, q0, location=None,
-                            goal=flat_pose(p_goal, yaw), options=options)
+        return planner.chain("translate", Task(goal=flat_pose(p_goal, yaw)), q0,
+                             np.zeros(robot.nq), t0=t0)
     except UnreachableError as exc:
         raise UnreachableError(f"translate goal: {exc}") from None
-    result = chain.solve_segment(nlp, solver)  # through the module: one place to stub it
-    plan = Plan.from_segments("translate", cell, [Segment.from_solution(nlp, result)],
-                              cone=options.cone, status="failed")
-    return finish_plan(plan, None if result.success else solver_failure("translate", nlp, result), t0,
-                   cell)
 
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
               solver: str = "auto", land=None, on_blade=None,
               options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
-    :data:`~flipkit.behaviors.targets.SUBBEHAVIORS` chained by (29) — each segment starts at the
+    :data:`~flipkit.behaviors.library.FLIP_NAMES` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
 
     Args:
@@ -126,7 +107,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
             The flipped burger's centre must land within ``options.r_land`` of it.
         on_blade: Where the burger's centre will sit on the blade (x, y) (blade frame, m)
             when it is released; default ``None``: where the scoop model
-            (:func:`scoop_scenarios`) says the planned scoop leaves it, and with
+            (:func:`~flipkit.behaviors.pick.scoop_scenarios`) says the planned scoop leaves it, and with
             ``options.robust`` every scenario of its spread lands too.
         cell, solver, options: As :func:`plan_translate`.
         atlas: A warm-start :class:`~flipkit.planning.atlas.Atlas` built for ``cell`` and
@@ -143,91 +124,16 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
         AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
-    t0, cell = time.perf_counter(), cell or CellConfig()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
+    t0 = time.perf_counter()
+    planner = Planner(cell, solver=solver, options=options)
+    cell = planner.cell
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
-    on_blade = None if on_blade is None else _on_blade(on_blade, cell)
-    models = models_for(cell)
-    robot = models.bare
-    q = robot.q_home.copy() if q_start is None else check_joint_vector(
-        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
-    qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
-        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
-    guess = None if atlas is None else (
-        lambda name, nlp, q, qd: atlas.guess(name, pb, nlp, (q, qd)) if name in SEEDED
-        else None)
-    return _chain(pb, q, qd, [], models, cell, solver, spot, on_blade, options, t0, guess)
-
-
-def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
-    """Raise :class:`~flipkit.errors.AtlasError` if ``atlas`` (or ``None``) was built for
-    other planning options or another cell."""
-    if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
-        raise AtlasError("stale atlas: built for other planning options or another cell; "
-                         "rebuild it with `flipkit atlas build`")
-
-
-def _on_blade(on_blade, cell: CellConfig) -> np.ndarray:
-    """(x, y) (m) of the burger's centre on the blade, on the blade, or ConfigError."""
-    xy = np.asarray(on_blade, dtype=float).ravel()
-    sp = cell.spatula
-    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or abs(xy[0]) > sp.length / 2 or abs(
-            xy[1]) > sp.width / 2:
-        raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
-                          f", ±{sp.width / 2} m, got {on_blade!r}")
-    return xy
-
-
-def scoop_scenarios(segment: Segment, location, cell: CellConfig,
-                    uncertainty: ScoopUncertainty = ScoopUncertainty()) -> tuple:
-    """Where the solved ``segment`` (a scoop) leaves the burger on the blade, and the spread.
-
-    The friction model of :mod:`flipkit.model.scoop` with the cell's nominal patty and grill
-    gives the predicted place (x, y) (m, blade frame). The scenarios bound its spread over what
-    the cell does not know (:class:`~flipkit.config.ScoopUncertainty`): the burger-blade
-    friction at both ends of its range combined with the burger put ± k σ along the scoop
-    (the extremes of x), and ± k σ sideways (y, which the scoop does not change).
-
-    Returns:
-        ``(predicted, scenarios)``: (2,) and a list of four (x, y), clipped to the blade.
-    """
-    robot = models_for(cell).bare
-    path = ScoopPath(robot, segment.t, segment.q, segment.qd, location,
-                     grill_height=cell.grill.height)
-    kw = {"diameter": cell.burger.diameter, "mu_grill": cell.physics.mu_grill,
-          "rim": cell.physics.burger_edge_radius}
-    mu, d = cell.burger.mu, uncertainty.placement
-    nominal = path.outcome(mu_blade=mu, **kw)
-    xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), **kw)[0]
-          for f in uncertainty.mu_scale for s in (-d, d)]
-    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
-    scenarios = [(min(xs), nominal[1]), (max(xs), nominal[1]),
-                 (nominal[0], nominal[1] - d), (nominal[0], nominal[1] + d)]
-    return np.clip(nominal, -half, half), [np.clip(v, -half, half) for v in scenarios]
-
-
-def _chain(pb, q, qd, done: list, models, cell, solver, spot, on_blade, options, t0,
-           guess=None) -> Plan:
-    """The flip's subbehaviours after the segments ``done`` from (q, q̇); ``on_blade`` None:
-    the flip is planned for where the scoop model puts the burger after the solved scoop,
-    and with ``options.robust`` for the scenarios of its spread too."""
-    where = {"on_blade": on_blade, "scenarios": ()}
-
-    def build(name, q, qd, o):
-        return build_segment(name, models, q, qd, location=pb, land=spot,
-                             on_blade=(0.0, 0.0) if where["on_blade"] is None
-                             else where["on_blade"], scenarios=where["scenarios"], options=o)
-
-    def decorate(name, seg):
-        if name == "scoop" and on_blade is None:
-            where["on_blade"], scenarios = scoop_scenarios(seg, pb, cell)
-            where["scenarios"] = scenarios if options.robust else ()
-
-    return chain_segments("flip", tg.SUBBEHAVIORS, build, q, qd, done, cell, solver, options,
-                          t0, pb, decorate=decorate, guess=guess)
+    on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
+    q, qd = check_start(planner.models.bare, q_start, qd_start)
+    return planner.chain("flip", Task(location=pb, land=spot, on_blade=on_blade), q, qd,
+                         guess=seeding(atlas, pb), t0=t0)
 
 
 def covers(landing: dict, on_blade) -> bool:
@@ -271,16 +177,15 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
     """
     t0 = time.perf_counter()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
     if plan.behavior != "flip" or plan.status != "solved":
         raise ConfigError("replan_flip needs a solved flip plan")
     cell = plan.cell()
     flip = next(s for s in plan.segments if s.name == "flip")
-    on_blade = _on_blade(on_blade, cell)
+    on_blade = check_on_blade(on_blade, cell)
+    planner = Planner(cell, solver=solver,
+                      options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
     if covers(flip.landing, on_blade):
         return plan
-    options = replace(options, r_land=flip.landing["r_land"], cone=plan.cone)
     done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
     before = {s.name: s for s in plan.segments}
 
@@ -288,9 +193,10 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         s = before[name]
         return nlp.layout.pack(s.q, s.qd, s.qdd, s.u, s.alpha, s.T)
 
-    return _chain(np.asarray(plan.burger["location"], float), done[-1].q[-1], done[-1].qd[-1],
-                  done, models_for(cell), cell, solver, np.asarray(flip.landing["target"]),
-                  on_blade, options, t0, own)
+    task = Task(location=np.asarray(plan.burger["location"], float),
+                land=np.asarray(flip.landing["target"]), on_blade=on_blade)
+    return planner.chain("flip", task, done[-1].q[-1], done[-1].qd[-1], done=done, guess=own,
+                         t0=t0)
 
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
@@ -318,13 +224,8 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
         ConfigError: No location, more than :data:`MAX_BATCH`, or a malformed start.
         UnreachableError: A location off the grill (named by its index, from 1).
     """
-    from tqdm import tqdm
-
-    from flipkit.planning.motions import REST_TOL
-
-    cell = cell or CellConfig()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
+    planner = Planner(cell, solver=solver, options=options)  # checks the solver
+    cell, home = planner.cell, planner.models.bare.q_home
     locs = list(locations)
     if not 1 <= len(locs) <= MAX_BATCH:
         raise ConfigError(f"a batch takes 1 to {MAX_BATCH} burger locations, got {len(locs)}")
@@ -334,7 +235,6 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
             checked.append(tg.check_location(cell, loc))
         except UnreachableError as exc:
             raise UnreachableError(f"burger {k}: {exc}") from None
-    home = models_for(cell).bare.q_home
     check_atlas(atlas, cell, options)
     kw = {"cell": cell, "solver": solver, "options": options, "atlas": atlas}
     ahead = None if executor is None else [
@@ -356,14 +256,6 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
             if max(np.abs(q - home).max(), np.abs(qd).max()) <= REST_TOL:
                 q, qd = home, None  # at rest at q_home, to the solver's tolerance
     return plans
-
-
-def plan_serve(burger, table_spot, q_start=None, qd_start=None, **kwargs) -> Plan:
-    """Serve the burger at ``burger`` to ``table_spot`` (x, y) on the side table, from
-    ``q_start`` (default q_home): :func:`flipkit.planning.serve.plan_serve`, same arguments."""
-    from flipkit.planning.serve import plan_serve as _plan_serve
-
-    return _plan_serve(burger, table_spot, q_start, qd_start, **kwargs)
 
 
 SUMMARY_HEADER = ("burger", "location_m", "status", "solve_time_s", "iterations",
@@ -394,6 +286,5 @@ def format_summary(rows) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["SOLVERS", "MAX_BATCH", "SUMMARY_HEADER", "covers", "models_for", "scoop_scenarios",
-           "solve_segment",
-           "plan_translate", "plan_flip", "plan_serve", "plan_batch", "summary_table", "format_summary"]
+__all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "plan_batch",
+           "plan_flip", "plan_translate", "replan_flip", "summary_table"]

@@ -25,7 +25,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.planning.motions import REST_TOL, MotionJob, PlannedMotion, default_planners
+from flipkit.planning.motions import MotionJob, PlannedMotion, default_planners
+from flipkit.planning.planner import REST_TOL
 
 
 def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str,

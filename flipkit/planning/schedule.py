@@ -51,7 +51,8 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.cook import SECOND_SIDE_S, CookBurger, check_cook, table_spots
-from flipkit.planning.motions import (KINDS, REST_TOL, MissingPlannerError, MotionJob,
+from flipkit.planning.planner import REST_TOL
+from flipkit.planning.motions import (KINDS, MissingPlannerError, MotionJob,
                                      MotionPlanner)
 
 FORMAT = "flipkit-timeline/1"

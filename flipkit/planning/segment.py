@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flipkit.behaviors.segments import BEHAVIORS, CARRIES_BURGER
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.behaviors.targets import Pose
 from flipkit.errors import ConfigError
 from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
@@ -14,9 +14,9 @@ from flipkit.planning.json_fields import (check_array, check_choice, check_keys,
 
 def default_payload(name: str) -> list[str]:
     """The bodies a segment of behaviour ``name`` carries when nothing says otherwise: the
-    spatula, and the burger where the behaviour carries it (CARRIES_BURGER). Used for
+    spatula, and the burger where the subbehaviour carries it (``carries_burger``). Used for
     segments built in memory and for ``flipkit-plan/1`` files, which did not list them."""
-    return ["spatula", "burger"] if CARRIES_BURGER[name] else ["spatula"]
+    return ["spatula", "burger"] if SUBBEHAVIORS[name].carries_burger else ["spatula"]
 
 
 SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
@@ -108,7 +108,7 @@ class Segment:
     placing: dict | None = None
 
     def __post_init__(self):
-        check_choice("name", self.name, BEHAVIORS)
+        check_choice("name", self.name, tuple(SUBBEHAVIORS))
         self.T = check_number("T", self.T, positive=True)
         self.t = check_array("t", self.t, (None,))
         n = self.t.size

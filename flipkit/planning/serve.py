@@ -5,7 +5,7 @@ table (:mod:`flipkit.behaviors.serve`), then return home.
 each segment starts at the previous one's final (q, q̇) — and checks the plan independently
 (:func:`~flipkit.planning.verify.verify_plan`) like every planner entry point
 (:mod:`flipkit.planning.planner`): status ``solved`` only if every segment converged and the
-check passes. It is re-exported as :func:`flipkit.planning.planner.plan_serve`.
+check passes.
 """
 
 from __future__ import annotations
@@ -17,23 +17,16 @@ import numpy as np
 
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import SegmentOptions, build_segment
+from flipkit.behaviors.library import SERVE_NAMES
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.spec import Task
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
+from flipkit.planning.atlas import check_atlas, seeding
+from flipkit.planning.chain import Planner
+from flipkit.planning.inputs import check_on_blade, check_start
 from flipkit.planning.plan_file import Plan
-from flipkit.planning.inputs import check_joint_vector
-from flipkit.planning.atlas import SEEDED
-from flipkit.planning.planner import SOLVERS, _on_blade, chain_segments, check_atlas, models_for
-
-
-def placing_record(cell: CellConfig, spot, on_blade=(0.0, 0.0)) -> dict:
-    """The ``placing`` record of the carry and place segments: the table ``spot`` (x, y) (m),
-    ``on_blade`` (x, y) (m, blade frame) where the burger was planned to sit, the blade's
-    ``heading`` and ``pitch`` at the place's end (rad) (:func:`flipkit.behaviors.serve.place_end`)."""
-    end = sv.place_end(cell, spot, on_blade)
-    return {"spot": [float(v) for v in spot], "on_blade": [float(v) for v in on_blade],
-            "heading": float(end.o[2]), "pitch": float(end.o[1])}
 
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
@@ -71,46 +64,23 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             reach. ConfigError: Malformed start state. InvalidChoiceError: Unknown solver.
         AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
-    t0, cell = time.perf_counter(), cell or CellConfig()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
+    t0 = time.perf_counter()
+    planner = Planner(cell, solver=solver, options=options)
+    cell, models = planner.cell, planner.models
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, burger)
     spot = sv.check_table_spot(cell, table_spot)
-    on_blade = _on_blade(on_blade, cell)
-    models = models_for(cell)
-    robot = models.bare
-    q = robot.q_home.copy() if q_start is None else check_joint_vector(
-        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
-    qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
-        "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    on_blade = check_on_blade(on_blade, cell)
+    q, qd = check_start(models.bare, q_start, qd_start)
     for what, pose in (("carry end", sv.carry_end(cell, spot, on_blade)),
                        ("place", sv.place_end(cell, spot, on_blade))):
         try:  # reachability first, one clear line
-            solve_pose(models.loaded, pose.p, pose.o, robot.q_home)
+            solve_pose(models.loaded, pose.p, pose.o, models.bare.q_home)
         except UnreachableError as exc:
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
-    guess = None if atlas is None else (
-        lambda name, nlp, q, qd: atlas.guess(name, pb, nlp, (q, qd)) if name in SEEDED
-        else None)
-    return _chain(pb, spot, on_blade, q, qd, [], models, cell, solver, options, t0, guess)
-
-
-def _chain(pb, spot, on_blade, q, qd, done, models, cell, solver, options, t0,
-           guess=None) -> Plan:
-    """The serve's subbehaviours after the segments ``done`` from (q, q̇); the carry and
-    place segments record the ``placing``."""
-    def build(name, q, qd, o):
-        return build_segment(name, models, q, qd, location=pb, spot=spot, on_blade=on_blade,
-                             options=o)
-
-    def decorate(name, seg):
-        if name in ("carry", "place"):
-            seg.placing = placing_record(cell, spot, on_blade)
-
-    return chain_segments("serve", sv.SERVE_SUBBEHAVIORS, build, q, qd, done, cell, solver,
-                          options, t0, pb, decorate, guess)
+    return planner.chain("serve", Task(location=pb, spot=spot, on_blade=on_blade), q, qd,
+                         guess=seeding(atlas, pb), t0=t0)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
@@ -132,17 +102,15 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
         ConfigError: ``plan`` is not a solved serve plan, or ``on_blade`` is off the blade.
     """
     t0 = time.perf_counter()
-    if solver not in SOLVERS:
-        raise InvalidChoiceError("solver", solver, SOLVERS)
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError("replan_serve needs a solved serve plan")
     cell = plan.cell()
-    on_blade = _on_blade(on_blade, cell)
-    options = replace(options, cone=plan.cone)
-    done = [s for s in plan.segments if s.name in sv.SERVE_SUBBEHAVIORS[:4]]
-    return _chain(np.asarray(plan.burger["location"], float), table_spot(plan), on_blade,
-                  done[-1].q[-1], done[-1].qd[-1], done, models_for(cell), cell, solver,
-                  options, t0)
+    on_blade = check_on_blade(on_blade, cell)
+    planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone))
+    done = [s for s in plan.segments if s.name in SERVE_NAMES[:4]]
+    task = Task(location=np.asarray(plan.burger["location"], float), spot=table_spot(plan),
+                on_blade=on_blade)
+    return planner.chain("serve", task, done[-1].q[-1], done[-1].qd[-1], done=done, t0=t0)
 
 
 def table_spot(plan: Plan) -> np.ndarray:
@@ -157,4 +125,4 @@ def table_spot(plan: Plan) -> np.ndarray:
     return np.asarray(rec["spot"], float)
 
 
-__all__ = ["plan_serve", "replan_serve", "placing_record", "table_spot"]
+__all__ = ["plan_serve", "replan_serve", "table_spot"]

@@ -4,14 +4,14 @@ Nothing here uses :mod:`flipkit.transcription.nlp` or
 :mod:`flipkit.transcription.constraints`; kinematics and dynamics come from pinocchio through
 :class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
 bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
-:mod:`flipkit.behaviors.segments` only the tables T_BOUNDS, SCOOP_PRESS, SCOOP_TIP_BAND and
+:mod:`flipkit.behaviors` only the duration bounds of the specs, SCOOP_PRESS, SCOOP_TIP_BAND and
 grill_floor, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
 poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
 =================  ==========================================================  ==============
-time_grid          t_i = iT/N; T within T_BOUNDS (upper × T_STRETCH) (s)       1e-9 s; tol
+time_grid          t_i = iT/N; T within the spec's bounds (upper × T_STRETCH) (s)       1e-9 s; tol
 dynamics           RNEA(q_i, q̇_i, q̈_i) − u_i, payload per segment (N·m)        tol·u_max/10
 defects            Hermite–Simpson interpolation and Simpson defects (rad,     tol
                    rad/s) at the odd nodes, x = (q, q̇), ẋ = (q̇, q̈)
@@ -55,13 +55,14 @@ singularity        q3 and q5 at every node within the band of q_home held      t
 10 × the SQP feasibility tolerance (1e-6) on the same rows: the solver divides dynamics rows
 and torques by u_max/10 and q̈ and the cone rows by 10, multiplies the interpolant's velocity
 rows by 0.01 and its acceleration rows by 0.001, and leaves everything else unscaled. The
-duration bounds are today's T_BOUNDS: a plan written under other bounds fails ``time_grid``.
+duration bounds are today's specs' (``duration``): a plan written under other bounds fails
+``time_grid``.
 Task-space position, velocity and acceleration bounds (cell.limits) are not checked. The
 pitch range, the cell's boxes and margin and the side table come from the plan's
 ``cell_geometry`` record (:mod:`flipkit.planning.cell_record`): ``arm_clearance``,
-``orientation`` and ``placing`` check against the cell the plan was made in (a file without
-the record, written before session 7, against today's defaults of
-:class:`~flipkit.config.CellConfig`, as ``time_grid`` checks against today's T_BOUNDS).
+``orientation`` and ``placing`` check against the cell the plan was made in (an older file
+without the record, against today's defaults of :class:`~flipkit.config.CellConfig`, as
+``time_grid`` checks against today's duration bounds).
 """
 
 from __future__ import annotations
@@ -71,12 +72,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from flipkit.behaviors.targets import SUBBEHAVIORS
 
+from flipkit.behaviors.library import FLIP_NAMES, SERVE_NAMES, SUBBEHAVIORS
+from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH
+from flipkit.behaviors.transcribe import blade_floor
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.segments import (SCOOP_PRESS, SCOOP_TIP_BAND, T_BOUNDS, T_STRETCH,
-                                       grill_floor)
 from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
@@ -130,7 +131,7 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
     # A flip plan is the five subbehaviours in order (a plan cut short by a failed segment
     # must not pass); a translate plan has at least one segment.
     names = [s.name for s in plan.segments]
-    expected = {"flip": list(SUBBEHAVIORS), "serve": list(sv.SERVE_SUBBEHAVIORS)}.get(
+    expected = {"flip": list(FLIP_NAMES), "serve": list(SERVE_NAMES)}.get(
         plan.behavior)
     missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
                if expected is not None else int(not names))
@@ -155,7 +156,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     """Time grid, dynamics, limits, defects, clearance, cone and behaviour of segment k."""
     N, T, add = seg.N, seg.T, report.add
     add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
-    T_lo, T_hi = T_BOUNDS[seg.name]
+    T_lo, T_hi = SUBBEHAVIORS[seg.name].duration
     add("time_grid", k, _outside(T, T_lo, T_STRETCH * T_hi), tol)
     dyn_tol = tol * robot.u_max / 10
     tau = np.array([robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
@@ -180,7 +181,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
 
     states = [robot.state(seg.q[i], seg.qd[i], seg.qdd[i]) for i in range(N + 1)]
     l, w = cell.spatula.length / 2, cell.spatula.width / 2
-    floor = grill_floor(seg.name, cell, N)
+    floor = blade_floor(seg.name, cell, N)
     for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
         heights = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
         add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
@@ -189,7 +190,8 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     required = {"translate": range(N + 1), "pickup": range(N + 1),
                 "scoop": tg.scoop_cone_nodes(cell, N),
                 "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)],
-                "carry": sv.cone_nodes("carry", N), "place": sv.cone_nodes("place", N)}
+                "carry": range(N + 1),
+                "place": [i for i in range(N + 1) if i <= sv.PLACE_CONE_FRACTION * N + 1e-9]}
     on_blade = (seg.landing or seg.placing or {}).get(
         "burger_on_blade" if seg.landing else "on_blade", (0.0, 0.0))
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
@@ -255,7 +257,7 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         check_flight(report, k, seg, robot, cell, states)
     elif seg.name in ("turn_back", "return_home"):
         add("endpoints", k, np.abs(seg.q[-1] - robot.q_home), tol, N)
-    if seg.name in sv.SERVE_ONLY:
+    if seg.name in SERVE_NAMES[3:]:
         _check_serve(report, k, seg, cell, states, tol, pose)
 
 

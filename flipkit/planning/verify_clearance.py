@@ -6,7 +6,7 @@ the cell's boxes go into a pinocchio ``GeometryModel``; pinocchio places them at
 (``updateGeometryPlacements``) and coal measures each (shape, box) pair's distance. Nothing
 here uses the NLP's :class:`~flipkit.transcription.constraints.clearance.ArmClearance` (its
 minimum over shapes, its cap, its gradients). The pairs a segment exempts come from
-:func:`flipkit.behaviors.segments.clearance_excluded`.
+the spec's ``exempt`` (:mod:`flipkit.behaviors.clearance`).
 
 Group ``arm_clearance``: shortfall (m) of each applied pair's distance below the cell's
 margin (``cell.space.margin``) at nodes 1..N (node 0 is the previous segment's last).
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from flipkit.behaviors.segments import clearance_excluded
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.model.collision import ArmShapes, distance_request, sphere_box_bound
 from flipkit.model.orientation import rpy
 
@@ -81,7 +81,7 @@ class CellGeometry:
 
     def applied(self, name: str, node: int, N: int) -> np.ndarray:
         """Mask (n shapes, n boxes) of the pairs segment ``name`` holds to the margin at node."""
-        skip = clearance_excluded(name, node, N)
+        skip = SUBBEHAVIORS[name].exempt(node, N)
         return np.array([[(s, b) not in skip for b in self.box_names] for s in self.shape_names])
 
 

@@ -166,7 +166,7 @@ def shade_segments(ax, boundaries, names, color: str = "0.92", label_y: float = 
     Args:
         ax: A 2D matplotlib axes whose x axis is time (s).
         boundaries: Segment edges t_0 < t_1 < ... < t_K (s), K = len(names).
-        names: Segment (subbehaviour) names, e.g. ``targets.SUBBEHAVIORS``.
+        names: Segment (subbehaviour) names, e.g. ``FLIP_NAMES``.
         color: Colour of the shaded (every other) band.
         label_y: Height of the names in axes coordinates (0 bottom, 1 top).
 

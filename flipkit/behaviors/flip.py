@@ -1,0 +1,78 @@
+"""Flip (26) and turn back (27), and the pickup-and-flip behaviour.
+
+The flip keeps the burger in contact up to the release node r = ⌈release_fraction · N⌉ (the
+paper's cone on i ≤ 0.6 N, extended to r); after it the burger flies ballistically, clear of
+the blade, and lands on the spot (:mod:`flipkit.transcription.constraints.flight`), with
+every scenario of its place on the blade. It ends moving, with room to brake, and its last
+state, coasting for the turn back's first node interval, keeps the space margin too. The
+turn back returns to q_home at rest, above any flipped burger on the grill.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.clearance import FLIP_END_ALLOWANCE, tool_leaves_grill
+from flipkit.behaviors.guesses import flip_guess, turn_back_guess
+from flipkit.behaviors.options import FLIGHT_MARGIN
+from flipkit.behaviors.pick import GO_TO_BURGER, PICKUP, SCOOP
+from flipkit.behaviors.spec import Behavior, Subbehavior
+from flipkit.config import CellConfig
+from flipkit.transcription.constraints import KinematicBlock
+from flipkit.transcription.constraints.flight import FlightClearance, Landing, ScenarioLanding
+
+
+def release_node(ctx) -> int:
+    """The flip's release node r (0 for the paper's flip without a landing)."""
+    return ctx.options.release_node() if ctx.options.landing else 0
+
+
+def flip_cone(ctx) -> list[int]:
+    """Contact up to the release node (at least the paper's 0.6 N)."""
+    r = release_node(ctx)
+    return [i for i in range(ctx.layout.n_nodes) if i <= max(r, tg.FLIP_CONE_FRACTION * ctx.layout.N)]
+
+
+def flip_path(ctx) -> list:
+    """Release, flight clearance and landing (nominal and scenarios), then the end set of
+    eq. (26): the blade's normal, its x axis on every node, the height at the end."""
+    L, cell, task, o = ctx.layout, ctx.cell, ctx.task, ctx.options
+    r, hg, bg = release_node(ctx), cell.grill.height, cell.burger
+    blocks = []
+    if o.landing:
+        spot = (tg.landing_spot(cell, ctx.location) if task.land is None
+                else tg.check_spot(cell, task.land))
+        margin = np.full(L.N - r, FLIGHT_MARGIN)
+        margin[0] = 0.0  # the burger has only just left the blade at node r + 1
+        on_blade = task.blade_point()
+        blocks += [Landing(L, r, spot, o.r_land, thickness=bg.thickness, grill_height=hg,
+                           gravity=cell.gravity, on_blade=on_blade),
+                   FlightClearance(L, r, margin, thickness=bg.thickness, diameter=bg.diameter,
+                                   gravity=cell.gravity, on_blade=on_blade)]
+        if len(task.scenarios):
+            blocks.append(ScenarioLanding(L, r, spot, o.r_scenario, task.scenarios,
+                                          thickness=bg.thickness, grill_height=hg,
+                                          gravity=cell.gravity))
+    (lo_n, hi_n), (lo_x, hi_x), band = tg.FLIP_NORMAL_BOUNDS, tg.FLIP_XAXIS_BOUNDS, tg.FLIP_HEIGHT_BAND
+    return blocks + [
+        KinematicBlock("flip_normal", L, "normal", [L.N], lo_n, hi_n),
+        KinematicBlock("flip_xaxis", L, "xaxis", range(1, L.n_nodes), lo_x, hi_x),
+        KinematicBlock("flip_height", L, "height", [L.N], hg + band[0], hg + band[1]),
+    ]
+
+
+def above_burger(cell: CellConfig, N: int) -> np.ndarray:
+    """The blade's edges above a flipped burger lying anywhere on the grill (m)."""
+    return np.full(N + 1, cell.grill.height + cell.burger.thickness + FLIGHT_MARGIN)
+
+
+TURN_BACK = Subbehavior(
+    "turn_back", duration=(0.4, 1.2), carries_burger=False, end="home", floor=above_burger,
+    guess=turn_back_guess, doc="eq. (27): back to q_home at rest")
+FLIP = Subbehavior(
+    "flip", duration=(0.2, 0.6), carries_burger=True, end="moving", needs=("location",),
+    exempt=tool_leaves_grill, path=flip_path, cone=flip_cone, cone_on_blade=True,
+    guess=flip_guess, end_allowance=FLIP_END_ALLOWANCE, coast_into=TURN_BACK.name,
+    doc="eq. (26) with release, flight and landing")
+PICKUP_AND_FLIP = Behavior("flip", (GO_TO_BURGER, SCOOP, PICKUP, FLIP, TURN_BACK))

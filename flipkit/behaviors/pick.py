@@ -1,0 +1,111 @@
+"""Go to burger (22), scoop (23–24) and pickup (25): the paper's first three subbehaviours,
+shared by the flip and the serve; and where the scoop leaves the burger on the blade.
+
+The scoop slides the blade under the burger with its tip pressed SCOOP_PRESS into the grill
+(the grill's contact absorbs it) within ±SCOOP_TIP_BAND, straight (a lateral and attitude
+band: a blade that drifts sideways or yaws pushes the burger), and ends at rest with the
+blade flat: any downward or pitching velocity there would push it through the grill on
+pickup. It brakes within friction once the burger is over the blade.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from flipkit.behaviors import targets as tg
+from flipkit.behaviors.clearance import tool_at_grill
+from flipkit.behaviors.guesses import task_path_guess
+from flipkit.behaviors.options import (SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND, SCOOP_PRESS,
+                                       SCOOP_TIP_BAND)
+from flipkit.behaviors.spec import Subbehavior, Task
+from flipkit.config import CellConfig, ScoopUncertainty
+from flipkit.model.scoop import ScoopPath
+from flipkit.transcription.constraints import KinematicBlock
+
+
+def pressed_floor(cell: CellConfig, N: int) -> np.ndarray:
+    """The blade pressed SCOOP_PRESS into the grill, less the tip's band, at every node (m)."""
+    return np.full(N + 1, cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND)
+
+
+def arrival_floor(cell: CellConfig, N: int) -> np.ndarray:
+    """Above the grill, and pressed into it at the last node (the scoop's start pose) (m)."""
+    floor = np.full(N + 1, cell.grill.height)
+    floor[-1] = cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND
+    return floor
+
+
+def scoop_path(ctx) -> list:
+    """The tip on the grill (eq. 24), pressed in, within ±SCOOP_TIP_BAND, on nodes 1..N−1;
+    the blade straight under the burger (lateral and attitude bands). With q held to a
+    degree-6 polynomial by the outputs (18), tip equalities on every node plus the end pose
+    and rest would leave a square, generically infeasible system: hence the band."""
+    L, hg, pb = ctx.layout, ctx.cell.grill.height, np.asarray(ctx.location)
+    inner = range(1, L.N)
+    tip = {"length": ctx.cell.spatula.length, "width": ctx.cell.spatula.width}
+    band = np.array([np.inf, SCOOP_LATERAL_BAND, np.inf])
+    ang = np.array([SCOOP_ANGLE_BAND, np.inf, SCOOP_ANGLE_BAND])
+    return [KinematicBlock("scoop_tip", L, "tip_height", inner, hg - SCOOP_PRESS - SCOOP_TIP_BAND,
+                           hg - SCOOP_PRESS + SCOOP_TIP_BAND, ctx=tip),
+            KinematicBlock("scoop_lateral", L, "position", inner, pb - band, pb + band),
+            KinematicBlock("scoop_attitude", L, "rpy", inner, -ang, ang)]
+
+
+def scoop_scenarios(segment, location, models,
+                    uncertainty: ScoopUncertainty = ScoopUncertainty()) -> tuple:
+    """Where the solved ``segment`` (a scoop: ``t``, ``q``, ``qd``) leaves the burger on the
+    blade, and the spread; ``models``: the cell's :class:`~flipkit.behaviors.models.Models`.
+
+    The friction model of :mod:`flipkit.model.scoop` with the cell's nominal patty and grill
+    gives the predicted place (x, y) (m, blade frame). The scenarios bound its spread over what
+    the cell does not know (:class:`~flipkit.config.ScoopUncertainty`): the burger-blade
+    friction at both ends of its range combined with the burger put ± k σ along the scoop
+    (the extremes of x), and ± k σ sideways (y, which the scoop does not change).
+
+    Returns:
+        ``(predicted, scenarios)``: (2,) and a list of four (x, y), clipped to the blade.
+    """
+    cell = models.cell
+    path = ScoopPath(models.bare, segment.t, segment.q, segment.qd, location,
+                     grill_height=cell.grill.height)
+    kw = {"diameter": cell.burger.diameter, "mu_grill": cell.physics.mu_grill,
+          "rim": cell.physics.burger_edge_radius}
+    mu, d = cell.burger.mu, uncertainty.placement
+    nominal = path.outcome(mu_blade=mu, **kw)
+    xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), **kw)[0]
+          for f in uncertainty.mu_scale for s in (-d, d)]
+    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    scenarios = [(min(xs), nominal[1]), (max(xs), nominal[1]),
+                 (nominal[0], nominal[1] - d), (nominal[0], nominal[1] + d)]
+    return np.clip(nominal, -half, half), [np.clip(v, -half, half) for v in scenarios]
+
+
+def predict_on_blade(segment, task: Task, models, options) -> Task:
+    """After the scoop: a task whose burger place is not known yet gets the scoop model's
+    prediction, and with ``options.robust`` the scenarios of its spread."""
+    if task.on_blade is not None:
+        return task
+    predicted, scenarios = scoop_scenarios(segment, task.location, models)
+    return task.with_(on_blade=predicted, scenarios=tuple(scenarios) if options.robust else ())
+
+
+GO_TO_BURGER = Subbehavior(
+    "go_to_burger", duration=(0.3, 0.75), carries_burger=False, end="rest",
+    needs=("location",), floor=arrival_floor, pressed=True, exempt=tool_at_grill,
+    end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location), guess=task_path_guess,
+    doc="eq. (22): to the scoop's start, tip pressed into the grill before the burger")
+SCOOP = Subbehavior(
+    "scoop", duration=(0.2, 0.6), carries_burger=False, end="rest", needs=("location",),
+    floor=pressed_floor, pressed=True, exempt=tool_at_grill, path=scoop_path,
+    end_pose=lambda ctx: tg.scoop_end(ctx.cell, ctx.location),
+    cone=lambda ctx: tg.scoop_cone_nodes(ctx.cell, ctx.layout.N),
+    guess=partial(task_path_guess, tip_pressed=True), after_solve=predict_on_blade,
+    doc="eqs. (23–24): slide under the burger, tip on the grill")
+PICKUP = Subbehavior(
+    "pickup", duration=(0.2, 0.25), carries_burger=True, end="moving", needs=("location",),
+    floor=pressed_floor, pressed=True, exempt=tool_at_grill,
+    end_pose=lambda ctx: tg.pickup_end(ctx.cell, ctx.location),
+    cone=lambda ctx: list(range(ctx.layout.n_nodes)), guess=task_path_guess,
+    doc="eq. (25): lift the burger 5 cm, tipped back")

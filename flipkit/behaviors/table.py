@@ -1,0 +1,50 @@
+"""Carry, place and return home: the serve's subbehaviours at the side table, and the serve
+behaviour (go to burger, scoop, pickup, then these three).
+
+The geometry (where the blade ends, where the burger comes to rest, why a tilt-off) is
+:mod:`flipkit.behaviors.serve`; ``docs/adding-a-behaviour.md`` walks through these specs.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from flipkit.behaviors import serve as sv
+from flipkit.behaviors.clearance import tool_at_table, tool_leaves_grill
+from flipkit.behaviors.guesses import return_home_guess, task_path_guess
+from flipkit.behaviors.pick import GO_TO_BURGER, PICKUP, SCOOP
+from flipkit.behaviors.spec import Behavior, Subbehavior, Task
+
+
+def record_placing(segment, task: Task, models) -> None:
+    """The carry and place record where they put the burger (``segment.placing``)."""
+    segment.placing = sv.placing_record(models.cell, task.spot, task.blade_point())
+
+
+def place_cone(ctx) -> list[int]:
+    """The burger rides the descent: the cone on nodes i ≤ PLACE_CONE_FRACTION · N."""
+    return [i for i in range(ctx.layout.n_nodes)
+            if i <= sv.PLACE_CONE_FRACTION * ctx.layout.N + 1e-9]
+
+
+_to_table = partial(task_path_guess, joint_fallback=True)  # a straight carry may pass the base
+
+# The carry covers up to ~1 m under the cone (planned μ 0.4: ≤ 3.9 m/s² sideways).
+CARRY = Subbehavior(
+    "carry", duration=(0.6, 1.6), carries_burger=True, end="rest", needs=("spot",),
+    floor=sv.table_floor, exempt=tool_leaves_grill,
+    end_pose=lambda ctx: sv.carry_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
+    cone=lambda ctx: list(range(ctx.layout.n_nodes)), cone_on_blade=True, guess=_to_table,
+    record=record_placing, doc="to above the place pose, flat, cone on every node")
+PLACE = Subbehavior(
+    "place", duration=(0.3, 0.8), carries_burger=True, end="rest", needs=("spot",),
+    floor=sv.table_floor, exempt=tool_at_table, path=sv.place_pivot,
+    end_pose=lambda ctx: sv.place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
+    cone=place_cone, cone_on_blade=True, guess=_to_table, record=record_placing,
+    doc="tilt-off about the tip, just above the table")
+# The return unrolls the heading back to q_home's.
+RETURN_HOME = Subbehavior(
+    "return_home", duration=(0.5, 1.5), carries_burger=False, end="home",
+    floor=sv.withdrawn_floor, exempt=tool_at_table, path=sv.withdrawal,
+    guess=return_home_guess, doc="withdraw the blade in its plane, then home")
+SERVE = Behavior("serve", (GO_TO_BURGER, SCOOP, PICKUP, CARRY, PLACE, RETURN_HOME))

@@ -1,0 +1,69 @@
+"""The task's choices: what the subbehaviours aim at, and the margins they keep (SI units).
+
+Each constant names its source: an equation of the paper (Kolathaya et al., RA-L 2018,
+Sec. IV.C) where it gives the value, or a stated choice of flipkit's with its reason where
+the paper is silent. The behaviour layer (:mod:`flipkit.behaviors`) reads them from here.
+"""
+
+from __future__ import annotations
+
+# --- the paper's targets, eqs. (22)–(26) -----------------------------------------------------
+SCOOP_PITCH = 0.314  # rad, o_y* of the blade going to the burger, eq. (22)
+PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, the pickup's end from p^b, eq. (25)
+PICKUP_PITCH = -0.05  # rad, the pickup's end tipped back, eq. (25)
+FLIP_CONE_FRACTION = 0.6  # the flip's cone on nodes i <= 0.6 N, eq. (26)
+FLIP_NORMAL_BOUNDS = ((-0.5, -0.5, -1.0), (0.0, 0.5, -0.8))  # F_n(q_N), eq. (26)
+FLIP_XAXIS_BOUNDS = ((0.6, -1.0, -1.0), (1.0, 1.0, 1.0))  # R(q_i) x̂, eq. (26)
+FLIP_HEIGHT_BAND = (0.1, 0.4)  # m, h_g + band on p_z(q_N), eq. (26)
+
+# --- the scoop (flipkit's choices; the paper's eq. 24 keeps the tip on the grill) -------------
+# The blade's tip is pressed this far into the grill: the grill's contact absorbs it, the
+# arm's PD presses the blade onto the grill, and a grill up to this much lower than modelled
+# still meets the tip.
+SCOOP_PRESS = 0.003  # m
+SCOOP_TIP_BAND = 0.0005  # m, the tip's band about h_g − SCOOP_PRESS: never above h_g + 0.5 mm
+# The tip comes down this far before the burger's near edge (the paper: at it, eq. 23): three
+# standard deviations of the burger's placement (5 mm, the Table I trials' placement error),
+# so that the blade does not land on the burger's rim.
+SCOOP_START_MARGIN = 0.015  # m
+SCOOP_LATERAL_BAND = 0.01  # m, |p_y − p^b_y| during the scoop: slide straight under it
+SCOOP_ANGLE_BAND = 0.05  # rad, |o_x|, |o_z| during the scoop: no yaw or roll that pushes it
+
+# --- the flip's landing (flipkit's release, flight and landing) ------------------------------
+RELEASE_FRACTION = 0.7  # release node r = ceil(0.7 N): contact on 70 % of the flip
+# The nominal landing aims within R_LAND of the spot, which leaves the whole of the paper's
+# 5 cm success square for what the plan cannot know.
+R_LAND = 0.005  # m
+# Every scenario of the burger's place on the blade lands within R_SCENARIO: 1 cm inside the
+# paper's success square (5 cm in x and y), which holds the disc.
+R_SCENARIO = 0.04  # m
+FLIGHT_MARGIN = 0.002  # m, the blade plane below the flying burger from node r + 2 on
+# Friction safety factor of the planned cone: the burger–blade friction is known to ±20 %
+# (the Table I trials draw it × U(0.8, 1.2)); a cone planned at the nominal μ is active, and a
+# less sticky burger then slides.
+MU_SAFETY = 0.8
+
+# --- segment ends and durations ---------------------------------------------------------------
+# A moving segment end keeps the stopping distance at this share of q̈_max: the next segment's
+# polynomial motion cannot realise a bang-bang stop at the full limit.
+BRAKING_FRACTION = 0.5
+# A segment infeasible within its duration bound is planned once more with the upper bound
+# stretched by this factor: the bounds are a preference for a fast chain, not a physical
+# limit (the joint limits, dynamics and cone are).
+T_STRETCH = 1.5
+
+# --- clearance of the tool end (see flipkit.behaviors.clearance) ------------------------------
+FLIP_TOOL_FRACTION = 0.25  # the flip and carry hold the tool end to the margin from 0.25 N on
+FLIP_END_ALLOWANCE = 0.03  # m, ≈ 0.9 m/s × the turn back's first node (0.06 s) / 2
+
+# --- serving at the side table (see flipkit.behaviors.serve) ----------------------------------
+PLACE_PITCH = 0.70  # rad, tip down at the place's end: tan 0.70 = 0.84 > μ's range 0.2–0.8
+PLACE_TIP_GAP = 0.005  # m, the blade tip above the table at the place's end
+PLACE_CONE_FRACTION = 0.7  # the cone holds on place nodes i ≤ 0.7 N
+PIVOT_BAND = 0.003  # m, the tip within this of its final point while the blade tilts about it
+CARRY_CLEARANCE = 0.06  # m, the carry ends with the blade centre this far above the place pose
+WITHDRAW_NODES = 8  # return home's nodes 1..8 withdraw the blade in its own plane
+WITHDRAW_DISTANCE = 0.14  # m, back along −x of the blade by node 8: l − 2 cm of overlap
+BURGER_CLEARANCE = 0.01  # m, the blade's edges above the placed burger's top after withdrawing
+WITHDRAW_BAND = 0.005  # m, off the blade's start plane / start line while withdrawing
+WITHDRAW_ANGLE_BAND = 0.05  # rad, rpy about the place end's while withdrawing

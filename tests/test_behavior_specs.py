@@ -1,0 +1,116 @@
+"""Behaviours as data: the specs validate, the library holds every behaviour, transcribing
+checks the task, and a new subbehaviour is one spec that the one planner chains and that
+``verify`` checks like the others."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+
+import numpy as np
+import pytest
+
+from flipkit.behaviors import library
+from flipkit.behaviors.guesses import end_pose_guess
+from flipkit.behaviors.models import models_for
+from flipkit.behaviors.spec import Behavior, Subbehavior, Task
+from flipkit.behaviors.transcribe import blade_floor, flat_pose, transcribe
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.model.ik import solve_pose
+from flipkit.planning.chain import Planner
+from flipkit.planning.verify import verify_plan
+
+CELL = CellConfig()
+
+
+def _spec(**kw):
+    base = dict(name="x", duration=(0.2, 0.6), carries_burger=False, end="rest",
+                guess=end_pose_guess)
+    return Subbehavior(**{**base, **kw})
+
+
+@pytest.mark.parametrize("kw, word", [({"duration": (0.6, 0.2)}, "duration"),
+                                      ({"duration": (0.0, 0.5)}, "duration"),
+                                      ({"end": "stopped"}, "rest, home, moving"),
+                                      ({"needs": ("burger",)}, "location, goal, spot")])
+def test_a_malformed_spec_is_refused_in_one_line(kw, word):
+    with pytest.raises(ConfigError, match=word) as err:
+        _spec(**kw)
+    assert "\n" not in str(err.value)
+
+
+def test_the_library_holds_every_step_of_every_behaviour():
+    assert set(library.BEHAVIORS) == {"translate", "flip", "serve"}
+    for b in library.BEHAVIORS.values():
+        assert all(library.SUBBEHAVIORS[s.name] is s for s in b.steps)
+    assert library.FLIP_NAMES == ("go_to_burger", "scoop", "pickup", "flip", "turn_back")
+    assert library.SERVE_NAMES[:3] == library.FLIP_NAMES[:3]
+    with pytest.raises(InvalidChoiceError, match="'scoop'"):
+        library.subbehavior("scop")
+    with pytest.raises(InvalidChoiceError, match="'serve'"):
+        library.behavior("dance")
+
+
+def test_the_flip_and_carry_hold_the_burger_and_the_turn_back_ends_at_home():
+    s = library.SUBBEHAVIORS
+    assert [n for n, v in s.items() if v.carries_burger] == ["translate", "pickup", "flip",
+                                                             "carry", "place"]
+    assert {n for n, v in s.items() if v.end == "moving"} == {"pickup", "flip"}
+    assert {n for n, v in s.items() if v.end == "home"} == {"turn_back", "return_home"}
+
+
+@pytest.mark.parametrize("name, message", [("carry", "carry needs the table spot"),
+                                           ("scoop", "scoop needs the burger location"),
+                                           ("translate", "translate needs a goal pose")])
+def test_transcribing_without_the_task_it_needs_is_one_line(name, message):
+    models = models_for(CELL)
+    with pytest.raises(ConfigError, match=message):
+        transcribe(name, models, models.bare.q_home)
+
+
+def test_floors_follow_the_spec():
+    hg, N = CELL.grill.height, 20
+    assert np.all(blade_floor("translate", CELL, N) == hg)
+    arrival = blade_floor("go_to_burger", CELL, N)
+    assert np.all(arrival[:-1] == hg) and arrival[-1] < hg  # pressed in at the scoop's start
+    assert np.all(blade_floor("turn_back", CELL, N) > hg + CELL.burger.thickness)
+
+
+def test_the_scoop_predicts_the_burger_place_for_the_flip_only_when_unknown():
+    after = library.SUBBEHAVIORS["scoop"].after_solve
+    known = Task(location=(0.7, 0.0, 0.073), on_blade=(0.01, 0.0))
+    assert after(None, known, models_for(CELL), None) is known
+
+
+# A new subbehaviour, declared as one spec: lift the carried burger, flat, to a goal pose.
+HOVER = Subbehavior("hover", duration=(0.4, 1.5), carries_burger=True, end="rest",
+                    needs=("goal",), end_pose=lambda ctx: ctx.task.goal,
+                    cone=lambda ctx: list(range(ctx.layout.n_nodes)), guess=end_pose_guess)
+
+
+def test_a_new_subbehaviour_is_one_spec_that_the_planner_chains_and_verify_checks(monkeypatch):
+    monkeypatch.setitem(library.SUBBEHAVIORS, "hover", HOVER)
+    monkeypatch.setitem(library.BEHAVIORS, "translate", Behavior("translate", (HOVER,),
+                                                                 stretch=False))
+    planner = Planner(CELL, solver="sqp")
+    robot = planner.models.loaded
+    q0 = solve_pose(robot, (0.70, 0.0, 0.25), (0.0, 0.0, 0.0), robot.q_home)
+    plan = planner.chain("translate", Task(goal=flat_pose((0.70, 0.0, 0.35))), q0,
+                         np.zeros(robot.nq))
+    assert plan.status == "solved", plan.failure
+    seg = plan.segments[0]
+    assert seg.name == "hover" and 0.4 <= seg.T <= 1.5
+    assert np.linalg.norm(robot.position(seg.q[-1]) - (0.70, 0.0, 0.35)) < 1e-4
+    assert np.allclose(seg.qd[-1], 0.0, atol=1e-6) and seg.payload == ["spatula", "burger"]
+    assert verify_plan(plan, space=CELL.space).ok
+    plan.segments[0].q[-1, 0] += 0.05  # the goal missed: verify says so
+    assert not verify_plan(plan, space=CELL.space).ok
+
+
+def test_the_plan_format_names_every_registered_subbehaviour():
+    """A new subbehaviour's name goes into the plan file's schema too."""
+    schema = json.loads(resources.files("flipkit.data").joinpath(
+        "plan-format.schema.json").read_text())
+    names = schema["$defs"]["segment"]["properties"]["name"]["enum"]
+    assert sorted(names) == sorted(library.SUBBEHAVIORS)
