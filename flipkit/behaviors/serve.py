@@ -64,6 +64,8 @@ from flipkit.errors import UnreachableError
 from flipkit.model.orientation import rpy
 from flipkit.model.robot import skew
 from flipkit.transcription.constraints.kinematic import KinematicBlock, Quantity
+from flipkit.model.ik import solve_pose
+from flipkit.model.orientation import rpy_matrix
 
 
 def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
@@ -154,8 +156,6 @@ class TipPoint(Quantity):
 
 def tip_point(cell: CellConfig, pose: Pose) -> np.ndarray:
     """World position (m) of the blade tip at ``pose``."""
-    from flipkit.model.orientation import rpy_matrix
-
     return np.asarray(pose.p, float) + rpy_matrix(pose.o) @ np.array(
         [cell.spatula.length / 2, 0.0, 0.0])
 
@@ -221,8 +221,6 @@ def reach(robot, pose: Pose, seeds=()) -> np.ndarray:
     Raises:
         UnreachableError: None does.
     """
-    from flipkit.model.ik import solve_pose
-
     for seed in (*seeds, robot.q_home):
         try:
             return solve_pose(robot, pose.p, pose.o, seed)

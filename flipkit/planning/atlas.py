@@ -29,10 +29,12 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.behaviors.library import FLIP_NAMES
-from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
+from flipkit.fileio import InputFileError, check_input
+from flipkit.fileio import replace_with
+from flipkit.transcription.guess import fit_guess
 
 FORMAT = "flipkit-atlas/1"
 # Segments the planners seed from the atlas.
@@ -108,8 +110,6 @@ class Atlas:
     def save(self, path) -> Path:
         """Write one compressed ``.npz`` (float32 solutions: a guess needs no more),
         atomically (:func:`flipkit.fileio.replace_with`)."""
-        from flipkit.fileio import replace_with
-
         path = Path(path)
         arrays = {f"x_{k}": v.astype(np.float32) for k, v in self.solutions.items()}
         header = {"format": FORMAT, "structure": self.structure, **self.meta}
@@ -124,8 +124,6 @@ class Atlas:
         Raises:
             AtlasError: Unreadable, not an atlas, or stale (other options or cell).
         """
-        from flipkit.fileio import InputFileError, check_input
-
         try:
             check_input(path, "atlas")
             with open(path, "rb") as fh:
@@ -224,8 +222,6 @@ def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
     whole path; "blend": fading out by a smoothstep, so the end is kept), then refitted by the
     Bezier polynomial from (q_start, q̇_start) with u = RNEA (:func:`~flipkit.transcription.guess.fit_guess`),
     at the duration of ``x``. A start that is ``x``'s own (to 1e-9) returns ``x``."""
-    from flipkit.transcription.guess import fit_guess
-
     L, robot = nlp.layout, nlp.robot
     nodes = L.nodes(x)
     offset = np.asarray(q_start, float) - nodes[0, 0]

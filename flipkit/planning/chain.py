@@ -23,6 +23,8 @@ from flipkit.planning.segment import Segment
 from flipkit.planning.verify import verify_plan
 from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
+from flipkit.solvers.ipopt import solve_ipopt
+from flipkit.solvers.sqp import solve_sqp
 
 
 def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
@@ -39,7 +41,6 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
         InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
     """
     if solver == "sqp":
-        from flipkit.solvers.sqp import solve_sqp
 
         try:
             return solve_sqp(nlp, x0, raise_on_failure=False)
@@ -49,7 +50,6 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
                                objective=nlp.objective(x), max_violation=float(
                                    nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
     if solver == "ipopt":
-        from flipkit.solvers.ipopt import solve_ipopt
 
         return solve_ipopt(nlp, x0, raise_on_failure=False)
     if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails

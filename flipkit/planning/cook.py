@@ -21,6 +21,7 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
+from flipkit.fileio import InputFileError, read_text
 
 FIRST_SIDE_S = 90.0  # s on the first side (paper Sec. I)
 SECOND_SIDE_S = 60.0  # s on the second side (paper Sec. I)
@@ -139,8 +140,6 @@ def read_cook_csv(path, cell: CellConfig | None = None, serve: bool = True) -> l
             values, a non-numeric or non-finite number, and everything :func:`check_cook`
             refuses — one line naming the file (and the line).
     """
-    from flipkit.fileio import InputFileError, read_text
-
     try:
         text = read_text(path, "cook order", 2**20)
     except InputFileError as exc:

@@ -39,6 +39,7 @@ from flipkit.provenance import git_commit
 from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, urdf_sha256
 
 from flipkit.planning.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
+from flipkit.model.robot import Robot
 PLAN_BEHAVIORS = tuple(BEHAVIORS)  # translate, flip, serve
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
@@ -201,8 +202,6 @@ class Plan:
                       cone: str = "physical", status: str | None = None) -> "Plan":
         """A plan of ``segments`` planned in ``cell``; status ``solved`` if every segment's
         solver says so (check it with :func:`flipkit.planning.verify.verify_plan` before writing)."""
-        from flipkit.model.robot import Robot
-
         robot = Robot(cell, with_burger=True)
         if status is None:
             status = "solved" if all(s.solver.status == "solved" for s in segments) else "failed"
@@ -270,8 +269,6 @@ class Plan:
             PlanFileError: No such segment, or the rebuilt model's spatula mount or a body
                 differs from the file's.
         """
-        from flipkit.model.robot import Robot
-
         if isinstance(segment, str):
             seg = next((s for s in self.segments if s.name == segment), None)
             if seg is None and segment not in SUBBEHAVIORS:

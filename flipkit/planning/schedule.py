@@ -54,6 +54,7 @@ from flipkit.planning.cook import SECOND_SIDE_S, CookBurger, check_cook, table_s
 from flipkit.planning.planner import REST_TOL
 from flipkit.planning.motions import (KINDS, MissingPlannerError, MotionJob,
                                      MotionPlanner)
+from tqdm import tqdm
 
 FORMAT = "flipkit-timeline/1"
 
@@ -199,8 +200,6 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
         MissingPlannerError: A kind in ``kinds`` without a planner.
         CookOrderError: A malformed order. ConfigError: Bad kinds, spots or times.
     """
-    from tqdm import tqdm
-
     cell = cell or CellConfig()
     kinds = tuple(kinds)
     if "flip" not in kinds or not set(kinds) <= set(KINDS):

@@ -87,6 +87,8 @@ from flipkit.planning.verify_clearance import CellGeometry, check_space
 from flipkit.planning.verify_flight import check_flight
 # the report's types, importable from here as before
 from flipkit.planning.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
+from flipkit.errors import VerificationError
+from scipy.interpolate import CubicHermiteSpline
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
@@ -206,8 +208,6 @@ def _check_interpolant(report, k, seg, robot, tol) -> None:
     """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly: on
     interval i, q = c0 τ³ + c1 τ² + c2 τ + c3 (τ ∈ [0, h]), so q̈ is linear (extremes at the
     ends) and q̇ a parabola (extremes at the ends or at τ* = −c1 / (3 c0))."""
-    from scipy.interpolate import CubicHermiteSpline
-
     c = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0).c  # (4, N, nq)
     h = np.diff(seg.t)[:, None]
     n = np.arange(seg.N)
@@ -316,8 +316,6 @@ def require_verified(plan: Plan, where, behaviors=None, *, force: bool = False,
         VerificationError: The plan is of another behaviour, not solved, or fails a check
             group (one line naming the file, the group, its segment and amount).
     """
-    from flipkit.errors import VerificationError
-
     wanted = "" if behaviors is None else " " + " or ".join(behaviors)
     if (behaviors is not None and plan.behavior not in behaviors) or (
             plan.status != "solved" and not force):

@@ -21,13 +21,13 @@ import pinocchio as pin
 from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.model.collision import ArmShapes, distance_request, sphere_box_bound
 from flipkit.model.orientation import rpy
+import coal
 
 
 class CellGeometry:
     """The arm's shapes and the cell's boxes as a pinocchio GeometryModel of ``robot``."""
 
     def __init__(self, robot, cell):
-        import coal
 
         self.robot, self.cell = robot, cell
         arm = ArmShapes(robot, cell)
@@ -58,8 +58,6 @@ class CellGeometry:
                 distance. A check of d ≥ floor reads the same either way; the default
                 measures every pair.
         """
-        import coal
-
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.gmodel, self.gdata,
                                      np.asarray(q, float))
         ns = len(self.shape_names)

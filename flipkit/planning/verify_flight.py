@@ -25,6 +25,8 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
+from flipkit.model.collision import pin_box_support
+import coal
 
 TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
 _LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
@@ -71,9 +73,6 @@ def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
 def blade_burger_distance(blade_pose, burger_pose, cell) -> float:
     """coal distance (m) between the blade box and the burger cylinder (negative: overlap
     depth as coal reports it). Poses are (p, R) in the world."""
-    import coal
-
-    from flipkit.model.collision import pin_box_support
 
     pin_box_support()  # coal's box support state, the same in every process
     sp, bg = cell.spatula, cell.burger

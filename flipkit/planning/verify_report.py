@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flipkit.errors import VerificationError
+from flipkit.fileio import write_text
 
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
@@ -117,8 +118,6 @@ class VerificationReport:
 
     def write_json(self, path) -> None:
         """Write :meth:`to_json` to ``path`` atomically (:func:`flipkit.fileio.write_text`)."""
-        from flipkit.fileio import write_text
-
         write_text(path, json.dumps(self.to_json(), indent=1))
 
     def raise_if_failed(self) -> None:

@@ -42,6 +42,7 @@ import scipy.sparse as sp
 
 from flipkit.errors import SolverError
 from flipkit.solvers.param_map import ParameterMap, osqp_form
+import osqp
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 ADD_PER_ROUND = 10  # compact mode: most violated dropped rows added per round
@@ -192,8 +193,6 @@ class OSQPDriver:
     def _solve_persistent(self, P, q, A, l, u, work, settings, first=True):
         """One round on the persistent solver: every row, the dropped ones unbounded; the
         matrices are updated (and refactorised) in a solve's first round only."""
-        import osqp
-
         lw, uw = np.where(work, l, -np.inf), np.where(work, u, np.inf)
         if self._osqp is None:
             self._osqp = osqp.OSQP(algebra="builtin")  # named: no probing of cuda/mkl modules
@@ -213,8 +212,6 @@ class OSQPDriver:
         """One round on a fresh solver holding the working rows only (``first`` plays no
         part: each round sets up afresh); the result's dual vectors are returned at full
         length (zero on the dropped rows), as cvxpy unpacks."""
-        import osqp
-
         rows = np.flatnonzero(work)
         solver = osqp.OSQP(algebra="builtin")
         solver.setup(P, q, A[rows], l[rows], u[rows], **settings)
