@@ -25,16 +25,16 @@ __version__ = "0.1.0"
 _LAZY = {
     "CellConfig": "flipkit.config",
     "FlipkitError": "flipkit.errors",
-    "Plan": "flipkit.planning.plan_file",
-    "Planner": "flipkit.planning.chain",
-    "plan_translate": "flipkit.planning.planner",
-    "plan_flip": "flipkit.planning.planner",
-    "plan_batch": "flipkit.planning.planner",
-    "replan_flip": "flipkit.planning.planner",
-    "plan_serve": "flipkit.planning.serve",
-    "verify_plan": "flipkit.planning.verify",
+    "Plan": "flipkit.planning.plans.plan_file",
+    "Planner": "flipkit.planning.planners.chain",
+    "plan_translate": "flipkit.planning.planners.planner",
+    "plan_flip": "flipkit.planning.planners.planner",
+    "plan_batch": "flipkit.planning.planners.planner",
+    "replan_flip": "flipkit.planning.planners.planner",
+    "plan_serve": "flipkit.planning.planners.serve",
+    "verify_plan": "flipkit.planning.plans.verify",
     "validate": "flipkit.experiments.trials",
-    "schedule": "flipkit.planning.schedule",
+    "schedule": "flipkit.planning.kitchen.schedule",
 }
 _ALIASES = {"schedule": "schedule_cook", "validate": "validate_plan_file"}
 

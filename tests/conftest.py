@@ -68,8 +68,8 @@ def flip_plan():
     ``FLIPKIT_TEST_PLAN=path.json`` reuses a plan file instead (e.g. while iterating on the
     simulation side); the default plans it with the current planner.
     """
-    from flipkit.planning.plan_file import Plan
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.plans.plan_file import Plan
+    from flipkit.planning.planners.planner import plan_flip
 
     path = os.environ.get("FLIPKIT_TEST_PLAN")
     plan = Plan.load(path) if path else plan_flip((0.69, -0.16, 0.072))

@@ -21,8 +21,8 @@ TRANSLATE = ((0.60, -0.20, 0.30), (0.80, 0.20, 0.30))  # start and goal (m)
 
 def motions():
     """(key, plan) of every reference motion: the ten Table I chains, a serve, a translate."""
-    from flipkit.planning.planner import plan_flip, plan_translate
-    from flipkit.planning.serve import plan_serve
+    from flipkit.planning.planners.planner import plan_flip, plan_translate
+    from flipkit.planning.planners.serve import plan_serve
 
     for k, loc in enumerate(TABLE1_LOCATIONS):
         yield f"table1_{k}", plan_flip(loc, solver="sqp")

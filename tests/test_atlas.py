@@ -10,9 +10,9 @@ from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import AtlasError
 from flipkit.experiments.atlas import solve_entry
-from flipkit.planning.atlas import BRANCH_TOL, Atlas, default_path, options_hash
-from flipkit.planning.planner import plan_flip
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.planners.atlas import BRANCH_TOL, Atlas, default_path, options_hash
+from flipkit.planning.planners.planner import plan_flip
+from flipkit.planning.plans.verify import verify_plan
 
 LOC = TABLE1_LOCATIONS[6]
 
@@ -129,8 +129,8 @@ def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch)
     """The serve shares go to burger, scoop and pickup with the flip: the atlas seeds those
     (at the entry itself, the stored solution exactly) and no other segment; the serve is
     solved and verified like any plan."""
-    from flipkit.planning import chain
-    from flipkit.planning.serve import plan_serve
+    from flipkit.planning.planners import chain
+    from flipkit.planning.planners.serve import plan_serve
 
     seeded, solve = {}, chain.solve_segment
 
@@ -158,7 +158,7 @@ def test_anchored_guess_starts_at_the_segment_start_and_keeps_the_turn_back_end(
     neighbour ended; a start that is the neighbour's own returns its solution unchanged."""
     from flipkit.behaviors.models import Models
     from flipkit.behaviors.transcribe import transcribe
-    from flipkit.planning.atlas import anchored_guess
+    from flipkit.planning.planners.atlas import anchored_guess
 
     models = Models(CellConfig())
     rng = np.random.default_rng(0)

@@ -18,8 +18,8 @@ from flipkit.behaviors.transcribe import blade_floor, flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
-from flipkit.planning.chain import Planner
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.planners.chain import Planner
+from flipkit.planning.plans.verify import verify_plan
 
 CELL = CellConfig()
 

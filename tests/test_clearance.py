@@ -19,8 +19,8 @@ from flipkit.config.space import BACK_WALL, CellBox, SpaceConfig
 from flipkit.errors import ConfigError
 from flipkit.model.collision import ArmShapes
 from flipkit.model.orientation import rpy
-from flipkit.planning.verify import verify_plan
-from flipkit.planning.verify_clearance import CellGeometry, min_clearances
+from flipkit.planning.plans.verify import verify_plan
+from flipkit.planning.plans.verify_clearance import CellGeometry, min_clearances
 from flipkit.transcription.constraints.clearance import CAP, ArmClearance
 from flipkit.transcription.layout import Evaluation, Layout
 
@@ -276,7 +276,7 @@ def test_a_hood_where_the_elbow_goes_is_refused_or_avoided(models):
     """A hood box around the elbow's place at the end of a translate (README's example): the
     planner either refuses (a failed plan naming the clearance) or finds a motion that keeps
     every link 2 cm from it — never a solved plan through the hood."""
-    from flipkit.planning.planner import plan_translate
+    from flipkit.planning.planners.planner import plan_translate
 
     start, goal = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)
     free = plan_translate(start, goal, solver="sqp")

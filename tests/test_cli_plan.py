@@ -13,8 +13,8 @@ from flipkit.cli import main
 from flipkit.cli.plan import read_locations
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.verify import verify_plan
 
 
 def _run(capsys, *argv):
@@ -142,8 +142,8 @@ def test_batch_warm_starts_from_the_package_atlas_unless_told_not_to(tmp_path, c
                                                                       monkeypatch):
     """``plan batch`` plans each burger as ``plan flip`` does: from the package's atlas when
     it serves the default options, cold with ``--no-atlas``."""
-    import flipkit.planning.planner as planner
-    from flipkit.planning.atlas import default_atlas
+    import flipkit.planning.planners.planner as planner
+    from flipkit.planning.planners.atlas import default_atlas
 
     if default_atlas() is None:
         pytest.skip("no atlas shipped")

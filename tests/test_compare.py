@@ -14,9 +14,9 @@ from flipkit.baseline.classify import FAILURE_CLASSES
 from flipkit.cli import main
 from flipkit.experiments.compare_ik import compare_ik, plan_filename
 from flipkit.config import TABLE1_LOCATIONS
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.plans.plan_file import Plan
 from flipkit.experiments.sweep import make_executor
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.verify import verify_plan
 
 LOCATION = TABLE1_LOCATIONS[1]  # (0.75, 0.00, 0.073): IPOPT solves it, the IK baseline fails
 COLLOCATION_KEYS = {"status", "reason", "time_s", "judge"}

@@ -31,7 +31,7 @@ first = {{first!r}}
 if first == "blade":  # a box–box pair first: the blade to the grill
     S.distance(models.bare.q_home, S.shape_index("blade"), S.box_index("grill"))
 elif first == "flight":  # verify_flight's blade–burger distance first
-    from flipkit.planning.verify_flight import blade_burger_distance
+    from flipkit.planning.plans.verify_flight import blade_burger_distance
     blade_burger_distance((np.zeros(3), np.eye(3)), (np.array([0.0, 0.0, 0.05]), np.eye(3)), cell)
 q = np.array({Q!r})
 d, g = S.distance(q, S.shape_index("wrist_1"), S.box_index("grill"))
@@ -61,11 +61,11 @@ def test_coal_boxes_are_exact_once_flipkit_is_loaded():
 PLAN = """
 import hashlib, numpy as np
 from flipkit.config import CellConfig, TABLE1_LOCATIONS
-from flipkit.planning.planner import plan_flip, plan_translate
+from flipkit.planning.planners.planner import plan_flip, plan_translate
 if {before!r} == "translate":  # a carry first: its solve queried the blade's box first
     plan_translate((0.55, -0.25, 0.15), (0.7, -0.05, 0.15), solver="sqp")
 elif {before!r} == "flight":  # what an earlier test (verify_flight) may have done
-    from flipkit.planning.verify_flight import blade_burger_distance
+    from flipkit.planning.plans.verify_flight import blade_burger_distance
     blade_burger_distance((np.zeros(3), np.eye(3)), (np.array([0.0, 0.0, 0.05]), np.eye(3)),
                           CellConfig())
 plan = plan_flip(TABLE1_LOCATIONS[8], solver="sqp")

@@ -7,8 +7,8 @@ from test_plan import translate_plan
 
 from flipkit.cli import main
 from flipkit.errors import FlipkitError
-from flipkit.planning.export import resample, write_csv
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.plans.export import resample, write_csv
+from flipkit.planning.plans.plan_file import Plan
 
 RATE = 100.0  # Hz; the plan lasts 1.0 + 0.8 s
 

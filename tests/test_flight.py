@@ -16,8 +16,8 @@ from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.errors import ConfigError, UnreachableError
 from flipkit.model.flight import predict_landing
 from flipkit.behaviors.models import models_for
-from flipkit.planning.verify import verify_plan
-from flipkit.planning.verify_flight import recompute_landing
+from flipkit.planning.plans.verify import verify_plan
+from flipkit.planning.plans.verify_flight import recompute_landing
 
 G = (0.0, 0.0, -9.81)
 
@@ -89,7 +89,7 @@ def test_release_node_and_options_are_validated():
 
 
 def test_landing_spot_off_the_grill_is_refused(flip_nlp):
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
 
     with pytest.raises(UnreachableError, match="landing spot"):
         plan_flip((0.69, -0.16, 0.072), land=(1.5, 0.0))

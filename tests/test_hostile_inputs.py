@@ -45,7 +45,7 @@ def refused(capsys, argv, *, inputs=(), outputs=(), contains=(), watch=None) -> 
 @pytest.fixture(scope="module")
 def translate_file(tmp_path_factory):
     """A solved translate plan (one short NLP, about 1 s)."""
-    from flipkit.planning.planner import plan_translate
+    from flipkit.planning.planners.planner import plan_translate
 
     plan = plan_translate((0.6, -0.1, 0.2), (0.7, 0.0, 0.25))
     assert plan.status == "solved", plan.failure
@@ -93,8 +93,8 @@ def test_validate_plan_file_gates_the_library_call_too(unverified_flip):
 
 
 def test_verify_fails_a_plan_inside_the_singularity_margin(translate_file):
-    from flipkit.planning.plan_file import Plan
-    from flipkit.planning.verify import verify_plan
+    from flipkit.planning.plans.plan_file import Plan
+    from flipkit.planning.plans.verify import verify_plan
 
     assert verify_plan(Plan.load(translate_file)).groups["singularity"].ok
     plan = Plan.load(translate_file)
@@ -135,7 +135,7 @@ def test_schedule_json_onto_the_cook_order_is_refused(tmp_path, capsys):
 
 
 def test_plan_json_onto_the_atlas_is_refused(tmp_path, capsys):
-    from flipkit.planning.atlas import default_path
+    from flipkit.planning.planners.atlas import default_path
 
     atlas = tmp_path / "atlas.json"  # a .json name, so only the same-file check can refuse
     atlas.write_bytes(default_path().read_bytes())
@@ -262,7 +262,7 @@ def test_a_non_npz_atlas_gets_no_pickle_advice(plan_copy, tmp_path, capsys):
 
 
 def test_a_cook_order_with_a_byte_order_mark_is_read(tmp_path):
-    from flipkit.planning.cook import read_cook_csv
+    from flipkit.planning.kitchen.cook import read_cook_csv
 
     cook = tmp_path / "cook.csv"
     cook.write_bytes("burger,t_drop,x,y\nb1,0,0.69,-0.16\n".encode("utf-8-sig"))
@@ -270,7 +270,7 @@ def test_a_cook_order_with_a_byte_order_mark_is_read(tmp_path):
 
 
 def test_flip_only_is_not_refused_for_table_capacity(cell):
-    from flipkit.planning.cook import CookBurger, CookOrderError, check_cook, table_spots
+    from flipkit.planning.kitchen.cook import CookBurger, CookOrderError, check_cook, table_spots
 
     n = len(table_spots(cell)) + 1
     order = [CookBurger(f"b{k}", 200.0 * k, 0.69, -0.16) for k in range(n)]
@@ -368,3 +368,21 @@ def test_the_animation_formats_are_the_renderers():
     from flipkit.simulation.animate import FORMATS as RENDERED
 
     assert FORMATS == RENDERED
+
+
+@pytest.mark.parametrize("goal, names", [
+    (("1.10", "0", "0.30"), ("goal (1.10, 0.00, 0.30)", "wall", "margin 2 cm")),
+    (("0.70", "-0.20", "0.10"), ("goal (0.70, -0.20, 0.10)", "handle", "grill", "1.8 cm"))])
+def test_an_infeasible_translate_goal_is_explained_before_any_nlp(tmp_path, capsys,
+                                                                   monkeypatch, goal, names):
+    """Issue 28 item 4: every IK branch is checked against the joint bounds and the cell
+    first; the refusal names the link, the box and the distance, and no solver runs."""
+    from flipkit.planning.planners import chain
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("a solver ran for a goal the pre-check refuses")
+
+    monkeypatch.setattr(chain, "solve_segment", no_solve)
+    out = tmp_path / "t.json"
+    refused(capsys, ["plan", "translate", "--from", "0.62", "-0.20", "0.30", "--to", *goal,
+                     "--json", out], outputs=[out], contains=names)

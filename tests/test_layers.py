@@ -81,10 +81,10 @@ def test_no_import_runs_up_a_layer(path):
 def test_the_checker_catches_an_upward_import(tmp_path, monkeypatch):
     """A planted model module importing the planner is reported (the test can fail)."""
     fake = PACKAGE / "model" / "robot.py"
-    src = "from flipkit.planning.planner import plan_flip\nfrom ..errors import FlipkitError\n"
+    src = "from flipkit.planning.planners.planner import plan_flip\nfrom ..errors import FlipkitError\n"
     monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: src)
     found = imports(fake)
-    assert (1, "flipkit.planning.planner") in found and (2, "flipkit.errors") in found
+    assert (1, "flipkit.planning.planners.planner") in found and (2, "flipkit.errors") in found
     assert RANK[layer_of(found[0][1])] > RANK[layer_of(module_name(fake))]
 
 

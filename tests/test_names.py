@@ -14,7 +14,7 @@ def test_solver_names():
 
 def test_the_planner_and_the_command_line_accept_the_same_solvers():
     from flipkit.cli.common import SOLVER_CHOICES
-    from flipkit.planning.chain import SOLVERS as PLANNER_SOLVERS
+    from flipkit.planning.planners.chain import SOLVERS as PLANNER_SOLVERS
 
     assert PLANNER_SOLVERS == SOLVER_CHOICES == SOLVERS
 

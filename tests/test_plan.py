@@ -18,8 +18,8 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, PlanFileError
 from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy
-from flipkit.planning.plan_file import FORMAT, Plan
-from flipkit.planning.segment import Segment, SolverInfo
+from flipkit.planning.plans.plan_file import FORMAT, Plan
+from flipkit.planning.plans.segment import Segment, SolverInfo
 from flipkit.solvers.sqp import SolveResult
 
 LOCATION = (0.68, -0.31, 0.072)  # Table I, location 5

@@ -15,8 +15,8 @@ from test_plan_schema import SCHEMA
 from flipkit.cli import main
 from flipkit.config import default_urdf, urdf_sha256
 from flipkit.errors import PlanFileError
-from flipkit.planning.plan_file import FORMAT, Plan
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.plan_file import FORMAT, Plan
+from flipkit.planning.plans.verify import verify_plan
 
 PORTABLE_UR10 = "example-robot-data:ur_description/urdf/ur10_joint_limited_robot.urdf"
 

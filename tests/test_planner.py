@@ -1,21 +1,21 @@
-"""flipkit.planning.planner: translate / flip / batch front end, status only 'solved' when verified."""
+"""flipkit.planning.planners.planner: translate / flip / batch front end, status only 'solved' when verified."""
 
 import numpy as np
 import pytest
 from test_plan import models  # noqa: F401  (fixture)
 
-import flipkit.planning.planner as planner
-import flipkit.planning.chain as chain
+import flipkit.planning.planners.planner as planner
+import flipkit.planning.planners.chain as chain
 from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.plans.plan_file import Plan
 from flipkit.behaviors.models import models_for
-from flipkit.planning.chain import solve_segment
-from flipkit.planning.planner import (format_summary, plan_batch, plan_flip, plan_translate,
+from flipkit.planning.planners.chain import solve_segment
+from flipkit.planning.planners.planner import (format_summary, plan_batch, plan_flip, plan_translate,
                                       summary_table)
 from flipkit.solvers.sqp import SolveResult
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.verify import verify_plan
 
 GRILL_A, GRILL_B = (0.65, -0.30, 0.15), (0.80, -0.10, 0.15)
 
@@ -160,8 +160,8 @@ def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
     0.6 s; the planner tries once more with the bound × T_STRETCH and the plan verifies."""
     from flipkit.behaviors.library import SUBBEHAVIORS
     from flipkit.behaviors.options import T_STRETCH
-    from flipkit.planning.planner import plan_flip
-    from flipkit.planning.verify import verify_plan
+    from flipkit.planning.planners.planner import plan_flip
+    from flipkit.planning.plans.verify import verify_plan
 
     plan = plan_flip((0.629686, -0.347136, 0.072))
     assert plan.status == "solved", plan.failure
@@ -179,7 +179,7 @@ def test_a_duration_beyond_the_stretched_bound_fails_verify(models):
 
     from flipkit.behaviors.library import SUBBEHAVIORS
     from flipkit.behaviors.options import T_STRETCH
-    from flipkit.planning.verify import verify_plan
+    from flipkit.planning.plans.verify import verify_plan
 
     ok = translate_plan(models, durations=(T_STRETCH * SUBBEHAVIORS["translate"].duration[1] - 0.01,))
     bad = translate_plan(models, durations=(T_STRETCH * SUBBEHAVIORS["translate"].duration[1] + 0.01,))

@@ -14,8 +14,8 @@ from flipkit import figures
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError
 from flipkit.model.ik import solve_pose
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.segment import Segment
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.segment import Segment
 from flipkit.behaviors.models import models_for
 from flipkit.figures import data
 from flipkit.figures import draw

@@ -12,11 +12,11 @@ import pytest
 
 from flipkit.config import CellConfig
 from flipkit.experiments.sweep import make_executor
-from flipkit.planning.cook import CookBurger, check_cook, table_spots
-from flipkit.planning.motions import default_planners
-from flipkit.planning.prefetch import PrefetchPlanners
-from flipkit.planning.schedule import schedule_cook
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.kitchen.cook import CookBurger, check_cook, table_spots
+from flipkit.planning.kitchen.motions import default_planners
+from flipkit.planning.kitchen.prefetch import PrefetchPlanners
+from flipkit.planning.kitchen.schedule import schedule_cook
+from flipkit.planning.plans.verify import verify_plan
 
 CELL = CellConfig()
 ORDER = [CookBurger("b1", 0.0, 0.64, -0.33), CookBurger("b2", 5.0, 0.69, -0.16)]  # Table I 1, 6
@@ -51,7 +51,7 @@ def test_prefetched_cook_equals_the_serial_one():
 @pytest.mark.slow
 def test_parallel_batch_equals_the_serial_one():
     from flipkit.config import TABLE1_LOCATIONS
-    from flipkit.planning.planner import plan_batch
+    from flipkit.planning.planners.planner import plan_batch
 
     locs = [TABLE1_LOCATIONS[6], TABLE1_LOCATIONS[8]]
     serial = plan_batch(locs, progress=False, solver="sqp")

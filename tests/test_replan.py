@@ -9,9 +9,9 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.simulation.judges import LANDING_TOL, judge_flip, judge_scoop
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.simulation.execute import execute_plan
-from flipkit.planning.planner import plan_flip, replan_flip
+from flipkit.planning.planners.planner import plan_flip, replan_flip
 from flipkit.experiments.trials import landing_target
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.verify import verify_plan
 
 
 @pytest.fixture(scope="module")

@@ -11,9 +11,9 @@ import pytest
 from flipkit.config import CellConfig, ScoopUncertainty
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.scoop import GRAVITY, ScoopPath, footprint_share
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.servo_command import command_lead, position_command
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.servo_command import command_lead, position_command
+from flipkit.planning.plans.verify import verify_plan
 from flipkit.transcription.constraints.flight import ScenarioLanding
 from conftest import check_block_jacobian
 
@@ -202,7 +202,7 @@ def test_the_arm_holds_while_the_replan_runs_and_the_camera_errs(flip_plan):
 
 
 def test_a_place_inside_the_scenarios_needs_no_replan(flip_plan):
-    from flipkit.planning.planner import covers, replan_flip
+    from flipkit.planning.planners.planner import covers, replan_flip
 
     flip = next(s for s in flip_plan.segments if s.name == "flip")
     nominal = flip.landing["burger_on_blade"]
@@ -253,7 +253,7 @@ def test_validate_command_line_takes_the_command_stream(flip_plan_file, tmp_path
     import json
 
     from flipkit.cli import main
-    from flipkit.planning.servo_command import COMMANDS
+    from flipkit.planning.plans.servo_command import COMMANDS
 
     out = tmp_path / "v.json"
     rc = main(["validate", "--plan", str(flip_plan_file), "--trials", "1", "--mode", "position",

@@ -13,10 +13,10 @@ import pytest
 from flipkit import cli
 from flipkit.config import CellConfig
 from flipkit.errors import InvalidChoiceError
-from flipkit.planning import cook, motions
-from flipkit.planning.cook import CookBurger, CookOrderError, check_cook, read_cook_csv
-from flipkit.planning.motions import MissingPlannerError, PlannedMotion
-from flipkit.planning.schedule import schedule_cook
+from flipkit.planning.kitchen import cook, motions
+from flipkit.planning.kitchen.cook import CookBurger, CookOrderError, check_cook, read_cook_csv
+from flipkit.planning.kitchen.motions import MissingPlannerError, PlannedMotion
+from flipkit.planning.kitchen.schedule import schedule_cook
 
 CELL = CellConfig()
 FLIP_T, FLIP_EVENT, SERVE_T, SERVE_EVENT = 3.4, 2.2, 5.0, 1.5  # s, the fixed planners
@@ -272,8 +272,8 @@ def test_same_spot_is_fine_once_the_first_burger_is_gone(tmp_path):
 # ---------------------------------------------------------------- real plan_flip, end to end
 @pytest.mark.slow
 def test_flip_only_schedule_with_the_real_planner(tmp_path, capsys):
-    from flipkit.planning.plan_file import Plan
-    from flipkit.planning.verify import verify_plan
+    from flipkit.planning.plans.plan_file import Plan
+    from flipkit.planning.plans.verify import verify_plan
 
     path = tmp_path / "order.csv"
     path.write_text("burger,t_drop,x,y\nb1,0,0.69,-0.16\n")

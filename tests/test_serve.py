@@ -17,10 +17,10 @@ from flipkit.cli import main
 from flipkit.config import TableConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.orientation import rpy
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.serve import plan_serve
-from flipkit.planning.serve import replan_serve, table_spot
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.planners.serve import plan_serve
+from flipkit.planning.planners.serve import replan_serve, table_spot
+from flipkit.planning.plans.verify import verify_plan
 from flipkit.simulation.judges import SERVE_TOL, judge_serve
 from flipkit.simulation.run import BurgerRun
 
@@ -267,7 +267,7 @@ def test_return_home_guess_makes_the_withdrawal():
 
     cell = CellConfig()
     models = Models(cell)
-    from flipkit.planning.cook import table_spots
+    from flipkit.planning.kitchen.cook import table_spots
 
     spot = table_spots(cell)[0]
     end = sv.place_end(cell, spot, (0.0, 0.0))

@@ -269,7 +269,7 @@ def cold_flip():
     from flipkit.behaviors.models import Models
     from flipkit.behaviors.transcribe import transcribe
     from flipkit.config import TABLE1_LOCATIONS, CellConfig
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
 
     cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
     pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments

@@ -6,9 +6,9 @@ import pytest
 
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.config import TABLE1_LOCATIONS
-from flipkit.planning.planner import plan_flip
+from flipkit.planning.planners.planner import plan_flip
 from flipkit.behaviors import targets as tg
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.verify import verify_plan
 
 
 @pytest.mark.parametrize("index", range(len(TABLE1_LOCATIONS)))

@@ -78,7 +78,7 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     the SQP, the turn back within 40 iterations and within its (possibly stretched) bound,
     and the plan verified; the flip ends where coasting keeps the margin."""
     from flipkit.behaviors.models import models_for
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
     from flipkit.config import CellConfig
 
     plan = plan_flip(FAR_GRILL, solver="sqp")

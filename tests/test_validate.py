@@ -81,7 +81,7 @@ def test_perturbation_draws_within_their_ranges():
 
 
 def test_tracked_poses_follow_the_plan(plan_file):
-    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.plans.plan_file import Plan
 
     plan = Plan.load(plan_file)
     t, p, R, bounds, errors = track_plan(plan)

@@ -12,8 +12,8 @@ from flipkit.behaviors.options import SCOOP_PRESS
 from flipkit.behaviors import targets as tg
 from flipkit.cli import main
 from flipkit.errors import ConfigError, VerificationError
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.verify import GROUPS, INTERPOLANT_TOL, verify_plan
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.verify import GROUPS, INTERPOLANT_TOL, verify_plan
 from flipkit.transcription.constraints.interpolant import ACC_SCALE, VEL_SCALE
 from flipkit.model.ik import solve_pose
 
@@ -243,7 +243,7 @@ def test_cli_exit_codes(models, tmp_path, capsys):
 def test_rows_recorded_node_by_node_match_one_call_per_node():
     """VerificationReport.add_nodes (one call for a segment's nodes) records the same worst
     row — violation, tolerance, node — as add once per node in order, NaN and ties included."""
-    from flipkit.planning.verify import VerificationReport
+    from flipkit.planning.plans.verify import VerificationReport
 
     rng = np.random.default_rng(3)
     for trial in range(50):

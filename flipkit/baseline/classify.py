@@ -322,7 +322,7 @@ def classify_plan(plan, rate: float = 500.0, thresholds: Thresholds = Thresholds
     no tracking error), with the segment's payload.
 
     Args:
-        plan: A :class:`~flipkit.planning.plan_file.Plan`. rate: Sample rate (Hz).
+        plan: A :class:`~flipkit.planning.plans.plan_file.Plan`. rate: Sample rate (Hz).
 
     Returns:
         One :class:`SegmentVerdict` per segment.

@@ -3,7 +3,7 @@
 
 Each is dynamically consistent (u = RNEA(q, q̇, q̈) along a Bezier polynomial,
 :mod:`flipkit.transcription.guess`); the solver starts there. A warm-start atlas, when present,
-replaces them for the segments it seeds (:mod:`flipkit.planning.atlas`).
+replaces them for the segments it seeds (:mod:`flipkit.planning.planners.atlas`).
 """
 
 from __future__ import annotations

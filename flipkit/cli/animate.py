@@ -58,12 +58,12 @@ def run(args: argparse.Namespace) -> int:
     os.environ.setdefault("MUJOCO_GL", "osmesa")  # before anything imports mujoco
     from flipkit.simulation.animate import write_animation, write_filmstrip
     from flipkit.simulation.execute import execute_plan
-    from flipkit.planning.verify import load_verified
+    from flipkit.planning.plans.verify import load_verified
 
     plan = load_verified(args.plan, ("flip",))
     replan = None
     if args.replan:
-        from flipkit.planning.planner import replan_flip
+        from flipkit.planning.planners.planner import replan_flip
 
         replan = replan_flip
     ex = execute_plan(plan, args.mode, replan=replan)

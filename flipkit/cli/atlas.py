@@ -42,7 +42,7 @@ def run_build(args: argparse.Namespace) -> int:
     from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
     from flipkit.experiments.atlas import DEFAULT_GRID, build_atlas
     from flipkit.fileio import check_output
-    from flipkit.planning.atlas import default_path
+    from flipkit.planning.planners.atlas import default_path
 
     grid = tuple(args.grid) if args.grid else DEFAULT_GRID
     for n in grid:
@@ -67,7 +67,7 @@ def run_info(args: argparse.Namespace) -> int:
     """One paragraph about an atlas, and whether it serves today's default options."""
     from flipkit.behaviors.options import SegmentOptions
     from flipkit.config import CellConfig
-    from flipkit.planning.atlas import Atlas, default_path, options_hash
+    from flipkit.planning.planners.atlas import Atlas, default_path, options_hash
 
     path = args.file or default_path()
     atlas = Atlas.load(path)

@@ -54,9 +54,9 @@ def check_float(flag: str, value, lo: float, hi: float, unit: str) -> float:
 
 
 def precheck_plan(path) -> None:
-    """The cheap checks of a plan file (:func:`flipkit.planning.plan_doc.read_plan_doc`),
+    """The cheap checks of a plan file (:func:`flipkit.planning.plans.plan_doc.read_plan_doc`),
     before a command imports the models: a malformed file is refused at once."""
-    from flipkit.planning.plan_doc import read_plan_doc
+    from flipkit.planning.plans.plan_doc import read_plan_doc
 
     read_plan_doc(path)
 

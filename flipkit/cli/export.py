@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 
-RATE_RANGE = (1.0, 10_000.0)  # Hz, --rate (flipkit.planning.export.RATE_RANGE)
+RATE_RANGE = (1.0, 10_000.0)  # Hz, --rate (flipkit.planning.plans.export.RATE_RANGE)
 
 
 def register(subparsers) -> None:
@@ -41,8 +41,8 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.csv, "--csv", (".csv",), inputs=[args.plan])
     check_float("--rate", args.rate, RATE_RANGE[0], RATE_RANGE[1], "Hz")
     precheck_plan(args.plan)
-    from flipkit.planning.export import write_csv
-    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.plans.export import write_csv
+    from flipkit.planning.plans.plan_file import Plan
 
     plan = Plan.load(args.plan)
     rows = write_csv(plan, args.csv, args.rate, force=args.force, where=args.plan)

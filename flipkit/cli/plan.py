@@ -1,7 +1,7 @@
 """``flipkit plan``: plan a translate, a pickup-and-flip, a serve to the table, or a batch of
 burgers.
 
-Exit status: 0 every plan is solved and passes :func:`~flipkit.planning.verify.verify_plan`; 1 a plan
+Exit status: 0 every plan is solved and passes :func:`~flipkit.planning.plans.verify.verify_plan`; 1 a plan
 failed — one line ``flipkit: error: <segment>: <group> violated by <amount> (...)`` on
 stderr per failed plan, and the plan file is still written, with ``"status": "failed"``, so
 it can be inspected (``flipkit verify`` exits 1 on it, ``flipkit export`` refuses it without
@@ -161,7 +161,7 @@ def _start_q(values, cell):
     if values is None:
         return None
     from flipkit.model.singular import check_start
-    from flipkit.planning.inputs import check_joint_vector
+    from flipkit.planning.planners.inputs import check_joint_vector
     from flipkit.behaviors.models import models_for
 
     q = _numbers("--start-q", values, 6)
@@ -187,7 +187,7 @@ def read_locations(path) -> list[tuple[float, float, float]]:
         ConfigError: Unreadable file, missing columns, a non-numeric or non-finite value,
             no rows or more than five (one line naming the file and the line).
     """
-    from flipkit.planning.planner import MAX_BATCH
+    from flipkit.planning.planners.planner import MAX_BATCH
 
     from flipkit.fileio import InputFileError, read_text
 
@@ -250,7 +250,7 @@ def _report(plan, path: str | None) -> int:
 
 def run_translate(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
-    from flipkit.planning.planner import plan_translate
+    from flipkit.planning.planners.planner import plan_translate
 
     _quiet()
     _json_out(args)
@@ -263,7 +263,7 @@ def run_translate(args: argparse.Namespace) -> int:
 def run_flip(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     from flipkit.behaviors.options import SegmentOptions
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
 
     from flipkit.config import CellConfig
 
@@ -296,7 +296,7 @@ def _atlas(args: argparse.Namespace, options):
     """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
     package's when it exists and serves ``options``, else ``None`` (cold starts)."""
     from flipkit.config import CellConfig
-    from flipkit.planning.atlas import Atlas, default_atlas
+    from flipkit.planning.planners.atlas import Atlas, default_atlas
 
     if args.no_atlas:
         return None
@@ -307,7 +307,7 @@ def _atlas(args: argparse.Namespace, options):
 
 def run_serve(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
-    from flipkit.planning.serve import plan_serve
+    from flipkit.planning.planners.serve import plan_serve
 
     from flipkit.behaviors.options import SegmentOptions
     from flipkit.behaviors.serve import check_table_spot
@@ -337,12 +337,12 @@ def run_batch(args: argparse.Namespace) -> int:
     """Plan the batch, write every plan and summary.csv, print the table."""
     from flipkit.behaviors.options import SegmentOptions
     from flipkit.fileio import write_text
-    from flipkit.planning.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
+    from flipkit.planning.planners.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
 
     from flipkit.cli.common import MAX_WORKERS, check_int
     from flipkit.config import CellConfig
     from flipkit.fileio import check_output_dir
-    from flipkit.planning.inputs import check_spacing
+    from flipkit.planning.planners.inputs import check_spacing
 
     _quiet()
     if args.workers is not None:

@@ -6,7 +6,7 @@ line per failure on stderr; the timeline and the plan files (the failed one with
 header, a non-finite number, a drop time outside [0, 86400] s, a burger off the grill,
 duplicate ids, two burgers closer than one diameter on the grill at once, more burgers to
 serve than table spots), an output that is not writable, of an unknown format or the cook
-order itself, or a motion kind without a planner (``flipkit.planning.planner.plan_serve``
+order itself, or a motion kind without a planner (``flipkit.planning.planners.planner.plan_serve``
 missing) — one line on stderr, nothing planned, nothing written.
 """
 
@@ -67,10 +67,10 @@ def _safe(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Read, check, plan, write, report."""
     from flipkit.config import CellConfig
-    from flipkit.planning.cook import read_cook_csv
-    from flipkit.planning.atlas import default_atlas
-    from flipkit.planning.motions import default_planners
-    from flipkit.planning.schedule import format_timeline, schedule_cook
+    from flipkit.planning.kitchen.cook import read_cook_csv
+    from flipkit.planning.planners.atlas import default_atlas
+    from flipkit.planning.kitchen.motions import default_planners
+    from flipkit.planning.kitchen.schedule import format_timeline, schedule_cook
 
     from flipkit.cli.common import MAX_WORKERS, check_int
     from flipkit.fileio import check_output, check_output_dir
@@ -97,8 +97,8 @@ def run(args: argparse.Namespace) -> int:
     executor = None
     if workers > 1:
         from flipkit.experiments.sweep import make_executor
-        from flipkit.planning.cook import check_cook, table_spots
-        from flipkit.planning.prefetch import PrefetchPlanners
+        from flipkit.planning.kitchen.cook import check_cook, table_spots
+        from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 
         executor = make_executor(workers=workers)
         planners = PrefetchPlanners(check_cook(burgers, cell, serve=not args.flip_only),

@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
             check_output_dir(directory, flag, inputs=inputs)
     if args.plan is not None:
         precheck_plan(args.plan)
-        from flipkit.planning.verify import load_verified
+        from flipkit.planning.plans.verify import load_verified
 
         load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
     from flipkit.experiments.compare_ik import LOCATION_SETS

@@ -22,7 +22,7 @@ def register(subparsers) -> None:
     parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT (.json; not the plan)")
     parser.add_argument("--tol", type=float, metavar="TOL",
                         help="tolerance in the solver's scaled units, in [1e-12, 1] (default: "
-                             "flipkit.planning.verify.TOL, 10x the SQP feasibility tolerance)")
+                             "flipkit.planning.plans.verify.TOL, 10x the SQP feasibility tolerance)")
     parser.set_defaults(run=run)
 
 
@@ -36,8 +36,8 @@ def run(args: argparse.Namespace) -> int:
     if args.tol is not None:
         check_float("--tol", args.tol, 1e-12, 1.0, "(scaled units)")
     precheck_plan(args.plan)
-    from flipkit.planning.plan_file import Plan
-    from flipkit.planning.verify import TOL, verify_plan
+    from flipkit.planning.plans.plan_file import Plan
+    from flipkit.planning.plans.verify import TOL, verify_plan
 
     report = verify_plan(Plan.load(args.plan), tol=TOL if args.tol is None else args.tol)
     print(report.table())

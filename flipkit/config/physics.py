@@ -83,7 +83,7 @@ class PhysicsConfig:
             :data:`flipkit.simulation.tracking.DEFAULT_KP` / ``DEFAULT_KD`` (about critical damping at
             q_home, stated there); UR does not publish its servo gains.
         servo_gain_scale: Factor on ``kp`` and ``kd`` of the simulated servo: the real gains
-            are unknown, while the commands of :mod:`flipkit.planning.servo_command` are
+            are unknown, while the commands of :mod:`flipkit.planning.plans.servo_command` are
             computed with the nominal ones. 1; range 0.5-2 (no source: UR publishes none).
     """
 

@@ -1,4 +1,4 @@
-"""Building the warm-start atlas (:mod:`flipkit.planning.atlas`): pickup-and-flip solved on a
+"""Building the warm-start atlas (:mod:`flipkit.planning.planners.atlas`): pickup-and-flip solved on a
 grid over the grill with the sweep executor (local processes or a Dask cluster).
 
     flipkit atlas build [--grid NX NY] [--scheduler ADDRESS] [--out FILE]
@@ -24,7 +24,7 @@ from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 from flipkit.experiments.sweep import grill_grid, make_executor, run_sweep
-from flipkit.planning.atlas import FORMAT, Atlas, options_hash
+from flipkit.planning.planners.atlas import FORMAT, Atlas, options_hash
 from flipkit.provenance import git_commit
 
 DEFAULT_GRID = (5, 7)  # 35 locations, 5.6 cm × 9.4 cm apart over the grill area
@@ -34,7 +34,7 @@ def solve_entry(item) -> dict:
     """Plan the chain at one location (sweep worker): ``{"location", "status", "failure",
     "x": {segment: Z}, "structure": {segment: key}, "wall_s", "iterations"}``."""
     from flipkit.behaviors.models import models_for
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
 
     location, cell, options = item
     plan = plan_flip(location, cell=cell, options=options, solver="sqp")

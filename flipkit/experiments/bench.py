@@ -11,7 +11,7 @@ IPOPT with L-BFGS through callbacks, all on the same scaled NLP — without the 
 rows, which have no symbolic form (``--full``: the planner's NLP with them, the SQP and
 L-BFGS IPOPT only). ``flip``: the full
 pickup-and-flip (five segments) at the first N Table I locations with the SQP from cold
-starts, the SQP warm-started from the atlas (:mod:`flipkit.planning.atlas`; the package's
+starts, the SQP warm-started from the atlas (:mod:`flipkit.planning.planners.atlas`; the package's
 by default) and IPOPT, then
 a batch of the first K locations with the SQP, cold and from the atlas (``flipkit plan
 batch``'s default), one after the other and on one worker process per CPU, beside the paper's budgets (Sec. I: < 20 s
@@ -39,10 +39,11 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.planning.atlas import Atlas, default_atlas
+from flipkit.planning.planners.atlas import Atlas, default_atlas
 from flipkit.behaviors.models import models_for
-from flipkit.planning.chain import solve_segment
-from flipkit.planning.planner import plan_batch, plan_flip
+from flipkit.planning.planners.chain import solve_segment
+from flipkit.planning.planners.planner import plan_batch, plan_flip
+from flipkit.experiments.bench_replan import bench_replan, load_result, run_validation
 from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
@@ -341,7 +342,10 @@ def main(argv=None) -> int:
     """Command-line entry point (see the module docstring)."""
     parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench",
                                      description=__doc__.splitlines()[0])
-    parser.add_argument("which", choices=("translate", "flip"))
+    parser.add_argument("which", choices=("translate", "flip", "replan"))
+    parser.add_argument("--validate", metavar="FILE",
+                        help="replan: the sensed places of this `flipkit validate --replan "
+                             "--json` result (default: run Table I, 3 trials, position mode)")
     parser.add_argument("--locations", type=int, default=len(TABLE1_LOCATIONS), metavar="N",
                         help="flip: the first N Table I locations (default all ten)")
     parser.add_argument("--batch", type=int, default=5, metavar="K",
@@ -365,6 +369,9 @@ def main(argv=None) -> int:
     cell = CellConfig()
     if args.which == "translate":
         result = bench_translate(cell, args.full, args.jit)
+    elif args.which == "replan":
+        print(machine())
+        result = bench_replan(load_result(args.validate) if args.validate else run_validation())
     else:
         atlas = None
         if not args.no_atlas:

@@ -2,8 +2,8 @@
 
 The paper's motivating claim (Sec. I) is that planning in end-effector space and tracking with
 inverse kinematics fails where joint-space collocation succeeds. :func:`compare_ik` runs both
-on each burger location — :func:`flipkit.planning.planner.plan_flip` (its plan re-checked by
-:func:`flipkit.planning.verify.verify_plan`) and :func:`flipkit.baseline.run_baseline` — on the sweep
+on each burger location — :func:`flipkit.planning.planners.planner.plan_flip` (its plan re-checked by
+:func:`flipkit.planning.plans.verify.verify_plan`) and :func:`flipkit.baseline.run_baseline` — on the sweep
 executor, and summarises success fractions, the baseline's failure reasons and classes, and
 the median wall time per subbehaviour of each method.
 
@@ -47,8 +47,8 @@ def plan_filename(location, solver: str) -> str:
 
 
 def _collocation(location, solver: str, plans_dir) -> dict:
-    from flipkit.planning.planner import plan_flip
-    from flipkit.planning.verify import verify_plan
+    from flipkit.planning.planners.planner import plan_flip
+    from flipkit.planning.plans.verify import verify_plan
 
     t0 = time.perf_counter()
     try:

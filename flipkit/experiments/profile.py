@@ -57,7 +57,7 @@ def profile_flip(location, segment: str = "flip", atlas=None) -> dict:
         ``{"location", "segment", "atlas", "iterations", "sqp_s", "parts_ms_per_iteration":
         {part: ms}, "solve_s_unprofiled"}``; ``parts`` sum to the SQP's time per iteration.
     """
-    from flipkit.planning import planner
+    from flipkit.planning.planners import planner
     from flipkit.solvers import sqp
 
     planner.plan_flip(location, atlas=atlas)  # warm-up: compile every subproblem structure
@@ -121,7 +121,7 @@ def main(argv=None) -> int:
         parser.error(f"--location must be 1..{len(TABLE1_LOCATIONS)}")
     atlas = None
     if args.atlas:
-        from flipkit.planning.atlas import default_atlas
+        from flipkit.planning.planners.atlas import default_atlas
 
         atlas = default_atlas()
         if atlas is None:

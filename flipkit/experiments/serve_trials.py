@@ -7,7 +7,7 @@ physics perturbed (:class:`~flipkit.experiments.trials.Perturbations`, drawn fro
 the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
 within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
 ``replan`` the cell measures where the burger lies on the blade at the end of the carry and
-re-plans place and return home for it (:func:`flipkit.planning.serve.replan_serve`).
+re-plans place and return home for it (:func:`flipkit.planning.planners.serve.replan_serve`).
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ import numpy as np
 from flipkit.errors import ConfigError
 from flipkit.experiments.trials import (HOLD_S, TRACK_RATE_HZ, Perturbations, merge_tracking,
                                         plan_from_text, trial_jobs, trial_key)
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.serve import table_spot
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.planners.serve import table_spot
 from flipkit.simulation.judges import judge_pickup, judge_scoop, judge_serve
 from flipkit.simulation.modes import FEEDFORWARD
 
@@ -38,7 +38,7 @@ def run_serve_trial(job: dict) -> dict:
         spot (m), ``up_z``), ``replan`` (sensed position and failure, or ``None``).
     """
     from flipkit.config import with_parameter
-    from flipkit.planning.serve import replan_serve
+    from flipkit.planning.planners.serve import replan_serve
     from flipkit.simulation.execute import execute_plan
 
     plan = plan_from_text(job["plan_text"])
@@ -99,7 +99,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
 
     Raises:
         FlipkitError: The file is missing, malformed, not a serve plan, not solved or fails
-            :func:`~flipkit.planning.verify.verify_plan`.
+            :func:`~flipkit.planning.plans.verify.verify_plan`.
     """
     from pathlib import Path
 
@@ -108,7 +108,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     plan = Plan.load(path)
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
-    from flipkit.planning.verify import require_verified
+    from flipkit.planning.plans.verify import require_verified
 
     require_verified(plan, path, ("serve",))  # nothing unverified is simulated
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:

@@ -27,7 +27,7 @@ from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP
 from flipkit.config import CellConfig, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.perturbations import Perturbations
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.plans.plan_file import Plan
 from flipkit.simulation.modes import FEEDFORWARD, MODES
 from flipkit.solvers.names import SOLVERS
 
@@ -120,7 +120,7 @@ def run_trial(job: dict) -> dict:
             ``perturbations`` (:class:`Perturbations` fields), ``rate_hz`` (joint controller
             rate, Hz), ``mode`` (:data:`flipkit.simulation.modes.MODES`; default ``"feedforward"``),
             ``command`` (position mode's command stream,
-            :data:`flipkit.planning.servo_command.COMMANDS`; default ``"compensated"``),
+            :data:`flipkit.planning.plans.servo_command.COMMANDS`; default ``"compensated"``),
             optionally ``replan`` (bool, see :func:`validate`) and ``physics``
             (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
             simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
@@ -146,7 +146,7 @@ def run_trial(job: dict) -> dict:
         cell = with_parameter(cell, name, value)
     replan = None
     if job.get("replan", False):
-        from flipkit.planning.planner import replan_flip
+        from flipkit.planning.planners.planner import replan_flip
 
         replan = replan_flip
     command = job.get("command", "compensated")
@@ -242,8 +242,8 @@ def plan_location(job: dict) -> dict:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
     """
     from flipkit.experiments.compare_ik import plan_filename
-    from flipkit.planning.atlas import default_atlas
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.atlas import default_atlas
+    from flipkit.planning.planners.planner import plan_flip
 
     try:
         plan = plan_flip(job["location"], solver=job["solver"], atlas=default_atlas())
@@ -269,9 +269,9 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
         mode: Joint controller, one of :data:`flipkit.simulation.modes.MODES`.
         replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
-            and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planner.replan_flip`);
+            and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planners.planner.replan_flip`);
             ``False`` runs the plans open loop.
-        command: Position mode's command stream (:data:`flipkit.planning.servo_command.COMMANDS`).
+        command: Position mode's command stream (:data:`flipkit.planning.plans.servo_command.COMMANDS`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
 
     Returns:
@@ -308,7 +308,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
     """:func:`validate` of one plan file (a serve plan: :func:`~flipkit.experiments.serve_trials.validate_serve`);
     raises FlipkitError (one line) if it is missing, malformed, not a flip or serve plan, not
-    solved or fails :func:`~flipkit.planning.verify.verify_plan`. ``kwargs`` as :func:`validate`."""
+    solved or fails :func:`~flipkit.planning.plans.verify.verify_plan`. ``kwargs`` as :func:`validate`."""
     plan = Plan.load(path)
     if plan.behavior == "serve":  # the serve judge (flipkit.experiments.serve_trials)
         from flipkit.experiments.serve_trials import validate_serve
@@ -317,7 +317,7 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
         raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip or serve plan")
     if plan.status != "solved":
         raise FlipkitError(f"{path}: plan status is {plan.status!r}; validate needs a solved plan")
-    from flipkit.planning.verify import require_verified
+    from flipkit.planning.plans.verify import require_verified
 
     require_verified(plan, path, ("flip",))  # nothing unverified is simulated
     info = {"status": plan.status, "file": str(path)}

@@ -1,6 +1,6 @@
 """What the figures show, computed from plans, NLPs and the contact model (no drawing).
 
-Everything here reads the package's own objects — a :class:`~flipkit.planning.plan_file.Plan`, an
+Everything here reads the package's own objects — a :class:`~flipkit.planning.plans.plan_file.Plan`, an
 :class:`~flipkit.transcription.nlp.NLP` and its constraint blocks, the cone forms of
 :mod:`flipkit.model.contact` — so a figure shows exactly what the planner imposed and the
 verifier checked. Units: s, m, rad, m/s² (specific forces, i.e. force per burger mass).
@@ -103,7 +103,7 @@ def contact_series(plan, segments=None, mu: float | None = None) -> ContactSerie
     """f, cone margins and the enforced-cone mask at every node of ``segments``.
 
     Args:
-        plan: A :class:`~flipkit.planning.plan_file.Plan`.
+        plan: A :class:`~flipkit.planning.plans.plan_file.Plan`.
         segments: Segment names to evaluate (default: those that carry the burger, i.e.
             with cone nodes).
         mu: Friction coefficient (default: the plan's burger μ).

@@ -2,7 +2,7 @@
 
 * :func:`chain_translates` — the translate experiment of the paper's Fig. 6: one translate
   plan per pair of consecutive key points, chained (each starts where the last ended, at
-  rest), gathered into one multi-segment translate :class:`~flipkit.planning.plan_file.Plan`.
+  rest), gathered into one multi-segment translate :class:`~flipkit.planning.plans.plan_file.Plan`.
 * :func:`track_plan` — simulated execution of a plan (as in the Table I trials of
   :mod:`flipkit.experiments.trials`) beside the plan's desired spatula position.
 * :func:`nominal_trial` — one unperturbed Table I trial of a flip plan.
@@ -43,8 +43,8 @@ def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None =
         ``solved`` only if every plan was solved and verified) and the individual plans
         (each with ``failure``, ``wall_time_s`` and ``report``).
     """
-    from flipkit.planning.plan_file import Plan
-    from flipkit.planning.planner import plan_translate
+    from flipkit.planning.plans.plan_file import Plan
+    from flipkit.planning.planners.planner import plan_translate
 
     cell = cell or CellConfig()
     pts = [tuple(float(v) for v in p) for p in points]
@@ -166,7 +166,7 @@ def flip_solve_times(item) -> dict:
         ``segments``: ``[{name, status, wall_time_s, iterations, T}]`` (solver wall time, s;
         executed duration T, s) for the segments attempted.
     """
-    from flipkit.planning.planner import plan_flip
+    from flipkit.planning.planners.planner import plan_flip
 
     location, solver = [float(v) for v in item["location"]], str(item["solver"])
     cell = CellConfig()
@@ -263,7 +263,7 @@ def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = Tru
 
     replan_fn = None
     if replan:
-        from flipkit.planning.planner import replan_flip as replan_fn
+        from flipkit.planning.planners.planner import replan_flip as replan_fn
     ex = execute_plan(plan_from_text(plan_text), mode, None, hold=HOLD_S, replan=replan_fn)
     b = ex.bounds
     ok = {"scoop": judge_scoop(ex.run, b["scoop"]).ok}
@@ -311,7 +311,7 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
     from flipkit.baseline.classify import classify_plan
     from flipkit.baseline.ee_opt import sample_times
     from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
-    from flipkit.planning.plan_file import Plan
+    from flipkit.planning.plans.plan_file import Plan
 
     res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
     ts, qs, edges, t0 = [], [], [0.0], 0.0
@@ -329,7 +329,7 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
     if path is not None and path.exists():
         plan = Plan.load(path)
     else:
-        from flipkit.planning.planner import plan_flip
+        from flipkit.planning.planners.planner import plan_flip
         plan = plan_flip(location, solver=solver)
     ts, qs, edges, t0 = [], [], [0.0], 0.0
     for seg in plan.segments:

@@ -14,7 +14,7 @@ decides how hard it pushes. Two controllers (``mode``):
   controller adds gravity compensation from *its own* model — the arm with the spatula as its
   configured payload, not the burger (a UR controller knows only the payload it is told) —
   evaluated at the measured q, plus the same PD. The commands are the plan's (q, q̇)
-  pre-compensated for that servo (:mod:`flipkit.planning.servo_command`), or as they are
+  pre-compensated for that servo (:mod:`flipkit.planning.plans.servo_command`), or as they are
   (``command="raw"``).
 
 The plant's burger (mass, friction, placement, grill height) follows the trial's perturbation
@@ -32,7 +32,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
-from flipkit.planning.servo_command import COMMANDS, command_lead, position_command
+from flipkit.planning.plans.servo_command import COMMANDS, command_lead, position_command
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
@@ -139,7 +139,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
-        plan: A solved flip or serve :class:`~flipkit.planning.plan_file.Plan` (segments
+        plan: A solved flip or serve :class:`~flipkit.planning.plans.plan_file.Plan` (segments
             go_to_burger … turn_back, or go_to_burger … return_home; a serve plan tilts the
             burger off onto the scene's table).
         mode: One of :data:`~flipkit.simulation.modes.MODES`, ``"feedforward"`` or
@@ -155,7 +155,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         hold: Time (s) the last desired state is held after the plan.
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
         command: ``position`` mode's command stream, one of
-            :data:`~flipkit.planning.servo_command.COMMANDS`: ``"compensated"`` (default) sends
+            :data:`~flipkit.planning.plans.servo_command.COMMANDS`: ``"compensated"`` (default) sends
             q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the nominal latency and half a servo period,
             ``"raw"`` the plan's (q, q̇) as they are. Commands use the plan's nominal servo
             model; the servo itself follows ``cell.physics``.
@@ -163,8 +163,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
             rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
             flat above the table, :data:`SENSE_AFTER`) with the burger's centre measured in
-            the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planner.replan_flip`
-            (serve: :func:`flipkit.planning.serve.replan_serve`); the rest of the run
+            the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planners.planner.replan_flip`
+            (serve: :func:`flipkit.planning.planners.serve.replan_serve`); the rest of the run
             follows the returned plan, which must keep the segments up to then and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan

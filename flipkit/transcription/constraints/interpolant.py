@@ -16,7 +16,7 @@ Rows per interval: a_0 (nq), a_1 (nq), c (nq). Their coefficients are large (6/h
 rad at T = 0.6 s), so the rows are scaled by :data:`ACC_SCALE` and :data:`VEL_SCALE`; measured
 (session 9, cold flips at Table I locations 2, 6, 9): with the node rows' scale (0.1 and 1) the
 restoration QPs took 2–4 × the ADMM iterations of a flip without the rows, with 0.001 and
-0.01 1–2 ×. :func:`flipkit.planning.verify.verify_plan` checks them in the same scaled units.
+0.01 1–2 ×. :func:`flipkit.planning.plans.verify.verify_plan` checks them in the same scaled units.
 """
 
 from __future__ import annotations

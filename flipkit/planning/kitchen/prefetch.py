@@ -6,7 +6,7 @@ and each serve depends only on its flip's predicted landing and its table spot.
 :class:`PrefetchPlanners` submits every flip to an executor as soon as it is made, and each
 serve as soon as its flip's plan is in, with the spot the scheduler will give it when every
 serve succeeds and they come in drop order (the k-th burger dropped, the k-th spot). The
-scheduler (:func:`~flipkit.planning.schedule.schedule_cook`) asks for motions as before; a
+scheduler (:func:`~flipkit.planning.kitchen.schedule.schedule_cook`) asks for motions as before; a
 request whose job and start configuration match a prefetched one gets that plan, any other
 (a spot shifted by a failed serve, a start elsewhere) is planned on demand, in this process.
 
@@ -25,8 +25,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.planning.motions import MotionJob, PlannedMotion, default_planners
-from flipkit.planning.planner import REST_TOL
+from flipkit.planning.kitchen.motions import MotionJob, PlannedMotion, default_planners
+from flipkit.planning.planners.planner import REST_TOL
 
 
 def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str,
@@ -39,12 +39,12 @@ class PrefetchPlanners(Mapping):
     """Planners (by kind) that serve plans computed ahead on ``executor``.
 
     Args:
-        order: The cook's burgers (:class:`~flipkit.planning.cook.CookBurger`), checked.
+        order: The cook's burgers (:class:`~flipkit.planning.kitchen.cook.CookBurger`), checked.
         kinds: Motion kinds planned (``("flip",)`` or ``("flip", "serve")``).
         q_rest: The rest configuration every motion starts and ends at (rad).
         spots: Table spots (x, y) (m), handed out in drop order.
         executor: A :class:`concurrent.futures.Executor` (worker processes or Dask).
-        cell, solver, atlas: As :func:`~flipkit.planning.motions.default_planners`.
+        cell, solver, atlas: As :func:`~flipkit.planning.kitchen.motions.default_planners`.
     """
 
     def __init__(self, order, kinds, q_rest, spots, executor: cf.Executor,

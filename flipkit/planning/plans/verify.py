@@ -38,13 +38,13 @@ grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m): 
 placing            serve: the table spot on the table, and the rest point        1 mm
                    predicted from the place's end pose (FK) at the spot
                    (:func:`flipkit.behaviors.serve.predicted_rest`)
-landing            flip: landing recomputed (:mod:`flipkit.planning.verify_flight`):    0.1 mm,
+landing            flip: landing recomputed (:mod:`flipkit.planning.plans.verify_flight`):    0.1 mm,
                    within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
 flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
 arm_clearance      every link (URDF collision hull), the handle and the blade  tol
                    keep cell.space.margin (2 cm) from grill, table and walls,
                    but the pairs the segment exempts (clearance_excluded);
-                   coal distances, :mod:`flipkit.planning.verify_clearance` (m)
+                   coal distances, :mod:`flipkit.planning.plans.verify_clearance` (m)
 orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     tol
 singularity        q3 and q5 at every node within the band of q_home held      tol
                    SINGULARITY_MARGIN (0.2 rad) from sin q = 0: the planner's
@@ -59,7 +59,7 @@ duration bounds are today's specs' (``duration``): a plan written under other bo
 ``time_grid``.
 Task-space position, velocity and acceleration bounds (cell.limits) are not checked. The
 pitch range, the cell's boxes and margin and the side table come from the plan's
-``cell_geometry`` record (:mod:`flipkit.planning.cell_record`): ``arm_clearance``,
+``cell_geometry`` record (:mod:`flipkit.planning.plans.cell_record`): ``arm_clearance``,
 ``orientation`` and ``placing`` check against the cell the plan was made in (an older file
 without the record, against today's defaults of :class:`~flipkit.config.CellConfig`, as
 ``time_grid`` checks against today's duration bounds).
@@ -82,11 +82,11 @@ from flipkit.model.contact import make_cone
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.verify_clearance import CellGeometry, check_space
-from flipkit.planning.verify_flight import check_flight
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
+from flipkit.planning.plans.verify_flight import check_flight
 # the report's types, importable from here as before
-from flipkit.planning.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
+from flipkit.planning.plans.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
 from flipkit.errors import VerificationError
 from scipy.interpolate import CubicHermiteSpline
 

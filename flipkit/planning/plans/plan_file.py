@@ -12,7 +12,7 @@ The format is documented in ``docs/plan-format.md`` (JSON Schema beside it). Amo
 fields: ``segments[k].goal = {"p": [3], "o": [3]}`` — the end pose of a
 ``translate`` segment (optional) — and, on a flip segment, ``release`` (node, time) and the
 predicted ``landing`` (target, r_land, point, offset, tilt_deg, time_of_flight), checked by
-:mod:`flipkit.planning.verify`.
+:mod:`flipkit.planning.plans.verify`.
 """
 
 from __future__ import annotations
@@ -31,14 +31,14 @@ from flipkit.config import BurgerConfig, CellConfig, GrillConfig, RobotConfig, S
 from flipkit.model.contact import CONE_FORMS
 from flipkit.errors import ConfigError, PlanFileError
 from flipkit.fileio import OutputPathError, write_text
-from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
+from flipkit.planning.plans.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text, dumps)
-from flipkit.planning.segment import SEGMENT_KEYS, Segment, default_payload
-from flipkit.planning.cell_record import cell_geometry, geometry_configs
+from flipkit.planning.plans.segment import SEGMENT_KEYS, Segment, default_payload
+from flipkit.planning.plans.cell_record import cell_geometry, geometry_configs
 from flipkit.provenance import git_commit
 from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, urdf_sha256
 
-from flipkit.planning.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
+from flipkit.planning.plans.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
 from flipkit.model.robot import Robot
 PLAN_BEHAVIORS = tuple(BEHAVIORS)  # translate, flip, serve
 PLAN_STATUSES = ("solved", "failed")
@@ -201,7 +201,7 @@ class Plan:
     def from_segments(cls, behavior: str, cell: CellConfig, segments: list, *, location=None,
                       cone: str = "physical", status: str | None = None) -> "Plan":
         """A plan of ``segments`` planned in ``cell``; status ``solved`` if every segment's
-        solver says so (check it with :func:`flipkit.planning.verify.verify_plan` before writing)."""
+        solver says so (check it with :func:`flipkit.planning.plans.verify.verify_plan` before writing)."""
         robot = Robot(cell, with_burger=True)
         if status is None:
             status = "solved" if all(s.solver.status == "solved" for s in segments) else "failed"
@@ -220,7 +220,7 @@ class Plan:
     def cell(self) -> CellConfig:
         """The cell the plan was made in, rebuilt from the file: its grill and table, task-space
         limits, space limits and acceleration bound from ``cell_geometry`` (a file written
-        without it gets today's defaults for them, :mod:`flipkit.planning.cell_record`).
+        without it gets today's defaults for them, :mod:`flipkit.planning.plans.cell_record`).
 
         Raises:
             PlanFileError: The URDF is missing here, differs from the one the plan recorded

@@ -1,7 +1,7 @@
 """Solving a chain of segments: one segment with a solver, one with its duration bound
 stretched if need be, and the whole chain of any behaviour (:class:`Planner`), each segment
 from the previous one's final state (eq. 29), checked at the end
-(:func:`~flipkit.planning.verify.verify_plan`).
+(:func:`~flipkit.planning.plans.verify.verify_plan`).
 """
 
 from __future__ import annotations
@@ -18,21 +18,27 @@ from flipkit.behaviors.spec import Behavior, Task
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError, FlipkitError, InvalidChoiceError, SolverError
-from flipkit.planning.plan_file import Plan
-from flipkit.planning.segment import Segment
-from flipkit.planning.verify import verify_plan
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.segment import Segment
+from flipkit.planning.plans.verify import verify_plan
 from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
-from flipkit.solvers.ipopt import solve_ipopt
-from flipkit.solvers.sqp import solve_sqp
+
+
+# The IPOPT fallback of ``auto``: the slowest fallback that succeeded on the planner's segments
+# took ~45 s and 429 iterations (a cold pickup; docs/benchmarks/2026-11-25-goal-check.md), so
+# the budget keeps every success seen and bounds a hopeless one. An explicit ``ipopt`` keeps
+# IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
+# (flipkit.model.goal_check), so the fallback no longer spends its budget on them.
+FALLBACK_IPOPT = {"max_wall_time": 60.0, "max_iter": 1000}
 
 
 def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
 
-    ``auto`` runs the SQP and, when it fails, IPOPT from the same start; the segment's
-    ``solver.name`` in the plan file records which one produced it and the wall time counts
-    both.
+    ``auto`` runs the SQP and, when it fails, IPOPT from the same start within
+    :data:`FALLBACK_IPOPT`'s budget (60 s, 1000 iterations); the segment's ``solver.name`` in
+    the plan file records which one produced it and the wall time counts both.
 
     Returns the result whatever its status (``result.success`` tells); the worst constraint
     group of a failure is ``nlp.worst_group(result.x)``.
@@ -40,7 +46,10 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     Raises:
         InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
     """
+    # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
+    # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
     if solver == "sqp":
+        from flipkit.solvers.sqp import solve_sqp
 
         try:
             return solve_sqp(nlp, x0, raise_on_failure=False)
@@ -49,14 +58,15 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
             return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
                                objective=nlp.objective(x), max_violation=float(
                                    nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
+    if solver in ("ipopt", "auto"):
+        from flipkit.solvers.ipopt import IpoptOptions, solve_ipopt
     if solver == "ipopt":
-
         return solve_ipopt(nlp, x0, raise_on_failure=False)
     if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
         first = solve_segment(nlp, "sqp", x0)
         if first.success:
             return first
-        second = solve_segment(nlp, "ipopt", x0)
+        second = solve_ipopt(nlp, x0, IpoptOptions(**FALLBACK_IPOPT), raise_on_failure=False)
         second.wall_time_s += first.wall_time_s
         return second
     raise InvalidChoiceError("solver", solver, SOLVERS)
@@ -75,8 +85,13 @@ def finish_plan(plan: Plan, failure: str | None, t0: float, cell: CellConfig | N
 
 
 def solver_failure(name: str, nlp, result) -> str:
+    """One line: the segment, its worst constraint group and amount, the solver's status
+    (and the fallback's budget where IPOPT ran out of it)."""
     group, amount = nlp.worst_group(result.x)
-    return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status})"
+    budget = (f" after the fallback's budget of {FALLBACK_IPOPT['max_wall_time']:g} s or "
+              f"{FALLBACK_IPOPT['max_iter']} iterations" if result.status in (
+                  Status.MAXIMUM_WALLTIME_EXCEEDED, Status.MAXIMUM_ITERATIONS_EXCEEDED) else "")
+    return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status}{budget})"
 
 
 def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):

@@ -28,7 +28,7 @@ SECOND_SIDE_S = 60.0  # s on the second side (paper Sec. I)
 CSV_HEADER = ("burger", "t_drop", "x", "y")
 SPOT_GAP = 0.01  # m: clearance between served burgers and from the table's edge (ours)
 MAX_T_DROP = 24 * 3600.0  # s: latest drop time accepted (a day on the order's clock)
-EXAMPLE_ORDER = Path(__file__).resolve().parents[1] / "data" / "cook_five.csv"  # 5 in 20 s
+EXAMPLE_ORDER = Path(__file__).resolve().parents[2] / "data" / "cook_five.csv"  # 5 in 20 s
 
 
 class CookOrderError(ConfigError):

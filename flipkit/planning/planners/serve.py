@@ -3,8 +3,8 @@ table (:mod:`flipkit.behaviors.serve`), then return home.
 
 :func:`plan_serve` chains go to burger, scoop, pickup, carry, place and return home by (29) —
 each segment starts at the previous one's final (q, q̇) — and checks the plan independently
-(:func:`~flipkit.planning.verify.verify_plan`) like every planner entry point
-(:mod:`flipkit.planning.planner`): status ``solved`` only if every segment converged and the
+(:func:`~flipkit.planning.plans.verify.verify_plan`) like every planner entry point
+(:mod:`flipkit.planning.planners.planner`): status ``solved`` only if every segment converged and the
 check passes.
 """
 
@@ -23,10 +23,10 @@ from flipkit.behaviors.spec import Task
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
-from flipkit.planning.atlas import check_atlas, seeding
-from flipkit.planning.chain import Planner
-from flipkit.planning.inputs import check_on_blade, check_start
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.planners.atlas import check_atlas, seeding
+from flipkit.planning.planners.chain import Planner
+from flipkit.planning.planners.inputs import check_on_blade, check_start
+from flipkit.planning.plans.plan_file import Plan
 
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
@@ -48,16 +48,16 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             during the carry and place; default the blade centre (:func:`replan_serve`
             re-plans for a sensed one).
         options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
-        atlas: A pickup-and-flip :class:`~flipkit.planning.atlas.Atlas` built for ``cell``
+        atlas: A pickup-and-flip :class:`~flipkit.planning.planners.atlas.Atlas` built for ``cell``
             and ``options``: go to burger, scoop and pickup (the flip's first three
             segments, the same NLPs) start from its interpolated solutions, carry, place
             and return home from their own guesses; ``None`` (default): cold starts.
 
     Returns:
-        The :class:`~flipkit.planning.plan_file.Plan`, behaviour ``serve``: status
+        The :class:`~flipkit.planning.plans.plan_file.Plan`, behaviour ``serve``: status
         ``solved`` (verified) or ``failed`` with ``plan.failure`` one line; on a segment
         failure the chain stops there. ``plan.report`` and ``plan.wall_time_s`` (s) as
-        :func:`~flipkit.planning.planner.plan_flip`. It ends at q_home, at rest.
+        :func:`~flipkit.planning.planners.planner.plan_flip`. It ends at q_home, at rest.
 
     Raises:
         UnreachableError: Burger off the grill, spot off the table, or the place pose out of
@@ -87,7 +87,7 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
                  options: SegmentOptions = SegmentOptions()) -> Plan:
     """Re-plan place and return home of a solved serve plan for a burger measured at
     ``on_blade`` on the blade at the end of the carry (sense, plan, act; as
-    :func:`~flipkit.planning.planner.replan_flip`): the carry ends at rest with the blade flat
+    :func:`~flipkit.planning.planners.planner.replan_flip`): the carry ends at rest with the blade flat
     above the table, so the cell can measure where the burger lies on it and wait there while
     this runs. Go to burger, scoop, pickup and carry are kept; the place is moved so that the
     burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a

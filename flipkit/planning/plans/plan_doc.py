@@ -1,7 +1,7 @@
 """The cheap first reading of a plan file: a bounded regular file, JSON, an object with a
 known ``format`` and every top-level key — before anything heavy is imported (pinocchio,
 jsonschema), so a malformed file is refused at once. :meth:`Plan.load
-<flipkit.planning.plan_file.Plan.load>` starts here and checks the rest."""
+<flipkit.planning.plans.plan_file.Plan.load>` starts here and checks the rest."""
 
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ import numpy as np
 from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.behaviors.targets import Pose
 from flipkit.errors import ConfigError
-from flipkit.planning.json_fields import (check_array, check_choice, check_keys, check_nested,
+from flipkit.planning.plans.json_fields import (check_array, check_choice, check_keys, check_nested,
                                           check_number, check_text)
 
 def default_payload(name: str) -> list[str]:
@@ -88,7 +88,7 @@ class Segment:
         placing: Serve carry and place only: ``spot`` (x, y) on the table (m), ``on_blade``
             (x, y) (m, blade frame) where the burger was planned to sit, the blade's
             ``heading`` and ``pitch`` at the place's end (rad)
-            (:func:`flipkit.planning.serve.placing_record`).
+            (:func:`flipkit.planning.planners.serve.placing_record`).
     """
 
     name: str

@@ -1,10 +1,10 @@
 """The arm's motions in a cook, as the scheduler sees them, and the real planners behind them.
 
-The scheduler (:mod:`flipkit.planning.schedule`) does not call a planner directly: it is
+The scheduler (:mod:`flipkit.planning.kitchen.schedule`) does not call a planner directly: it is
 given a mapping from motion kind (``"flip"``, ``"serve"``) to a :class:`MotionPlanner`, a
 function ``(job, q_start) -> PlannedMotion``. :func:`default_planners` wires in the real
-ones: :func:`~flipkit.planning.planner.plan_flip` for ``"flip"`` and
-:func:`~flipkit.planning.serve.plan_serve` for ``"serve"``. Tests inject planners with fixed
+ones: :func:`~flipkit.planning.planners.planner.plan_flip` for ``"flip"`` and
+:func:`~flipkit.planning.planners.serve.plan_serve` for ``"serve"``. Tests inject planners with fixed
 durations.
 """
 
@@ -18,8 +18,8 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError
-from flipkit.planning.planner import plan_flip
-from flipkit.planning.serve import plan_serve
+from flipkit.planning.planners.planner import plan_flip
+from flipkit.planning.planners.serve import plan_serve
 
 KINDS = ("flip", "serve")
 
@@ -60,7 +60,7 @@ class PlannedMotion:
         landing: Flip only: the burger's predicted landing point (x, y) (m).
         plan: The plan (anything with ``to_json(path)``), or ``None``.
         failure: One line saying why it is not ``ok``.
-        ready_s: Planned ahead (:mod:`flipkit.planning.prefetch`): when the plan was in, in s
+        ready_s: Planned ahead (:mod:`flipkit.planning.kitchen.prefetch`): when the plan was in, in s
             from the start of planning; ``None``: planned on demand, in ``planning_time_s``.
     """
 
@@ -93,7 +93,7 @@ def _segment_start(plan, name: str) -> float:
 
 
 def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
-    """A :class:`~flipkit.planning.plan_file.Plan` as a :class:`PlannedMotion`.
+    """A :class:`~flipkit.planning.plans.plan_file.Plan` as a :class:`PlannedMotion`.
 
     The event of a flip is its predicted landing: flip segment start + release time + time
     of flight. The event of a serve is the start of its ``pickup`` segment: the scoop has
@@ -118,7 +118,7 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
 
 def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                  ) -> MotionPlanner:
-    """The real flip: :func:`~flipkit.planning.planner.plan_flip` from ``q_start``, landing
+    """The real flip: :func:`~flipkit.planning.planners.planner.plan_flip` from ``q_start``, landing
     where the burger was picked up (its default), warm-started from ``atlas`` if given."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
@@ -130,7 +130,7 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
 
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                   ) -> MotionPlanner:
-    """The real serve: :func:`~flipkit.planning.serve.plan_serve` from ``q_start`` to the
+    """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
     job's table spot; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to burger, scoop
     and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:

@@ -1,7 +1,7 @@
 """Resample a verified plan at a controller rate and write it as CSV.
 
 A controller only gets verified plans: :func:`write_csv` runs
-:func:`flipkit.planning.verify.verify_plan` first and writes nothing if the plan fails it
+:func:`flipkit.planning.plans.verify.verify_plan` first and writes nothing if the plan fails it
 (``--force`` waives the plan's *status*, never the verification).
 
 Within a segment the collocation fixes (q, q̇, q̈) at the nodes; between two consecutive
@@ -22,9 +22,9 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.errors import FlipkitError
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.plans.plan_file import Plan
 from flipkit.fileio import replace_with
-from flipkit.planning.verify import TOL, require_verified
+from flipkit.planning.plans.verify import TOL, require_verified
 
 MAX_ROWS = 10_000_000  # refuse absurd rates rather than fill the disk
 RATE_RANGE = (1.0, 10_000.0)  # Hz: controller rates accepted
@@ -93,7 +93,7 @@ def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float 
     Args:
         plan: The plan. path: Output CSV. rate: Controller rate (Hz).
         force: Export even a plan whose status is not ``solved`` (it must still verify).
-        tol: Verification tolerance (scaled units, :data:`flipkit.planning.verify.TOL`).
+        tol: Verification tolerance (scaled units, :data:`flipkit.planning.plans.verify.TOL`).
         where: How messages name the plan (its file); default ``"plan"``.
 
     Raises:

@@ -11,7 +11,7 @@ pinocchio.
 
 Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt short
 of :data:`TILT_MIN_DEG` (deg), and the recorded prediction against the recomputed one (point
-m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.verify.LANDING_TOL`).
+m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.plans.verify.LANDING_TOL`).
 Group ``landing_scenarios`` (robust flips): the same rows for every recorded scenario of the
 burger's place on the blade, each against its own ``r_land``. Group
 ``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes

@@ -207,7 +207,7 @@ def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
 
 
 def seeding(atlas, location):
-    """A :meth:`~flipkit.planning.chain.Planner.chain` ``guess`` from ``atlas`` for the
+    """A :meth:`~flipkit.planning.planners.chain.Planner.chain` ``guess`` from ``atlas`` for the
     burger at ``location``: the atlas's interpolated solution for the segments it holds
     (:data:`SEEDED`); ``None`` without an atlas."""
     if atlas is None:

@@ -1,4 +1,4 @@
-"""The result of :func:`flipkit.planning.verify.verify_plan`: per check group, the worst row
+"""The result of :func:`flipkit.planning.plans.verify.verify_plan`: per check group, the worst row
 relative to its tolerance, where it is, and whether the group passes."""
 
 from __future__ import annotations

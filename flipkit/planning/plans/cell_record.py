@@ -3,7 +3,7 @@
 A plan is checked against the cell it was made in: its grill and table areas, the task-space
 limits of Constraint 1, the whole arm's clearance margin and the walls (issue 13), and the
 joint acceleration bound. The file records them so that ``flipkit verify`` and
-:meth:`~flipkit.planning.plan_file.Plan.cell` rebuild that cell, not today's defaults. Files
+:meth:`~flipkit.planning.plans.plan_file.Plan.cell` rebuild that cell, not today's defaults. Files
 written before this record (``cell_geometry`` absent) are read with the defaults.
 
 Layout (lengths m, angles rad, velocities m/s, accelerations m/s² or rad/s²)::

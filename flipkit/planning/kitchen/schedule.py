@@ -4,7 +4,7 @@ Every burger is dropped at ``t_drop``, must land on its second side at its 90 s 
 (``t_drop`` + 90 s) and leave the grill once its second side has cooked 60 s
 (``flip_time`` + 60 s, which is its 150 s mark when it was flipped on time). The arm is one
 resource; each burger needs two motions on it, a flip and then a serve
-(:mod:`flipkit.planning.motions`).
+(:mod:`flipkit.planning.kitchen.motions`).
 
 Policy — earliest deadline first, one arm, no early starts:
 
@@ -24,7 +24,7 @@ Lateness, reported per burger: landing − (``t_drop`` + 90 s) and lift-off − 
 Planning runs ahead of execution: the motions are planned one after another, in the order
 above, on a planning clock that starts at ``plan_start`` (default: the first drop). A
 motion's plan is ready at ``planned_at`` = ``plan_start`` + the planning times so far (or,
-planned ahead in parallel worker processes by :mod:`flipkit.planning.prefetch`, + when its
+planned ahead in parallel worker processes by :mod:`flipkit.planning.kitchen.prefetch`, + when its
 plan was in); its slack = (when the arm would start it: free and due) − ``planned_at``. A negative slack
 means planning fell behind: the motion then waits for its plan and its lateness shows it.
 
@@ -50,9 +50,9 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.planning.cook import SECOND_SIDE_S, CookBurger, check_cook, table_spots
-from flipkit.planning.planner import REST_TOL
-from flipkit.planning.motions import (KINDS, MissingPlannerError, MotionJob,
+from flipkit.planning.kitchen.cook import SECOND_SIDE_S, CookBurger, check_cook, table_spots
+from flipkit.planning.planners.planner import REST_TOL
+from flipkit.planning.kitchen.motions import (KINDS, MissingPlannerError, MotionJob,
                                      MotionPlanner)
 from tqdm import tqdm
 
@@ -179,16 +179,16 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
     """Order, time and plan the arm's motions for a cook order (policy: module docstring).
 
     Args:
-        burgers: :class:`~flipkit.planning.cook.CookBurger` rows (checked with
-            :func:`~flipkit.planning.cook.check_cook`).
-        planners: Motion kind → :class:`~flipkit.planning.motions.MotionPlanner`
-            (:func:`~flipkit.planning.motions.default_planners` for the real ones).
+        burgers: :class:`~flipkit.planning.kitchen.cook.CookBurger` rows (checked with
+            :func:`~flipkit.planning.kitchen.cook.check_cook`).
+        planners: Motion kind → :class:`~flipkit.planning.kitchen.motions.MotionPlanner`
+            (:func:`~flipkit.planning.kitchen.motions.default_planners` for the real ones).
         q_start: Configuration (rad) the arm rests at before the first motion.
         kinds: Motions to plan: ``("flip", "serve")`` (the cook) or ``("flip",)`` (flips
             only; burgers are left on the grill and ``serve_time`` stays ``None``).
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
         spots: Table spots (x, y) (m), taken in serve order (default
-            :func:`~flipkit.planning.cook.table_spots`).
+            :func:`~flipkit.planning.kitchen.cook.table_spots`).
         plan_start: When planning begins (s, order clock); default the first drop.
         progress: Show a tqdm progress bar (stderr), one step per motion.
 

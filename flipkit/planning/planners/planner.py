@@ -1,9 +1,9 @@
 """Planning front end: translate, pickup-and-flip and batches of burgers, checked plans.
 
-Each entry point chains a behaviour's segments with a :class:`~flipkit.planning.chain.Planner`
+Each entry point chains a behaviour's segments with a :class:`~flipkit.planning.planners.chain.Planner`
 (specs of :mod:`flipkit.behaviors.library`, solved with the SQP or IPOPT), wraps them in a
-:class:`~flipkit.planning.plan_file.Plan` and runs the independent check
-:func:`~flipkit.planning.verify.verify_plan`. A plan's ``status`` is
+:class:`~flipkit.planning.plans.plan_file.Plan` and runs the independent check
+:func:`~flipkit.planning.plans.verify.verify_plan`. A plan's ``status`` is
 ``"solved"`` only if every segment's solver converged *and* the check passes; otherwise it
 is ``"failed"`` and the attribute ``plan.failure`` (not written to the file) holds a one-line
 reason, e.g. ``"pickup: cone violated by 3.2e-04 (sqp: stalled)"``. Every plan returned also
@@ -30,11 +30,12 @@ from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import flat_pose
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
+from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
-from flipkit.planning.atlas import check_atlas, seeding
-from flipkit.planning.chain import Planner
-from flipkit.planning.inputs import check_joint_vector, check_on_blade, check_position, check_start
-from flipkit.planning.plan_file import Plan
+from flipkit.planning.planners.atlas import check_atlas, seeding
+from flipkit.planning.planners.chain import Planner
+from flipkit.planning.planners.inputs import check_joint_vector, check_on_blade, check_position, check_start
+from flipkit.planning.plans.plan_file import Plan
 
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
@@ -84,11 +85,16 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
             if gap > 1e-3:
                 raise ConfigError(f"start configuration puts the blade {gap * 1e3:.1f} mm from "
                                   "the start position; give one of them")
+    o = planner.options
+    try:  # every IK branch against the NLP's joint bounds and the cell, before any NLP (~1 ms)
+        check_goal(robot, planner.models.shapes, cell, p_goal, (0.0, 0.0, yaw), q_start=q0,
+                   singularity_margin=o.singularity_margin, clearance=o.arm_clearance)
+    except UnreachableError as exc:
+        raise UnreachableError(f"translate {exc}") from None  # "translate goal (...): ..."
     try:
-        solve_pose(robot, p_goal, (0.0, 0.0, yaw), q0)  # reachability, clear message
         return planner.chain("translate", Task(goal=flat_pose(p_goal, yaw)), q0,
                              np.zeros(robot.nq), t0=t0)
-    except UnreachableError as exc:
+    except UnreachableError as exc:  # the initial guess's IK can still fail
         raise UnreachableError(f"translate goal: {exc}") from None
 
 
@@ -110,7 +116,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
             (:func:`~flipkit.behaviors.pick.scoop_scenarios`) says the planned scoop leaves it, and with
             ``options.robust`` every scenario of its spread lands too.
         cell, solver, options: As :func:`plan_translate`.
-        atlas: A warm-start :class:`~flipkit.planning.atlas.Atlas` built for ``cell`` and
+        atlas: A warm-start :class:`~flipkit.planning.planners.atlas.Atlas` built for ``cell`` and
             ``options``: each segment starts from the atlas's interpolated solution (and
             from its own initial guess if that fails); ``None`` (default): cold starts.
 
@@ -205,7 +211,7 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
     """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
 
     Burger k starts where the last *solved* plan ended (a solved flip ends at q_home at
-    rest, and an end within :data:`~flipkit.planning.motions.REST_TOL` of it is taken as
+    rest, and an end within :data:`~flipkit.planning.kitchen.motions.REST_TOL` of it is taken as
     q_home itself); a failed plan is not executed, so it does not move the start of the next
     one. Since every solved plan ends at q_home, the burgers after the first are independent:
     with an ``executor`` (worker processes or Dask) they are planned at once, from q_home, and

@@ -1,0 +1,94 @@
+"""The replan latency of sense-plan-act: ``replan_flip`` after the scoop, timed alone.
+
+In sense-plan-act the arm holds at rest after the scoop while the planner re-plans the flip
+for where the camera saw the burger on the blade
+(:func:`~flipkit.planning.planners.planner.replan_flip`). This benchmark takes the sensed
+places of a ``flipkit validate --replan --json`` run (or makes one: Table I, position mode,
+open loop otherwise as validated), plans each location as the validation did (from the
+package's atlas), and times ``replan_flip`` for every sensed place in this process, one
+after the other on an otherwise idle machine. It prints the median and the worst, and how
+many places the robust plan already covered (no solve).
+
+Run as ``python -m flipkit.experiments.bench replan [--validate FILE]``.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from flipkit.config import TABLE1_LOCATIONS
+from flipkit.errors import FlipkitError
+from flipkit.experiments.trials import validate_locations
+from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.planner import covers, plan_flip, replan_flip
+
+TARGET_S = 0.15  # s, the latency the sense-plan-act cycle is to stay within
+
+
+def sensed_places(result: dict) -> list[tuple[tuple, list]]:
+    """``[(location, [sensed (x, y) ...]) ...]`` from a validate result with ``replan``."""
+    out = []
+    for entry in result["locations"]:
+        sensed = [row["replan"]["sensed_on_blade"] for row in entry.get("landings", ())
+                  if row.get("replan") and row["replan"].get("sensed_on_blade") is not None]
+        if sensed:
+            out.append((tuple(entry["location"]), sensed))
+    if not out:
+        raise FlipkitError("the validate result records no sensed place on the blade: run "
+                           "`flipkit validate --replan --json FILE` first")
+    return out
+
+
+def run_validation(trials: int = 3, seed: int = 3) -> dict:
+    """Table I, ``trials`` per location, position mode, sense-plan-act, two workers."""
+    with ProcessPoolExecutor(2) as pool:
+        return validate_locations(TABLE1_LOCATIONS, trials, seed=seed, mode="position",
+                                  replan=True, executor=pool, progress=False)
+
+
+def bench_replan(result: dict) -> dict:
+    """Time ``replan_flip`` at every sensed place of ``result``; print; return the rows."""
+    atlas, rows = default_atlas(), []
+    print(f"{'location (m)':<24}{'sensed (mm)':>16}{'covered':>9}{'replan s':>10}{'status':>8}")
+    for loc, places in sensed_places(result):
+        plan = plan_flip(loc, atlas=atlas)
+        if plan.status != "solved":
+            print(f"{str(loc):<24} plan failed: {plan.failure}")
+            continue
+        landing = next(s for s in plan.segments if s.name == "flip").landing
+        for xy in places:
+            t0 = time.perf_counter()
+            new = replan_flip(plan, xy)
+            dt = time.perf_counter() - t0
+            row = {"location": loc, "sensed": list(xy), "covered": covers(landing, xy),
+                   "time_s": dt, "status": new.status}
+            rows.append(row)
+            print(f"{'(' + ', '.join(f'{v:.3f}' for v in loc) + ')':<24}"
+                  f"{f'({1e3 * xy[0]:.1f}, {1e3 * xy[1]:.1f})':>16}{str(row['covered']):>9}"
+                  f"{dt:10.3f}{new.status:>8}", flush=True)
+    times = np.array([r["time_s"] for r in rows])
+    solved = np.array([r["time_s"] for r in rows if not r["covered"]])
+    summary = {"replans": len(rows), "covered": int(sum(r["covered"] for r in rows)),
+               "solved_ok": int(sum(r["status"] == "solved" for r in rows)),
+               "median_s": float(np.median(times)), "worst_s": float(times.max()),
+               "median_solving_s": float(np.median(solved)) if solved.size else None,
+               "within_target": int(np.sum(times <= TARGET_S)), "target_s": TARGET_S}
+    print(f"{summary['replans']} replans, {summary['covered']} covered by the robust plan (no "
+          f"solve), {summary['solved_ok']} solved; latency median {summary['median_s']:.3f} s, "
+          f"worst {summary['worst_s']:.3f} s, median when solving "
+          f"{summary['median_solving_s'] or float('nan'):.3f} s; "
+          f"{summary['within_target']}/{len(rows)} within {TARGET_S} s")
+    return {"rows": rows, "summary": summary}
+
+
+def load_result(path: str) -> dict:
+    """A validate JSON, or a one-line FlipkitError."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise FlipkitError(f"{path}: cannot read a validate result ({exc})") from None
