@@ -14,9 +14,13 @@ from flipkit.experiments.trials import landing_target
 from flipkit.planning.plans.verify import verify_plan
 
 
+def always_replan(plan, on_blade):
+    return replan_flip(plan, on_blade, keep=False)
+
+
 @pytest.fixture(scope="module")
 def replanned(flip_plan):
-    return execute_plan(flip_plan, "feedforward", replan=replan_flip)
+    return execute_plan(flip_plan, "feedforward", replan=always_replan)
 
 
 def test_replanned_flip_is_verified_and_made_for_the_sensed_burger(flip_plan, replanned):

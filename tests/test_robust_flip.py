@@ -267,3 +267,25 @@ def test_validate_command_line_takes_the_command_stream(flip_plan_file, tmp_path
     action = next(a for sub in parser._subparsers._group_actions
                   for a in sub.choices["validate"]._actions if a.dest == "command")
     assert tuple(action.choices) == COMMANDS  # the CLI offers exactly the library's streams
+
+
+def test_a_place_the_plan_already_lands_needs_no_replan(flip_plan):
+    """Outside the scenarios' hull, the plan's own release and flight decide: a place it
+    lands within r_scenario keeps the plan, one it misses by more is solved again."""
+    from flipkit.behaviors.models import models_for
+    from flipkit.planning.planners.planner import covers, landing_miss, replan_flip
+
+    models = models_for(flip_plan.cell())
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    nominal = np.asarray(flip.landing["burger_on_blade"])
+    recorded = np.hypot(*(np.asarray(flip.landing["point"][:2]) - flip.landing["target"]))
+    assert landing_miss(flip, nominal, models) == pytest.approx(recorded, abs=1e-4)
+    for row in flip.landing["scenarios"]:  # each scenario within its promise
+        assert landing_miss(flip, row["burger_on_blade"], models) <= row["r_land"] + 1e-4
+    r = max(row["r_land"] for row in flip.landing["scenarios"])
+    near = nominal + (0.0, 0.012)  # outside the hull (y spread ±2σ), landed within r
+    assert not covers(flip.landing, near) and landing_miss(flip, near, models) <= r
+    assert replan_flip(flip_plan, near) is flip_plan
+    far = nominal - (0.06, 0.0)  # 6 cm further back: it lands short by more than r
+    assert landing_miss(flip, far, models) > r
+    assert replan_flip(flip_plan, near, keep=False) is not flip_plan

@@ -17,6 +17,7 @@ before anything is solved.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
@@ -36,6 +37,7 @@ from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import check_joint_vector, check_on_blade, check_position, check_start
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.verify_flight import TILT_MIN_DEG, recompute_landing
 
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
@@ -156,8 +158,19 @@ def covers(landing: dict, on_blade) -> bool:
     return bool(hull.find_simplex(np.asarray(on_blade, float)[:2]) >= 0)
 
 
+def landing_miss(flip, on_blade, models) -> float:
+    """How far (m) the solved ``flip`` segment lands a burger lying at ``on_blade`` (x, y)
+    (m, blade frame) from its target: its own release state and a ballistic flight
+    (:func:`~flipkit.planning.plans.verify_flight.recompute_landing`); ``inf`` when the
+    burger would not land upside down or has no release."""
+    pred = recompute_landing(models.loaded, flip, models.cell, on_blade)
+    if pred is None or pred["tilt_deg"] < TILT_MIN_DEG:
+        return math.inf
+    return float(np.hypot(*(pred["point"][:2] - np.asarray(flip.landing["target"], float))))
+
+
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
-                options: SegmentOptions = SegmentOptions()) -> Plan:
+                options: SegmentOptions = SegmentOptions(), keep: bool = True) -> Plan:
     """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
     ``on_blade`` on the blade after the scoop (sense, plan, act).
 
@@ -170,14 +183,18 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     burger moved by centimetres on the blade: the old flip is close to the new one); the result
     is checked like any plan.
 
-    A robust plan already lands every place of the burger within the convex hull of its
-    scenarios (the landing is close to affine in that place over centimetres, and each corner
-    lands within ``r_scenario``): when the measured place lies in that hull the plan is
-    returned as it is, with no solve (:func:`covers`).
+    A robust plan promises a landing within ``r_scenario`` of the spot for every scenario of
+    the burger's place. The plan is returned as it is, with no solve, when the measured place
+    keeps that promise: it lies in the convex hull of the scenarios (the landing is close to
+    affine in that place over centimetres, :func:`covers`), or the plan's own release and
+    flight land it within ``r_scenario`` (:func:`landing_miss`). A plan without scenarios is
+    kept only when the measured place lands within its ``r_land``.
 
     Args:
         plan: A solved flip plan. on_blade: (x, y) of the burger's centre in the blade frame
             (m). solver, options: As :func:`plan_flip` (``r_land`` from the plan's landing).
+        keep: Return ``plan`` itself where it already lands the measured place (default);
+            ``False`` always solves.
 
     Raises:
         ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
@@ -190,7 +207,10 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     on_blade = check_on_blade(on_blade, cell)
     planner = Planner(cell, solver=solver,
                       options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
-    if covers(flip.landing, on_blade):
+    radius = max((row["r_land"] for row in flip.landing.get("scenarios", ())),
+                 default=flip.landing["r_land"])
+    if keep and (covers(flip.landing, on_blade)
+                 or landing_miss(flip, on_blade, planner.models) <= radius):
         return plan
     done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
     before = {s.name: s for s in plan.segments}
@@ -292,5 +312,5 @@ def format_summary(rows) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "plan_batch",
-           "plan_flip", "plan_translate", "replan_flip", "summary_table"]
+__all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "landing_miss",
+           "plan_batch", "plan_flip", "plan_translate", "replan_flip", "summary_table"]

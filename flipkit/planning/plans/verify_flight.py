@@ -22,11 +22,12 @@ from __future__ import annotations
 
 import math
 
+import coal
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
+
 from flipkit.model.collision import pin_box_support
-import coal
 
 TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
 _LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
