@@ -32,9 +32,9 @@ stays hard:
                                                           box_lo ≤ T v ≤ box_hi
 
 The full-space elastic QP (:mod:`flipkit.solvers.full_qp`) also softens the equality rows; it
-stays the fallback when the hard equalities and the box are incompatible. Measured on the cold
-Table I flips (session 13): the full-space restoration QPs took 65–130 ms each (530–1 200 ADMM
-iterations on ~550 variables, their slacks and every row), two or three per cold flip.
+stays the fallback when the hard equalities and the box are incompatible. The full-space
+restoration QP runs ADMM on ~550 variables, their slacks and every row, and costs an order of
+magnitude more than the condensed one (docs/history.md).
 """
 
 from __future__ import annotations

@@ -117,7 +117,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
             # certificate (measured): confirm it cold. A later try starts from this
             # subproblem's own previous try; confirming those never reversed a verdict on the
             # 20 Table I chains (cold and from the atlas: the same plans) and cost 5–7 % of
-            # their CPU time (measured, session 11).
+            # their CPU time.
             qp.cold()
             sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
             admm += sol.iterations
@@ -318,9 +318,8 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
             # Stationary but a hair outside (the Gauss–Newton tail converges linearly on
             # curved active rows): Newton corrections onto the violated rows, first holding
             # the subproblem's active rows at their bounds, as the line search's correction
-            # does (see newton_correction), else not. Measured (session 8, from the atlas):
-            # Table I location 10 in 39 SQP iterations instead of 42, and the five-burger
-            # schedule planned in 13.8–14.0 s instead of 14.5–16.3 s.
+            # does (see newton_correction), else not: the tail then takes a few iterations
+            # fewer.
             for _ in range(3):
                 q = held(p)
                 if q.v.sum() >= p.v.sum():
