@@ -10,7 +10,7 @@ import pytest
 
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.cli import main
-from flipkit.cli.plan import read_locations
+from flipkit.cli.commands.plan import read_locations
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
 from flipkit.planning.plans.plan_file import Plan

@@ -215,7 +215,7 @@ def test_t_drop_is_bounded(tmp_path, capsys):
 
 
 def test_yaw_is_wrapped():
-    from flipkit.cli.plan import _yaw
+    from flipkit.cli.commands.plan import _yaw
 
     assert _yaw("6.283185307") == pytest.approx(0.0, abs=1e-9)
     assert _yaw(str(math.pi)) == pytest.approx(math.pi)
@@ -231,7 +231,7 @@ def test_a_burger_height_off_the_grill_states_the_tolerance(tmp_path, capsys):
 
 def test_the_height_tolerance_is_the_planners(cell):
     from flipkit.behaviors.targets import check_location
-    from flipkit.cli.plan import BURGER_HEIGHT_TOL
+    from flipkit.cli.commands.plan import BURGER_HEIGHT_TOL
     from flipkit.errors import UnreachableError
 
     h = cell.grill.height

@@ -1,10 +1,19 @@
-"""The package's layers: no module imports a module of a higher layer (README, "Layers").
+"""The package's structure (docs/architecture.md, "Layers" and "One concept per module"):
 
-Every import is read from the source with ``ast`` — at module level and inside functions
-alike (a lazy import that runs up a layer is still a dependency on that layer).
+* no module imports a module of a higher layer;
+* no import cycle between modules;
+* no private name (leading underscore) imported from another module;
+* function-local imports only where a heavy optional dependency needs them, at most
+  :data:`MAX_LOCAL_IMPORTS` in the package.
+
+Every import is read from the source with ``ast`` — at module level and inside functions alike
+(a lazy import that runs up a layer, or closes a cycle, is still a dependency).
 """
 
+from __future__ import annotations
+
 import ast
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -26,6 +35,8 @@ LAYERS = (
     ("cli", "__main__"),
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
+MAX_LOCAL_IMPORTS = 15  # function-local imports in the whole package
+RESTRUCTURING = pytest.mark.xfail(strict=False, reason="planning/ restructuring in progress")
 
 
 def layer_of(module: str) -> str:
@@ -40,29 +51,136 @@ def module_name(path: Path) -> str:
     return ".".join(parts)
 
 
-def imports(path: Path) -> list[tuple[int, str]]:
-    """(line, absolute module) of every flipkit import in the file."""
+FILES = sorted(PACKAGE.rglob("*.py"))
+MODULES = {module_name(f) for f in FILES}
+
+
+@dataclass(frozen=True)
+class Import:
+    """One name brought in by an import statement of a flipkit module.
+
+    ``target`` is the flipkit module the name comes from — the submodule itself for
+    ``from flipkit.x import y`` when ``y`` is a module — and ``name`` the imported attribute
+    (``None`` for a module). ``local``: inside a function. ``typing_only``: under
+    ``if TYPE_CHECKING:`` (never executed).
+    """
+
+    line: int
+    target: str
+    name: str | None
+    local: bool
+    typing_only: bool
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def _statements(tree: ast.AST):
+    """(import statement, inside a function, under ``if TYPE_CHECKING``) of every import."""
+    def walk(node, local, typing_only):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.Import, ast.ImportFrom)):
+                yield child, local, typing_only
+            in_function = isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            guarded = isinstance(child, ast.If) and _is_type_checking(child.test)
+            if guarded:  # the else branch runs
+                for stmt in child.body:
+                    yield from walk(ast.Module(body=[stmt], type_ignores=[]), local, True)
+                for stmt in child.orelse:
+                    yield from walk(ast.Module(body=[stmt], type_ignores=[]), local,
+                                    typing_only)
+                continue
+            yield from walk(child, local or in_function, typing_only)
+
+    yield from walk(tree, False, False)
+
+
+def _resolve(dotted: str) -> str:
+    """The longest prefix of ``dotted`` that is a module of the package."""
+    while dotted not in MODULES and "." in dotted:
+        dotted = dotted.rpartition(".")[0]
+    return dotted
+
+
+def flipkit_imports(path: Path) -> list[Import]:
+    """Every flipkit name imported by the file, with the module it comes from."""
     mod = module_name(path)
     package = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
     out = []
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                target = ".".join(base + ([node.module] if node.module else []))
-            else:
-                target = node.module or ""
-            if target == "flipkit":  # from flipkit import x: x may be a subpackage
-                out += [(node.lineno, f"flipkit.{a.name}") if f"{a.name}" in RANK
-                        else (node.lineno, "flipkit") for a in node.names]
-            elif target.startswith("flipkit."):
-                out.append((node.lineno, target))
-        elif isinstance(node, ast.Import):
-            out += [(node.lineno, a.name) for a in node.names if a.name.startswith("flipkit")]
+    for node, local, typing_only in _statements(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out += [Import(node.lineno, _resolve(a.name), None, local, typing_only)
+                    for a in node.names if a.name.split(".")[0] == "flipkit"]
+            continue
+        if node.level:
+            base = package.split(".")[: len(package.split(".")) - node.level + 1]
+            target = ".".join(base + ([node.module] if node.module else []))
+        else:
+            target = node.module or ""
+        if target.split(".")[0] != "flipkit":
+            continue
+        for a in node.names:
+            sub = f"{target}.{a.name}"
+            out.append(Import(node.lineno, sub, None, local, typing_only) if sub in MODULES
+                       else Import(node.lineno, _resolve(target), a.name, local, typing_only))
     return out
 
 
-FILES = sorted(PACKAGE.rglob("*.py"))
+def imports(path: Path) -> list[tuple[int, str]]:
+    """(line, absolute module) of every flipkit import in the file."""
+    return [(i.line, i.target) for i in flipkit_imports(path)]
+
+
+def local_imports(path: Path) -> list[int]:
+    """Lines of the import statements (of any package) inside a function of the file."""
+    return [node.lineno for node, local, _ in _statements(ast.parse(path.read_text())) if local]
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module → the other flipkit modules it imports when it runs (``TYPE_CHECKING`` imports
+    are annotations, not dependencies)."""
+    return {module_name(f): {i.target for i in flipkit_imports(f)
+                             if not i.typing_only and i.target != module_name(f)}
+            for f in FILES}
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan), each sorted."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(out)
+
+
+def private(name: str | None) -> bool:
+    """A leading underscore, dunders (``__version__``) excepted."""
+    return bool(name) and name.startswith("_") and not (name.startswith("__")
+                                                        and name.endswith("__"))
 
 
 def test_every_module_belongs_to_a_declared_layer():
@@ -88,7 +206,48 @@ def test_the_checker_catches_an_upward_import(tmp_path, monkeypatch):
     assert RANK[layer_of(found[0][1])] > RANK[layer_of(module_name(fake))]
 
 
-def test_no_module_exceeds_400_lines():
-    long = {str(f.relative_to(PACKAGE)): n for f in FILES
-            if (n := len(f.read_text().splitlines())) > 400}
-    assert not long, f"modules over 400 lines: {long}"
+@RESTRUCTURING
+def test_no_import_cycles_between_modules():
+    found = cycles(import_graph())
+    assert not found, "import cycles: " + "; ".join(" <-> ".join(c) for c in found)
+
+
+@RESTRUCTURING
+def test_no_private_name_is_imported_across_modules():
+    bad = [f"{f.relative_to(PACKAGE.parent)}:{i.line}: {i.name} from {i.target}"
+           for f in FILES for i in flipkit_imports(f)
+           if private(i.name) and i.target != module_name(f)]
+    assert not bad, "private names imported from another module: " + "; ".join(bad)
+
+
+@RESTRUCTURING
+def test_function_local_imports_are_few():
+    """Only a heavy optional dependency (MuJoCo, Dask, papermill, matplotlib on a CLI path,
+    ...) justifies an import inside a function; everything else is imported at the top."""
+    found = [f"{f.relative_to(PACKAGE.parent)}:{line}" for f in FILES for line in local_imports(f)]
+    assert len(found) <= MAX_LOCAL_IMPORTS, (
+        f"{len(found)} function-local imports (at most {MAX_LOCAL_IMPORTS}): " + ", ".join(found))
+
+
+def test_the_checkers_catch_a_cycle_a_private_import_and_a_local_import(monkeypatch):
+    """Planted sources: a cycle through a submodule import, a private name and two local
+    imports are reported; a TYPE_CHECKING import and a dunder are not (the tests can fail)."""
+    sources = {
+        PACKAGE / "model" / "robot.py":
+            "from flipkit.model import bezier\nfrom flipkit.model.contact import _helper\n"
+            "from flipkit import __version__\n"
+            "def f():\n    import mujoco\n    def g():\n        from flipkit.errors import X\n",
+        PACKAGE / "model" / "bezier.py":
+            "import flipkit.model.robot\nfrom typing import TYPE_CHECKING\n"
+            "if TYPE_CHECKING:\n    from flipkit.model.ik import solve_pose\n",
+        PACKAGE / "model" / "ik.py": "from flipkit.model.bezier import Bezier\n",
+    }
+    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: sources[self])
+    graph = {module_name(p): {i.target for i in flipkit_imports(p) if not i.typing_only}
+             for p in sources}
+    assert cycles(graph) == [["flipkit.model.bezier", "flipkit.model.robot"]]
+    robot = flipkit_imports(PACKAGE / "model" / "robot.py")
+    assert [i.name for i in robot if private(i.name)] == ["_helper"]
+    assert local_imports(PACKAGE / "model" / "robot.py") == [5, 7]
+    assert [i.typing_only for i in flipkit_imports(PACKAGE / "model" / "bezier.py")] == [
+        False, True]

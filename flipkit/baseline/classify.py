@@ -36,7 +36,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from scipy.interpolate import CubicHermiteSpline
 
+from flipkit.baseline.ee_opt import sample_times
 from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
@@ -308,10 +310,6 @@ class BaselineResult:
 def resample_segment(seg, rate: float = 500.0):
     """A plan segment at ``rate`` Hz as the controller follows it: (t (s), q (rad)), the cubic
     Hermite interpolant of the nodes' (q, q̇) (:mod:`flipkit.simulation.execute`)."""
-    from scipy.interpolate import CubicHermiteSpline
-
-    from flipkit.baseline.ee_opt import sample_times
-
     t = sample_times(seg.T, rate)
     return t, CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(t)
 

@@ -56,7 +56,8 @@ from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.options import MU_SAFETY, RELEASE_FRACTION, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
-from flipkit.baseline.scp_problem import ORIENTATION_WEIGHT, REST, SCPProblem
+from flipkit.baseline.scp_problem import (ACC_WEIGHT, COST_SCALE, ORIENTATION_WEIGHT, REST,
+                                          SCPProblem)
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.guesses import flip_guess_pose
 from flipkit.config import CellConfig
@@ -190,7 +191,6 @@ def _objective(B, C, D, T, w_o) -> float:
     ds = 1.0 / (len(B[0]) - 1)
     acc = lambda X: ds / T**3 * np.sum((B[2] @ X) ** 2)  # noqa: E731
     jerk = lambda X: ds / T**5 * np.sum((B[3] @ X) ** 2)  # noqa: E731
-    from flipkit.baseline.scp_problem import ACC_WEIGHT, COST_SCALE
     return COST_SCALE * (jerk(C) + ACC_WEIGHT * acc(C) + w_o * (jerk(D) + ACC_WEIGHT * acc(D)))
 
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+import placo
 
 from flipkit.errors import ConfigError
 from flipkit.model.robot import SPATULA_FRAME, Robot
@@ -69,8 +70,6 @@ class PlacoTracker:
 
     def __init__(self, robot: Robot, iterations: int = 3, velocity_limits: bool = True,
                  w_pos: float = 1.0, w_ori: float = 1.0):
-        import placo
-
         if int(iterations) != iterations or iterations < 1:
             raise ConfigError(f"IK iterations must be a positive integer, got {iterations!r}")
         for name, w in (("w_pos", w_pos), ("w_ori", w_ori)):

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import argparse
 import os
-from pathlib import Path
+
+from flipkit.cli.common import check_float, check_int, deferred, precheck_plan
+from flipkit.fileio import check_output
 
 MODES = ("feedforward", "position")  # flipkit.simulation.execute.MODES (checked in tests)
 FORMATS = (".gif", ".mp4")  # flipkit.simulation.animate.FORMATS (checked in tests)
@@ -43,10 +45,8 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the outputs and options, load and verify the plan, simulate, render, write."""
-    from flipkit.cli.common import check_float, check_int, precheck_plan
-    from flipkit.fileio import check_output, replace_with
-
+    """Check the outputs, the options and the file cheaply, then load and verify the plan,
+    simulate, render and write (:mod:`flipkit.cli.commands.animate`)."""
     check_output(args.out, "--out", FORMATS, inputs=[args.plan])
     if args.filmstrip:
         check_output(args.filmstrip, "--filmstrip", (".png",), inputs=[args.plan],
@@ -56,21 +56,4 @@ def run(args: argparse.Namespace) -> int:
     check_int("--height", args.height, *SIZE_RANGE)
     precheck_plan(args.plan)
     os.environ.setdefault("MUJOCO_GL", "osmesa")  # before anything imports mujoco
-    from flipkit.simulation.animate import write_animation, write_filmstrip
-    from flipkit.simulation.execute import execute_plan
-    from flipkit.planning.plans.verify import load_verified
-
-    plan = load_verified(args.plan, ("flip",))
-    replan = None
-    if args.replan:
-        from flipkit.planning.planners.planner import replan_flip
-
-        replan = replan_flip
-    ex = execute_plan(plan, args.mode, replan=replan)
-    out = replace_with(args.out, lambda tmp: write_animation(
-        ex, tmp, args.fps, args.width, args.height, progress=not args.no_progress))
-    if args.filmstrip:
-        replace_with(args.filmstrip, lambda tmp: write_filmstrip(ex, tmp))
-    print(f"flipkit animate: {args.mode} execution, {ex.run.t[-1]:.2f} s, wrote {out}"
-          + (f" and {args.filmstrip}" if args.filmstrip else ""))
-    return 0
+    return deferred("animate")(args)

@@ -1,14 +1,18 @@
 """Options, bounds and file helpers shared by the sub-commands: the sweep options
 (compare-ik, validate), numeric options checked against their documented ranges, the cheap
-first reading of a plan file, and JSON written atomically."""
+first reading of a plan file, JSON written atomically, and the deferred import of a
+sub-command's work (:func:`deferred`)."""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import math
 
 from flipkit.errors import ConfigError
+from flipkit.fileio import write_text
+from flipkit.planning.plans.plan_doc import read_plan_doc
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 
@@ -56,18 +60,28 @@ def check_float(flag: str, value, lo: float, hi: float, unit: str) -> float:
 def precheck_plan(path) -> None:
     """The cheap checks of a plan file (:func:`flipkit.planning.plans.plan_doc.read_plan_doc`),
     before a command imports the models: a malformed file is refused at once."""
-    from flipkit.planning.plans.plan_doc import read_plan_doc
-
     read_plan_doc(path)
 
 
 def write_json(path, doc: dict) -> None:
     """Write ``doc`` as indented JSON (no NaN) to ``path`` atomically, or a one-line
     FlipkitError."""
-    from flipkit.fileio import write_text
-
     try:
         text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
     except ValueError as exc:
         raise ConfigError(f"cannot write {path}: {exc}") from None
     write_text(path, text)
+
+
+def deferred(command: str, function: str = "run"):
+    """The callable that runs ``flipkit.cli.commands.<command>.<function>(args)``.
+
+    A sub-command is two modules: ``flipkit.cli.<command>`` (its arguments and their cheap
+    checks, imported for every parse) and ``flipkit.cli.commands.<command>`` (its work, with
+    the models it needs: pinocchio, CasADi, cvxpy, MuJoCo, about 1 s to import). This is the
+    one place the command line defers an import, so that ``flipkit --help`` and an input
+    refused by the cheap checks never load the models.
+    """
+    def run(args: argparse.Namespace) -> int:
+        return getattr(importlib.import_module(f"flipkit.cli.commands.{command}"), function)(args)
+    return run

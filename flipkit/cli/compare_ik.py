@@ -12,8 +12,11 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import SOLVER_CHOICES, add_sweep_arguments, write_json
+from flipkit.cli.common import (MAX_GRID, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
+                                check_int, deferred)
 from flipkit.errors import ConfigError
+from flipkit.fileio import check_output, check_output_dir
+
 
 def register(subparsers) -> None:
     """Add the ``compare-ik`` sub-command to the ``flipkit`` parser."""
@@ -39,13 +42,8 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the comparison on the executor, write the JSON, print the summary."""
-    from flipkit.experiments.compare_ik import LOCATION_SETS, compare_ik, format_summary
-    from flipkit.experiments.sweep import grill_grid, make_executor
-
-    from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
-    from flipkit.fileio import check_output, check_output_dir
-
+    """Check the locations, the options and the outputs, then run the comparison
+    (:mod:`flipkit.cli.commands.compare_ik`)."""
     if args.locations is None and args.grid is None and not args.burger:
         raise ConfigError("give --locations table1, --grid NX NY and/or --burger X Y Z")
     for n in args.grid or ():
@@ -56,14 +54,4 @@ def run(args: argparse.Namespace) -> int:
     for flag, directory in (("--plans", args.plans), ("--cache", args.cache)):
         if directory is not None:
             check_output_dir(directory, flag)
-    locations = list(LOCATION_SETS[args.locations]) if args.locations else []
-    if args.grid is not None:
-        locations += grill_grid(nx=args.grid[0], ny=args.grid[1])
-    locations += [tuple(b) for b in args.burger or ()]
-    with make_executor(args.scheduler, args.workers) as executor:
-        out = compare_ik(locations, args.solver, executor, args.cache, args.plans,
-                         progress=not args.no_progress)
-    write_json(args.json, out)
-    print(format_summary(out["summary"]))
-    print(f"flipkit compare-ik: wrote {len(out['locations'])} locations to {args.json}")
-    return 0
+    return deferred("compare_ik")(args)

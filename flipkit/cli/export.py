@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import argparse
 
+from flipkit.cli.common import check_float, deferred, precheck_plan
+from flipkit.fileio import check_output
+
 RATE_RANGE = (1.0, 10_000.0)  # Hz, --rate (flipkit.planning.plans.export.RATE_RANGE)
 
 
@@ -34,18 +37,9 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the output and rate, load, verify, resample, write; one line with the row count."""
-    from flipkit.cli.common import check_float, precheck_plan
-    from flipkit.fileio import check_output
-
+    """Check the output, the rate and the file cheaply, then load, verify, resample and write
+    (:mod:`flipkit.cli.commands.export`)."""
     check_output(args.csv, "--csv", (".csv",), inputs=[args.plan])
     check_float("--rate", args.rate, RATE_RANGE[0], RATE_RANGE[1], "Hz")
     precheck_plan(args.plan)
-    from flipkit.planning.plans.export import write_csv
-    from flipkit.planning.plans.plan_file import Plan
-
-    plan = Plan.load(args.plan)
-    rows = write_csv(plan, args.csv, args.rate, force=args.force, where=args.plan)
-    total = sum(s.T for s in plan.segments)
-    print(f"flipkit export: wrote {rows} rows ({total:.3f} s at {args.rate:g} Hz) to {args.csv}")
-    return 0
+    return deferred("export")(args)

@@ -6,7 +6,8 @@ import argparse
 import sys
 
 from flipkit.errors import InvalidChoiceError
-from flipkit.figures import FIGURE_IDS
+from flipkit.figures import FIGURE_IDS, run_notebooks
+from flipkit.fileio import check_output_dir
 
 
 def register(subparsers) -> None:
@@ -30,9 +31,6 @@ def register(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Make the figures; print what was made, what is missing, and the manifest path."""
-    from flipkit.fileio import check_output_dir
-    from flipkit.figures import run_notebooks
-
     check_output_dir(args.out, "--out")  # before any notebook runs
     for fig_id in args.only or ():
         if fig_id not in FIGURE_IDS:

@@ -15,18 +15,10 @@ passed the check.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
-import math
-import os
-import sys
-import warnings
-from pathlib import Path
 
-from flipkit.errors import ConfigError, FlipkitError
+from flipkit.cli.common import deferred
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
-CSV_COLUMNS = (("x", "y", "z"), ("px", "py", "pz"))
 DESCRIPTION = (
     "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
     "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
@@ -61,7 +53,7 @@ def register(subparsers) -> None:
                    help="goal position X Y Z (m)")
     t.add_argument("--yaw", default="0", metavar="RAD", help="spatula heading o_z (rad), any finite number: wrapped to (-pi, pi]")
     common(t)
-    t.set_defaults(run=run_translate)
+    t.set_defaults(run=deferred("plan", "run_translate"))
 
     f = sub.add_parser("flip", help="pick up and flip one burger (five chained segments)",
                        description="Go to burger, scoop, pickup, flip and turn back "
@@ -79,7 +71,7 @@ def register(subparsers) -> None:
                         "(default: the planner's R_LAND, which the package's atlas serves)")
     atlas_arguments(f)
     common(f)
-    f.set_defaults(run=run_flip)
+    f.set_defaults(run=deferred("plan", "run_flip"))
 
     s = sub.add_parser("serve", help="pick up one burger and put it on the side table",
                        description="Go to burger, scoop, pickup (eqs. 22-25), carry with the "
@@ -95,7 +87,7 @@ def register(subparsers) -> None:
                         "singularities and 0.2 rad from them")
     atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
-    s.set_defaults(run=run_serve)
+    s.set_defaults(run=deferred("plan", "run_serve"))
 
     b = sub.add_parser("batch", help="pick up and flip up to five burgers in a row",
                        description="Plan up to five burgers, each starting where the "
@@ -113,175 +105,7 @@ def register(subparsers) -> None:
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
     atlas_arguments(b)
     common(b, json_out=False)
-    b.set_defaults(run=run_batch)
-
-
-def _numbers(what: str, values, count: int | None = None) -> list[float]:
-    """Command-line words as finite floats (exactly ``count`` of them if given)."""
-    values = [values] if isinstance(values, str) else list(values)
-    if count is not None and len(values) != count:
-        raise ConfigError(f"{what} takes {count} numbers, got {len(values)}")
-    try:
-        out = [float(v) for v in values]
-    except ValueError:
-        raise ConfigError(f"{what}: not a number in {' '.join(values)}") from None
-    if not all(math.isfinite(v) for v in out):
-        raise ConfigError(f"{what} must be finite, got {' '.join(values)}")
-    return out
-
-
-BURGER_HEIGHT_TOL = 0.01  # m: |z − h_g| accepted (flipkit.behaviors.targets.check_location)
-
-
-def _yaw(value) -> float:
-    """``--yaw`` (rad) wrapped to (−π, π]: 2π plans as 0."""
-    y = _numbers("--yaw", value)[0]
-    return math.pi - (math.pi - y) % (2 * math.pi)
-
-
-def _on_grill(loc, cell, what: str) -> None:
-    """Refuse a burger location (m) whose height is more than BURGER_HEIGHT_TOL from h_g."""
-    h = cell.grill.height
-    if abs(loc[2] - h) > BURGER_HEIGHT_TOL:
-        raise ConfigError(f"{what}: z = {loc[2]:g} m is not on the grill surface: give z = "
-                          f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
-
-
-def _burger(values, cell) -> list[float]:
-    """``--burger X Y Z`` (m), its height on the grill surface within BURGER_HEIGHT_TOL."""
-    loc = _numbers("--burger", values, 3)
-    _on_grill(loc, cell, "--burger")
-    return loc
-
-
-def _start_q(values, cell):
-    """``--start-q Q1 .. Q6`` (rad) within the joint limits and on q_home's side of the elbow
-    and wrist singularities, SINGULARITY_MARGIN from them (every plan from there would fail
-    verify's ``singularity`` check); ``None`` if not given."""
-    if values is None:
-        return None
-    from flipkit.model.singular import check_start
-    from flipkit.planning.planners.inputs import check_joint_vector
-    from flipkit.behaviors.models import models_for
-
-    q = _numbers("--start-q", values, 6)
-    robot = models_for(cell).for_segment("go_to_burger")
-    q = check_joint_vector("--start-q", q, robot.q_min, robot.q_max, "rad")
-    check_start(q, robot.q_home, "--start-q")
-    return q
-
-
-def _json_out(args, inputs=()) -> None:
-    """``--json``: a writable ``.json`` file, not an input (checked before planning)."""
-    from flipkit.fileio import check_output
-
-    check_output(args.json, "--json", (".json",), inputs=[*inputs, getattr(args, "atlas", None)])
-
-
-def read_locations(path) -> list[tuple[float, float, float]]:
-    """Burger locations (m) from a CSV with columns x,y,z or px,py,pz (others ignored).
-
-    Blank lines and lines starting with ``#`` are skipped; at most five rows.
-
-    Raises:
-        ConfigError: Unreadable file, missing columns, a non-numeric or non-finite value,
-            no rows or more than five (one line naming the file and the line).
-    """
-    from flipkit.planning.planners.planner import MAX_BATCH
-
-    from flipkit.fileio import InputFileError, read_text
-
-    try:
-        text = read_text(path, "--burgers", 2**20)
-    except InputFileError as exc:
-        raise ConfigError(f"--burgers {path}: cannot read burger CSV "
-                          f"({str(exc).split(': ', 1)[-1]})") from None
-    lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
-             if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
-        raise ConfigError(f"{path}: no header and no burger rows")
-    header = [h.strip().lower() for h in next(csv.reader([lines[0][1]]))]
-    cols = next((c for c in CSV_COLUMNS if set(c) <= set(header)), None)
-    if cols is None:
-        raise ConfigError(f"{path}: line {lines[0][0]}: header must have columns x,y,z or "
-                          f"px,py,pz, got {','.join(header)}")
-    idx = [header.index(c) for c in cols]
-    rows = lines[1:]
-    if not 1 <= len(rows) <= MAX_BATCH:
-        raise ConfigError(f"{path}: expected 1 to {MAX_BATCH} burger rows, got {len(rows)}")
-    out = []
-    for n, line in rows:
-        cells = next(csv.reader([line]))
-        if len(cells) != len(header):
-            raise ConfigError(f"{path}: line {n}: expected {len(header)} values, got {len(cells)}")
-        out.append(tuple(_numbers(f"{path}: line {n}", [cells[i].strip() for i in idx])))
-    return out
-
-
-def _quiet():
-    """Silence cvxpy's 'Solution may be inaccurate' warnings (the SQP handles them)."""
-    warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-
-
-def _report(plan, path: str | None) -> int:
-    """Print the plan's summary (stdout) or its failure (one line, stderr); 0 or 1."""
-    segs = plan.segments
-    for s in segs:
-        print(f"  {s.name:<13} T {s.T:5.3f} s  solve {s.solver.wall_time_s:7.2f} s  "
-              f"{s.solver.iterations:4d} it  viol {s.solver.max_violation:.1e}  {s.solver.status}")
-    where = f"; wrote {path}" if path else ""
-    solve = sum(s.solver.wall_time_s for s in segs)
-    print(f"flipkit plan: {plan.behavior} {plan.status}: {len(segs)} segment(s), "
-          f"T {sum(s.T for s in segs):.3f} s, solve {solve:.2f} s "
-          f"({segs[0].solver.name}), {sum(s.solver.iterations for s in segs)} iterations, "
-          f"max violation {max(s.solver.max_violation for s in segs):.1e}{where}")
-    for s in segs:
-        if s.landing:
-            land = s.landing
-            print(f"  landing: release at node {s.release['node']} ({s.release['time']:.3f} s), "
-                  f"flight {land['time_of_flight']:.3f} s, lands {1e3 * land['offset']:.1f} mm "
-                  f"from ({land['target'][0]:.3f}, {land['target'][1]:.3f}) m, top face "
-                  f"{land['tilt_deg']:.1f} deg from up")
-    if plan.status == "solved":
-        return 0
-    print(f"flipkit: error: {plan.failure}", file=sys.stderr)
-    return 1
-
-
-def run_translate(args: argparse.Namespace) -> int:
-    """Plan, write (solved or failed), summarise."""
-    from flipkit.planning.planners.planner import plan_translate
-
-    _quiet()
-    _json_out(args)
-    start, goal = _numbers("--from", args.start, 3), _numbers("--to", args.goal, 3)
-    plan = plan_translate(start, goal, solver=args.solver, yaw=_yaw(args.yaw))
-    plan.to_json(args.json)
-    return _report(plan, args.json)
-
-
-def run_flip(args: argparse.Namespace) -> int:
-    """Plan, write (solved or failed), summarise."""
-    from flipkit.behaviors.options import SegmentOptions
-    from flipkit.planning.planners.planner import plan_flip
-
-    from flipkit.config import CellConfig
-
-    _quiet()
-    _json_out(args)
-    cell = CellConfig()
-    location = _burger(args.burger, cell)
-    land = None if args.land is None else _numbers("--land", args.land, 2)
-    options = SegmentOptions() if args.r_land is None else SegmentOptions(
-        r_land=_numbers("--r-land", args.r_land)[0])
-    q_start = _start_q(args.start_q, cell)
-    atlas = _atlas(args, options)
-    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
-                     atlas=atlas)
-    plan.to_json(args.json)
-    if atlas is not None:
-        print(f"  warm start: atlas of {len(atlas)} locations")
-    return _report(plan, args.json)
+    b.set_defaults(run=deferred("plan", "run_batch"))
 
 
 def atlas_arguments(parser: argparse.ArgumentParser, which: str = "") -> None:
@@ -290,103 +114,3 @@ def atlas_arguments(parser: argparse.ArgumentParser, which: str = "") -> None:
                         help=f"warm-start atlas (`flipkit atlas build`){which}; default: the "
                              "package's atlas when it serves these options, else cold starts")
     parser.add_argument("--no-atlas", action="store_true", help="cold starts (no atlas)")
-
-
-def _atlas(args: argparse.Namespace, options):
-    """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
-    package's when it exists and serves ``options``, else ``None`` (cold starts)."""
-    from flipkit.config import CellConfig
-    from flipkit.planning.planners.atlas import Atlas, default_atlas
-
-    if args.no_atlas:
-        return None
-    if args.atlas:
-        return Atlas.load(args.atlas, CellConfig(), options)
-    return default_atlas(CellConfig(), options)  # else cold starts (e.g. another --r-land)
-
-
-def run_serve(args: argparse.Namespace) -> int:
-    """Plan, write (solved or failed), summarise."""
-    from flipkit.planning.planners.serve import plan_serve
-
-    from flipkit.behaviors.options import SegmentOptions
-    from flipkit.behaviors.serve import check_table_spot
-    from flipkit.config import CellConfig
-    from flipkit.errors import UnreachableError
-
-    _quiet()
-    _json_out(args)
-    cell = CellConfig()
-    location = _burger(args.burger, cell)
-    spot = _numbers("--table-spot", args.table_spot, 2)
-    try:
-        check_table_spot(cell, spot)
-    except UnreachableError as exc:
-        raise UnreachableError(f"--table-spot: {exc}") from None
-    q_start = _start_q(args.start_q, cell)
-
-    atlas = _atlas(args, SegmentOptions())
-    plan = plan_serve(location, spot, q_start, solver=args.solver, atlas=atlas)
-    plan.to_json(args.json)
-    if atlas is not None:
-        print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
-    return _report(plan, args.json)
-
-
-def run_batch(args: argparse.Namespace) -> int:
-    """Plan the batch, write every plan and summary.csv, print the table."""
-    from flipkit.behaviors.options import SegmentOptions
-    from flipkit.fileio import write_text
-    from flipkit.planning.planners.planner import SUMMARY_HEADER, format_summary, plan_batch, summary_table
-
-    from flipkit.cli.common import MAX_WORKERS, check_int
-    from flipkit.config import CellConfig
-    from flipkit.fileio import check_output_dir
-    from flipkit.planning.planners.inputs import check_spacing
-
-    _quiet()
-    if args.workers is not None:
-        check_int("--workers", args.workers, 1, MAX_WORKERS)
-    locations = read_locations(args.burgers)
-    cell = CellConfig()
-    for k, loc in enumerate(locations, 1):
-        _on_grill(loc, cell, f"{args.burgers}: burger {k}")
-    check_spacing(locations, cell.burger.diameter, str(args.burgers))  # as schedule does
-    check_output_dir(args.out, "--out", inputs=[args.burgers, args.atlas],
-                     names=[*(f"burger_{k}.json" for k in range(1, len(locations) + 1)),
-                            "summary.csv"])
-    atlas = _atlas(args, SegmentOptions())
-    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    executor = None
-    if workers > 1 and len(locations) > 1:
-        from flipkit.experiments.sweep import make_executor
-
-        executor = make_executor(workers=workers)
-    try:
-        plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
-                           executor=executor, atlas=atlas)
-    finally:
-        if executor is not None:
-            executor.shutdown(cancel_futures=True)
-    out = Path(args.out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        rows = summary_table(plans)
-        for k, plan in enumerate(plans, 1):
-            plan.to_json(out / f"burger_{k}.json")
-        text = io.StringIO(newline="")
-        w = csv.writer(text)
-        w.writerow(SUMMARY_HEADER[:1] + ("x", "y", "z") + SUMMARY_HEADER[2:])
-        for k, loc, *rest in rows:
-            w.writerow([k, *loc, *rest])
-        write_text(out / "summary.csv", text.getvalue())
-    except OSError as exc:
-        raise FlipkitError(f"{out}: cannot write ({exc.strerror or exc})") from None
-    print(format_summary(rows))
-    total = sum(r[3] for r in rows)
-    print(f"flipkit plan: batch of {len(plans)}: {sum(p.status == 'solved' for p in plans)} "
-          f"solved, solve time {total:.1f} s ({args.solver}); wrote {out}/")
-    for k, plan in enumerate(plans, 1):
-        if plan.status != "solved":
-            print(f"flipkit: error: burger {k}: {plan.failure}", file=sys.stderr)
-    return 0 if all(p.status == "solved" for p in plans) else 1

@@ -12,7 +12,8 @@ from __future__ import annotations
 import argparse
 
 from flipkit.cli.common import (MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
-                                check_float, check_int, precheck_plan, write_json)
+                                check_float, check_int, deferred, precheck_plan)
+from flipkit.fileio import check_output, check_output_dir
 
 RATE_RANGE = (10.0, 100_000.0)  # Hz, --rate of the PD controller
 
@@ -76,9 +77,8 @@ def format_table(out: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the input, run the trials on the executor, write the JSON, print the table."""
-    from flipkit.fileio import check_output, check_output_dir
-
+    """Check the options, the outputs and the plan file cheaply, then verify the plan and run
+    the trials (:mod:`flipkit.cli.commands.validate`)."""
     check_int("--trials", args.trials, 1, MAX_TRIALS)
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")
     if args.workers is not None:
@@ -90,27 +90,4 @@ def run(args: argparse.Namespace) -> int:
             check_output_dir(directory, flag, inputs=inputs)
     if args.plan is not None:
         precheck_plan(args.plan)
-        from flipkit.planning.plans.verify import load_verified
-
-        load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
-    from flipkit.experiments.compare_ik import LOCATION_SETS
-    from flipkit.experiments.sweep import make_executor
-    from flipkit.experiments.trials import validate_locations, validate_plan_file
-
-    common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
-                  replan=args.replan, command=args.command)
-    with make_executor(args.scheduler, args.workers) as executor:
-        if args.plan is not None:
-            out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
-                                     cache_dir=args.cache, **common)
-        else:
-            out = validate_locations(LOCATION_SETS[args.locations], args.trials, args.solver,
-                                     args.seed, executor=executor, cache_dir=args.cache,
-                                     plans_dir=args.plans, **common)
-    write_json(args.json, out)
-    print(format_table(out))
-    total = out["summary"]
-    print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
-          f"{total['locations']} locations, "
-          f"success {total['success']}; wrote {args.json}")
-    return 0
+    return deferred("validate")(args)

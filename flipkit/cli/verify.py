@@ -7,7 +7,9 @@ Exit status: 0 the plan passes, 1 it fails (one line names the worst group and a
 from __future__ import annotations
 
 import argparse
-import sys
+
+from flipkit.cli.common import check_float, deferred, precheck_plan
+from flipkit.fileio import check_output
 
 
 def register(subparsers) -> None:
@@ -27,24 +29,11 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Verify, print the table and the verdict; 0 pass, 1 fail."""
-    from flipkit.cli.common import check_float, precheck_plan
-    from flipkit.fileio import check_output
-
+    """Check the options and the file cheaply, then verify (:mod:`flipkit.cli.commands.verify`);
+    0 pass, 1 fail."""
     if args.json:
         check_output(args.json, "--json", (".json",), inputs=[args.plan])
     if args.tol is not None:
         check_float("--tol", args.tol, 1e-12, 1.0, "(scaled units)")
     precheck_plan(args.plan)
-    from flipkit.planning.plans.plan_file import Plan
-    from flipkit.planning.plans.verify import TOL, verify_plan
-
-    report = verify_plan(Plan.load(args.plan), tol=TOL if args.tol is None else args.tol)
-    print(report.table())
-    if args.json:
-        report.write_json(args.json)
-    if report.ok:
-        print(f"flipkit verify: {report.summary()}")
-        return 0
-    print(f"flipkit verify: {report.summary()}", file=sys.stderr)
-    return 1
+    return deferred("verify")(args)

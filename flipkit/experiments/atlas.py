@@ -19,12 +19,14 @@ import time
 import numpy as np
 
 from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import AtlasError
 from flipkit.experiments.sweep import grill_grid, make_executor, run_sweep
 from flipkit.planning.planners.atlas import FORMAT, Atlas, options_hash
+from flipkit.planning.planners.planner import plan_flip
 from flipkit.provenance import git_commit
 
 DEFAULT_GRID = (5, 7)  # 35 locations, 5.6 cm × 9.4 cm apart over the grill area
@@ -33,9 +35,6 @@ DEFAULT_GRID = (5, 7)  # 35 locations, 5.6 cm × 9.4 cm apart over the grill are
 def solve_entry(item) -> dict:
     """Plan the chain at one location (sweep worker): ``{"location", "status", "failure",
     "x": {segment: Z}, "structure": {segment: key}, "wall_s", "iterations"}``."""
-    from flipkit.behaviors.models import models_for
-    from flipkit.planning.planners.planner import plan_flip
-
     location, cell, options = item
     plan = plan_flip(location, cell=cell, options=options, solver="sqp")
     out = {"location": list(location), "status": plan.status, "failure": plan.failure,

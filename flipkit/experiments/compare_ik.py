@@ -23,10 +23,14 @@ from pathlib import Path
 
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
-from flipkit.baseline.classify import FAILURE_CLASSES, REASONS
+from flipkit.baseline import run_baseline
+from flipkit.baseline.classify import FAILURE_CLASSES, REASONS, classify_plan
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.sweep import run_sweep
+from flipkit.planning.planners.planner import plan_flip
+from flipkit.planning.plans.verify import verify_plan
+from flipkit.solvers.names import SOLVERS
 
 LOCATION_SETS = {"table1": TABLE1_LOCATIONS}
 METHODS = ("collocation", "ee_ik")
@@ -47,9 +51,6 @@ def plan_filename(location, solver: str) -> str:
 
 
 def _collocation(location, solver: str, plans_dir) -> dict:
-    from flipkit.planning.planners.planner import plan_flip
-    from flipkit.planning.plans.verify import verify_plan
-
     t0 = time.perf_counter()
     try:
         plan = plan_flip(location, solver=solver)
@@ -68,8 +69,6 @@ def _collocation(location, solver: str, plans_dir) -> dict:
 
 def _judge(plan) -> dict:
     """The baseline's judge on the collocation plan at :data:`RATE` (first failing segment)."""
-    from flipkit.baseline.classify import classify_plan
-
     verdicts = classify_plan(plan, RATE)
     bad = next((v for v in verdicts if v.status != "solved"), None)
     if bad is None:
@@ -80,8 +79,6 @@ def _judge(plan) -> dict:
 
 
 def _ee_ik(location) -> dict:
-    from flipkit.baseline import run_baseline
-
     res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
     failure = res.failure
     return {"status": res.status, "reason": res.reason,
@@ -195,8 +192,6 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
         UnreachableError: A location off the grill (named by its index, from 1).
         InvalidChoiceError: Unknown solver.
     """
-    from flipkit.solvers.names import SOLVERS
-
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
     cell, locs = cell or CellConfig(), []

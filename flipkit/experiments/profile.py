@@ -27,6 +27,9 @@ import pstats
 
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.experiments.bench import machine
+from flipkit.planning.planners import planner
+from flipkit.planning.planners.atlas import default_atlas
+from flipkit.solvers import sqp
 
 # part -> (file suffix, function name) whose cumulative time it is; the parts do not nest
 PARTS = {
@@ -57,9 +60,6 @@ def profile_flip(location, segment: str = "flip", atlas=None) -> dict:
         ``{"location", "segment", "atlas", "iterations", "sqp_s", "parts_ms_per_iteration":
         {part: ms}, "solve_s_unprofiled"}``; ``parts`` sum to the SQP's time per iteration.
     """
-    from flipkit.planning.planners import planner
-    from flipkit.solvers import sqp
-
     planner.plan_flip(location, atlas=atlas)  # warm-up: compile every subproblem structure
     plain = planner.plan_flip(location, atlas=atlas)
     plain_s = next(s.solver.wall_time_s for s in plain.segments if s.name == segment)
@@ -121,8 +121,6 @@ def main(argv=None) -> int:
         parser.error(f"--location must be 1..{len(TABLE1_LOCATIONS)}")
     atlas = None
     if args.atlas:
-        from flipkit.planning.planners.atlas import default_atlas
-
         atlas = default_atlas()
         if atlas is None:
             parser.error("the package's atlas does not serve the default options; "

@@ -14,7 +14,10 @@ from __future__ import annotations
 
 from flipkit.config import PHYSICAL_RANGES
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.experiments.trials import STAGES, TRACK_RATE_HZ, Perturbations, run_trial, trial_jobs, trial_key
+from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.sweep import run_sweep
+from flipkit.experiments.trial_jobs import TRACK_RATE_HZ, trial_jobs, trial_key
+from flipkit.experiments.trials import STAGES, run_trial
 from flipkit.simulation.modes import FEEDFORWARD
 
 ENDS = ("low", "high")
@@ -71,8 +74,6 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
         ConfigError: No plan, or ``trials`` not a positive integer.
         InvalidChoiceError: An unknown parameter name.
     """
-    from flipkit.experiments.sweep import run_sweep
-
     plan_texts = [t for t in plan_texts if t is not None]
     if not plan_texts:
         raise ConfigError("the sensitivity study needs at least one solved plan")

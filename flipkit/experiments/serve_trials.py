@@ -2,7 +2,7 @@
 
 As :mod:`flipkit.experiments.trials` for flips: each trial executes the plan closed-loop in the
 MuJoCo cell (:func:`flipkit.simulation.execute.execute_plan`) with the burger misplaced and the
-physics perturbed (:class:`~flipkit.experiments.trials.Perturbations`, drawn from
+physics perturbed (:class:`~flipkit.experiments.perturbations.Perturbations`, drawn from
 ``np.random.default_rng(seed + trial)``), then judges the scoop and pickup (paper Sec. V) and
 the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
 within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
@@ -13,14 +13,20 @@ re-plans place and return home for it (:func:`flipkit.planning.planners.serve.re
 from __future__ import annotations
 
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 
+from flipkit.config import with_parameter
 from flipkit.errors import ConfigError
-from flipkit.experiments.trials import (HOLD_S, TRACK_RATE_HZ, Perturbations, merge_tracking,
-                                        plan_from_text, trial_jobs, trial_key)
+from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.sweep import run_sweep
+from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
+                                            trial_jobs, trial_key)
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.planners.serve import table_spot
+from flipkit.planning.planners.serve import replan_serve, table_spot
+from flipkit.planning.plans.verify import require_verified
+from flipkit.simulation.execute import execute_plan
 from flipkit.simulation.judges import judge_pickup, judge_scoop, judge_serve
 from flipkit.simulation.modes import FEEDFORWARD
 
@@ -37,10 +43,6 @@ def run_serve_trial(job: dict) -> dict:
         ``tracking``, ``mode``, ``rest`` (final centre ``xy`` (m), ``distance`` from the
         spot (m), ``up_z``), ``replan`` (sensed position and failure, or ``None``).
     """
-    from flipkit.config import with_parameter
-    from flipkit.planning.planners.serve import replan_serve
-    from flipkit.simulation.execute import execute_plan
-
     plan = plan_from_text(job["plan_text"])
     draw = Perturbations(**job["perturbations"]).draw(
         np.random.default_rng(job["seed"] + job["trial"]))
@@ -101,15 +103,9 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
         FlipkitError: The file is missing, malformed, not a serve plan, not solved or fails
             :func:`~flipkit.planning.plans.verify.verify_plan`.
     """
-    from pathlib import Path
-
-    from flipkit.experiments.sweep import run_sweep
-
     plan = Plan.load(path)
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
-    from flipkit.planning.plans.verify import require_verified
-
     require_verified(plan, path, ("serve",))  # nothing unverified is simulated
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")

@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from flipkit import __version__
 from flipkit.config import CellConfig
@@ -36,10 +37,19 @@ def _single_threaded() -> None:
         os.environ.setdefault(name, "1")
 
 
-def _dask_executor_class():
-    from distributed.cfexecutor import ClientExecutor
+def _dask_executor(scheduler: str) -> cf.Executor:
+    """The executor of a Dask client connected to ``scheduler``; it closes the client when
+    shut down."""
+    import distributed.cfexecutor  # Dask takes ~0.5 s to import; only --scheduler needs it
 
-    class DaskExecutor(ClientExecutor):
+    try:
+        client = distributed.Client(scheduler, timeout="10s", set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise FlipkitError(f"cannot connect to the Dask scheduler at {scheduler}: "
+                           f"{msg}") from None
+
+    class DaskExecutor(distributed.cfexecutor.ClientExecutor):
         """A Dask client's executor that also closes the client when shut down."""
 
         def shutdown(self, wait: bool = True) -> None:
@@ -48,7 +58,7 @@ def _dask_executor_class():
             finally:
                 self._client.close()
 
-    return DaskExecutor
+    return DaskExecutor(client, pure=False)
 
 
 def make_executor(scheduler: str | None = None, workers: int | None = None) -> cf.Executor:
@@ -72,15 +82,7 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> c
                                 or workers < 1):
         raise ConfigError(f"workers must be a positive integer, got {workers!r}")
     if scheduler:
-        from dask.distributed import Client
-
-        try:
-            client = Client(scheduler, timeout="10s", set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as exc:
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise FlipkitError(f"cannot connect to the Dask scheduler at {scheduler}: "
-                               f"{msg}") from None
-        return _dask_executor_class()(client, pure=False)
+        return _dask_executor(scheduler)
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     return cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
@@ -165,8 +167,6 @@ def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, ke
         Whatever ``fn`` raises for an item (pending work is cancelled; results that already
         arrived stay cached). FlipkitError: The cache cannot be written.
     """
-    from tqdm import tqdm
-
     items = list(items)
     name = name or f"{fn.__module__}.{fn.__qualname__}"
     keys = [item if key_fn is None else key_fn(item) for item in items]

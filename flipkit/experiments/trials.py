@@ -15,7 +15,7 @@ the previous ones succeeded, as in Table I.
 
 from __future__ import annotations
 
-import json
+import tempfile
 from dataclasses import asdict
 from pathlib import Path
 
@@ -26,22 +26,23 @@ from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.serve_trials import validate_serve
+from flipkit.experiments.sweep import run_sweep
+from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
+                                            trial_jobs, trial_key)
+from flipkit.model.robot import Robot
+from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.planners.planner import plan_flip, replan_flip
+from flipkit.planning.plans.verify import require_verified
+from flipkit.simulation.execute import execute_plan
 from flipkit.simulation.modes import FEEDFORWARD, MODES
+from flipkit.simulation.tracking import track
 from flipkit.solvers.names import SOLVERS
 
-TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
-HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
 STAGES = ("scoop", "pickup", "flip")
-_PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
-              "cone", "segments", "created_by")
-
-
-def plan_from_text(text: str) -> Plan:
-    """A plan from the text of a ``flipkit-plan`` file (already checked by Plan.load)."""
-    doc = json.loads(text)
-    return Plan(**{k: doc[k] for k in _PLAN_KEYS})
 
 
 def track_plan(plan: Plan, plant_cell: CellConfig | None = None, rate_hz=TRACK_RATE_HZ):
@@ -56,9 +57,6 @@ def track_plan(plan: Plan, plant_cell: CellConfig | None = None, rate_hz=TRACK_R
         N×3×3), ``{segment: (t_start, t_end)}`` (s) and ``{segment: {"max_m", "sum_sq_m2",
         "n"}}``, the spatula position tracking error (m) of each segment.
     """
-    from flipkit.model.robot import Robot
-    from flipkit.simulation.tracking import track
-
     cell = plan.cell()
     plant_cell = plant_cell or cell
     plants = {w: Robot(plant_cell, with_burger=w) for w in (False, True)}
@@ -135,8 +133,6 @@ def run_trial(job: dict) -> dict:
         ``perturbation`` (the draw), ``tracking`` (spatula position error per segment, see
         :func:`track_plan`) and ``mode``.
     """
-    from flipkit.simulation.execute import execute_plan
-
     plan = plan_from_text(job["plan_text"])
     mode = job.get("mode", FEEDFORWARD)
     draw = Perturbations(**job["perturbations"]).draw(
@@ -144,11 +140,7 @@ def run_trial(job: dict) -> dict:
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
-    replan = None
-    if job.get("replan", False):
-        from flipkit.planning.planners.planner import replan_flip
-
-        replan = replan_flip
+    replan = replan_flip if job.get("replan", False) else None
     command = job.get("command", "compensated")
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
                       replan=replan, command=command)
@@ -172,17 +164,6 @@ def _predicted(plan) -> list | None:
     """The plan's predicted landing point (x, y) (m), or ``None`` without one."""
     flip = next((s for s in plan.segments if s.name == "flip"), None)
     return None if flip is None or not flip.landing else [float(v) for v in flip.landing["point"][:2]]
-
-
-def merge_tracking(errors: list) -> dict:
-    """Per-segment {"max_m", "rms_m"} (m) over several :func:`track_plan` error dicts."""
-    out = {}
-    for name in dict.fromkeys(k for e in errors for k in e):
-        rows = [e[name] for e in errors if name in e]
-        n = sum(r["n"] for r in rows)
-        out[name] = {"max_m": max(r["max_m"] for r in rows),
-                     "rms_m": float(np.sqrt(sum(r["sum_sq_m2"] for r in rows) / n))}
-    return out
 
 
 def location_entry(location, trials: int, results: list, plan_info: dict) -> dict:
@@ -211,26 +192,6 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
                           "replan": r.get("replan")} for r in results]}
 
 
-def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
-               rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
-               replan: bool = False, physics: dict | None = None,
-               command: str = "compensated") -> list:
-    """The :func:`run_trial` jobs of one plan (``physics``: see :func:`run_trial`; the key
-    is left out when empty, so the cache keys of nominal trials do not change)."""
-    extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
-    return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
-             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
-             "replan": bool(replan), "command": command, **extra} for i in range(trials)]
-
-
-def trial_key(job: dict) -> dict:
-    """Cache key of a trial job: the plan's digest instead of its text."""
-    from flipkit.experiments.sweep import stable_hash
-
-    return {**{k: v for k, v in job.items() if k != "plan_text"},
-            "plan": stable_hash(job["plan_text"])}
-
-
 def plan_location(job: dict) -> dict:
     """Plan pickup-and-flip at one location as `flipkit plan flip` does (from the package's
     atlas when it serves) and write the plan file (a sweep worker).
@@ -241,10 +202,6 @@ def plan_location(job: dict) -> dict:
     Returns:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
     """
-    from flipkit.experiments.compare_ik import plan_filename
-    from flipkit.planning.planners.atlas import default_atlas
-    from flipkit.planning.planners.planner import plan_flip
-
     try:
         plan = plan_flip(job["location"], solver=job["solver"], atlas=default_atlas())
     except FlipkitError as exc:
@@ -279,8 +236,6 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
         "trials", "success": {stage: count}, "independent": {stage: count}}}``.
     """
-    from flipkit.experiments.sweep import run_sweep
-
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
@@ -311,14 +266,11 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
     solved or fails :func:`~flipkit.planning.plans.verify.verify_plan`. ``kwargs`` as :func:`validate`."""
     plan = Plan.load(path)
     if plan.behavior == "serve":  # the serve judge (flipkit.experiments.serve_trials)
-        from flipkit.experiments.serve_trials import validate_serve
         return validate_serve(path, trials, seed, **kwargs)
     if plan.behavior != "flip":
         raise FlipkitError(f"{path}: a {plan.behavior} plan; validate needs a flip or serve plan")
     if plan.status != "solved":
         raise FlipkitError(f"{path}: plan status is {plan.status!r}; validate needs a solved plan")
-    from flipkit.planning.plans.verify import require_verified
-
     require_verified(plan, path, ("flip",))  # nothing unverified is simulated
     info = {"status": plan.status, "file": str(path)}
     return validate([(plan.burger["location"].tolist(), info, Path(path).read_text())], trials,
@@ -336,10 +288,6 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
     """
-    import tempfile
-
-    from flipkit.experiments.sweep import run_sweep
-
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:

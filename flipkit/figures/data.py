@@ -8,7 +8,9 @@ verifier checked. Units: s, m, rad, m/s² (specific forces, i.e. force per burge
 
 from __future__ import annotations
 
+import csv
 from dataclasses import dataclass
+from importlib import resources
 
 import numpy as np
 
@@ -319,9 +321,6 @@ def paper_table1() -> list[dict]:
 
     Read from the package copy of ``data/paper_table1.csv`` (a clean transcription).
     """
-    import csv
-    from importlib import resources
-
     text = resources.files("flipkit").joinpath("data", PAPER_TABLE1).read_text()
     rows = csv.DictReader(line for line in text.splitlines() if not line.startswith("#"))
     return [{"location": (float(r["px"]), float(r["py"]), float(r["pz"])),

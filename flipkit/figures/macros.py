@@ -6,6 +6,7 @@ import json
 import math
 from pathlib import Path
 
+
 MACRO_HEADER = r"""% Made by flipkit.figures.write_macros from figures/manifest.json; do not edit.
 % \fknum{<figure id>}{<number key>} prints a number of the manifest (nested keys joined by
 % ".", list items numbered from 1); \fkmm and \fkpct print metre values in mm and ratios
@@ -89,31 +90,31 @@ def config_constants() -> dict:
     flip's landing radius (mm), release fraction and node and minimum landing tilt (deg), acceleration limit, burger and spatula
     sizes, grill height, nodes per segment, and the duration bounds (s) of every
     segment with their sum over pickup-and-flip."""
-    from flipkit.behaviors import targets as tg
-    from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
-    from flipkit.behaviors.options import (FLIGHT_MARGIN, MU_SAFETY, R_LAND, RELEASE_FRACTION,
-                                           SCOOP_PRESS, SCOOP_TIP_BAND, SegmentOptions)
-    from flipkit.config import CellConfig
+    # Not at the top: `flipkit --help` imports this module (flipkit.figures), and these load
+    # the cell's configuration, pinocchio and CasADi.
+    from flipkit.behaviors import library, options
+    from flipkit.config import CellConfig, task
     from flipkit.model.flight import TILT_MIN_DEG
 
     cell = CellConfig()
     out = {"mu": cell.burger.mu, "grill_mu": cell.physics.mu_grill,
-           "scoop_press_mm": 1e3 * SCOOP_PRESS, "scoop_tip_band_mm": 1e3 * SCOOP_TIP_BAND,
-           "r_land_mm": 1e3 * R_LAND, "release_fraction": RELEASE_FRACTION,
-           "landing_tilt_min_deg": TILT_MIN_DEG, "mu_safety": MU_SAFETY,
-           "scoop_start_margin_mm": 1e3 * tg.SCOOP_START_MARGIN,
-           "flight_margin_mm": 1e3 * FLIGHT_MARGIN,
-           "release_node": SegmentOptions().release_node(),
+           "scoop_press_mm": 1e3 * task.SCOOP_PRESS, "scoop_tip_band_mm": 1e3 * task.SCOOP_TIP_BAND,
+           "r_land_mm": 1e3 * task.R_LAND, "release_fraction": task.RELEASE_FRACTION,
+           "landing_tilt_min_deg": TILT_MIN_DEG, "mu_safety": task.MU_SAFETY,
+           "scoop_start_margin_mm": 1e3 * task.SCOOP_START_MARGIN,
+           "flight_margin_mm": 1e3 * task.FLIGHT_MARGIN,
+           "release_node": options.SegmentOptions().release_node(),
            "accel_limit_rad_s2": cell.robot.accel_limit, "burger_diameter_m":
                cell.burger.diameter, "burger_thickness_m": cell.burger.thickness,
            "burger_mass_kg": cell.burger.mass,
            "spatula_length_m": cell.spatula.length, "spatula_width_m": cell.spatula.width,
-           "grill_height_m": cell.grill.height, "nodes": SegmentOptions().N + 1,
-           "segment_intervals": SegmentOptions().N}
-    for name, spec in SUBBEHAVIORS.items():
+           "grill_height_m": cell.grill.height, "nodes": options.SegmentOptions().N + 1,
+           "segment_intervals": options.SegmentOptions().N}
+    for name, spec in library.SUBBEHAVIORS.items():
         lo, hi = spec.duration
         out[f"T_{name}_min_s"], out[f"T_{name}_max_s"] = lo, hi
-    out["T_pickup_and_flip_max_s"] = round(sum(SUBBEHAVIORS[n].duration[1] for n in FLIP_NAMES), 9)
+    out["T_pickup_and_flip_max_s"] = round(
+        sum(library.SUBBEHAVIORS[n].duration[1] for n in library.FLIP_NAMES), 9)
     return out
 
 

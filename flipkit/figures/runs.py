@@ -16,16 +16,36 @@
 
 from __future__ import annotations
 
+import tempfile
 import time
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+from scipy.interpolate import CubicHermiteSpline
 
+from flipkit.baseline import run_baseline
+from flipkit.baseline.classify import classify_plan
+from flipkit.baseline.ee_opt import sample_times
 from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.models import models_for
+from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
+from flipkit.experiments.bench import warm_up
+from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
+from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.sweep import make_executor, run_sweep
+from flipkit.experiments.trial_jobs import HOLD_S, TRACK_RATE_HZ, plan_from_text, trial_jobs
+from flipkit.experiments.trials import landing_target, plan_location, run_trial
+from flipkit.experiments.trials import track_plan as track_execution
 from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
+from flipkit.model.robot import Robot
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.planners.planner import plan_flip, plan_translate, replan_flip
+from flipkit.simulation.execute import execute_plan
+from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop
 
 
 def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None = None,
@@ -43,9 +63,6 @@ def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None =
         ``solved`` only if every plan was solved and verified) and the individual plans
         (each with ``failure``, ``wall_time_s`` and ``report``).
     """
-    from flipkit.planning.plans.plan_file import Plan
-    from flipkit.planning.planners.planner import plan_translate
-
     cell = cell or CellConfig()
     pts = [tuple(float(v) for v in p) for p in points]
     if len(pts) < 2:
@@ -99,14 +116,8 @@ def track_plan(plan, rate_hz: float | None = None) -> Tracked:
     the nodes (q, q̇) — the controller's reference; the spline is local to each node
     interval, so one spline through all segments' nodes equals the per-segment ones.
     """
-    from scipy.interpolate import CubicHermiteSpline
-
-    from flipkit.model.robot import Robot
-    from flipkit.experiments.trials import TRACK_RATE_HZ
-    from flipkit.experiments.trials import track_plan as execute
-
     series = plan_series(plan)
-    t, p, _, _, _ = execute(plan, rate_hz=rate_hz or TRACK_RATE_HZ)
+    t, p, _, _, _ = track_execution(plan, rate_hz=rate_hz or TRACK_RATE_HZ)
     q_des = CubicHermiteSpline(series.t, series.q, series.qd, axis=0)(t)
     robot = Robot(plan.cell())
     return Tracked(t, p, spatula_positions(robot, q_des), series)
@@ -116,11 +127,6 @@ def nominal_trial(plan) -> dict:
     """One Table I trial of a solved flip plan without perturbation (burger exactly at p^b,
     nominal grill height, μ and mass): :func:`flipkit.experiments.trials.run_trial`'s result
     (``ok`` per stage, ``failure``, ``tracking``)."""
-    import tempfile
-    from pathlib import Path
-
-    from flipkit.experiments.trials import TRACK_RATE_HZ, Perturbations, run_trial, trial_jobs
-
     none = Perturbations(position_sigma=0.0, grill_offset=0.0, mu_scale=(1.0, 1.0),
                          mass_scale=(1.0, 1.0))
     with tempfile.TemporaryDirectory(prefix="flipkit-plan-") as tmp:
@@ -136,10 +142,6 @@ def _warm_sqp(cell: CellConfig, location) -> float:
     """One SQP iteration on each of the five segment structures, once per process: cvxpy's
     one-off compile of each QP (~2 s per structure) is set-up, not solve time (as in
     :mod:`flipkit.experiments.bench`). Returns the time spent (s)."""
-    from flipkit.behaviors.transcribe import transcribe
-    from flipkit.experiments.bench import warm_up
-    from flipkit.behaviors.models import models_for
-
     if cell in _WARMED:
         return 0.0
     models = models_for(cell)
@@ -166,8 +168,6 @@ def flip_solve_times(item) -> dict:
         ``segments``: ``[{name, status, wall_time_s, iterations, T}]`` (solver wall time, s;
         executed duration T, s) for the segments attempted.
     """
-    from flipkit.planning.planners.planner import plan_flip
-
     location, solver = [float(v) for v in item["location"]], str(item["solver"])
     cell = CellConfig()
     with warnings.catch_warnings():
@@ -192,8 +192,6 @@ def solve_time_sweep(locations, solvers=("sqp", "ipopt"), scheduler: str | None 
     for the CPU and the times are those of one core; with a Dask ``scheduler`` address they
     are spread over its workers.
     """
-    from flipkit.experiments.sweep import make_executor, run_sweep
-
     items = [{"location": [float(v) for v in loc], "solver": s}
              for loc in locations for s in solvers]
     executor = make_executor(scheduler) if scheduler else None
@@ -238,12 +236,6 @@ def plan_targets(locations, solver: str = "auto", executor=None, progress: bool 
     """Plan pickup-and-flip at every location on the sweep (in a temporary directory) and
     return the :func:`flipkit.experiments.trials.validate` targets ``[(location, plan_info, plan_text
     or None)]``, so that one set of plans serves several validations."""
-    import tempfile
-    from pathlib import Path
-
-    from flipkit.experiments.sweep import run_sweep
-    from flipkit.experiments.trials import plan_location
-
     with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
         jobs = [{"location": [float(v) for v in loc], "solver": solver, "plans_dir": tmp}
                 for loc in locations]
@@ -257,13 +249,7 @@ def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = Tru
     """One unperturbed execution of a plan file's text (the nominal cell), through the
     sense-plan-act pipeline with ``replan``: ``(execution, ok)``, ``ok`` = {stage: bool}
     (cumulative, the judges of Table I) — the run :mod:`flipkit.simulation.animate` renders."""
-    from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop
-    from flipkit.simulation.execute import execute_plan
-    from flipkit.experiments.trials import HOLD_S, landing_target, plan_from_text
-
-    replan_fn = None
-    if replan:
-        from flipkit.planning.planners.planner import replan_flip as replan_fn
+    replan_fn = replan_flip if replan else None
     ex = execute_plan(plan_from_text(plan_text), mode, None, hold=HOLD_S, replan=replan_fn)
     b = ex.bounds
     ok = {"scoop": judge_scoop(ex.run, b["scoop"]).ok}
@@ -303,16 +289,6 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
         ``{"location", "ee_ik": path, "collocation": path}``, each path ``{"t" (s), "q"
         (rad), "boundaries" (s), "names", "failed" (subbehaviour or None), "label"}``.
     """
-    from pathlib import Path
-
-    from scipy.interpolate import CubicHermiteSpline
-
-    from flipkit.baseline import run_baseline
-    from flipkit.baseline.classify import classify_plan
-    from flipkit.baseline.ee_opt import sample_times
-    from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
-    from flipkit.planning.plans.plan_file import Plan
-
     res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
     ts, qs, edges, t0 = [], [], [0.0], 0.0
     for track in res.tracks:
@@ -329,7 +305,6 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
     if path is not None and path.exists():
         plan = Plan.load(path)
     else:
-        from flipkit.planning.planners.planner import plan_flip
         plan = plan_flip(location, solver=solver)
     ts, qs, edges, t0 = [], [], [0.0], 0.0
     for seg in plan.segments:

@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from cycler import cycler
 
 from flipkit import __version__
 from flipkit.errors import FlipkitError, InvalidChoiceError
@@ -44,20 +45,18 @@ class _Style:
     """The flipkit rcParams, applied on creation; as a context manager, restored on exit."""
 
     def __init__(self):
-        import matplotlib as mpl
-        from cycler import cycler
+        import matplotlib as mpl  # not at the top: `flipkit --help` imports this module
 
-        self._saved = {k: mpl.rcParams[k] for k in (*RC, "axes.prop_cycle")}
-        mpl.rcParams.update(RC)
-        mpl.rcParams["axes.prop_cycle"] = cycler(color=COLORS)
+        self._rc = mpl.rcParams
+        self._saved = {k: self._rc[k] for k in (*RC, "axes.prop_cycle")}
+        self._rc.update(RC)
+        self._rc["axes.prop_cycle"] = cycler(color=COLORS)
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
-        import matplotlib as mpl
-
-        mpl.rcParams.update(self._saved)
+        self._rc.update(self._saved)
         return False
 
 
@@ -109,7 +108,7 @@ def save(fig, fig_id: str, caption: str, numbers: dict, out_dir="figures") -> li
         InvalidChoiceError: ``fig_id`` is not a known figure id.
         FlipkitError: Empty caption, or a number that is not JSON-serialisable.
     """
-    import matplotlib as mpl
+    import matplotlib as mpl  # not at the top: `flipkit --help` imports this module
 
     if fig_id not in FIGURES:
         raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)

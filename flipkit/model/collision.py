@@ -22,8 +22,10 @@ pair is unique, i.e. almost everywhere, for separated and penetrating pairs alik
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -58,8 +60,6 @@ _GENERIC_ROTATION = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64,
 def _box_probe() -> float:
     """A box–box distance that reads 0.3 with coal's exact box support and
     0.3 − 1.7e-11 with the inflated one."""
-    import coal
-
     req = coal.DistanceRequest()
     req.gjk_tolerance = GJK_TOLERANCE
     return float(coal.distance(
@@ -75,8 +75,6 @@ def pin_box_support() -> bool:
     inflated — distances then differ from other processes' by ~1e-11 m."""
     global _BOX_SUPPORT_PINNED
     if _BOX_SUPPORT_PINNED is None:
-        import coal
-
         # An ellipsoid first (GJK's first direction (−1, 0, 0) is its own), the box second,
         # turned so that the direction in its frame, the rotation's first row, has no zero.
         coal.distance(coal.Ellipsoid(0.1, 0.12, 0.14), coal.Transform3s(np.eye(3), np.zeros(3)),
@@ -85,8 +83,6 @@ def pin_box_support() -> bool:
                       coal.DistanceRequest(), coal.DistanceResult())
         _BOX_SUPPORT_PINNED = abs(_box_probe() - 0.3) <= 1e-13
         if not _BOX_SUPPORT_PINNED:
-            import warnings
-
             warnings.warn("coal's Box support was first used before flipkit in this process and "
                           "inflates boxes by 1e-10: collision distances (and so plans) may differ "
                           "from other processes' in their last digits", RuntimeWarning,
@@ -97,8 +93,6 @@ def pin_box_support() -> bool:
 def distance_request():
     """A coal DistanceRequest with :data:`GJK_TOLERANCE` (coal's box support pinned first,
     :func:`pin_box_support`)."""
-    import coal
-
     pin_box_support()
     req = coal.DistanceRequest()
     req.gjk_tolerance = GJK_TOLERANCE
@@ -156,8 +150,6 @@ def _mesh_shapes(robot: Robot) -> list[Shape]:
 
 def _load_mesh_shapes(robot: Robot) -> list[Shape]:
     """:func:`_mesh_shapes` without the cache."""
-    import coal
-
     dirs = [str(robots_dir().parent.parent)] if robots_dir() is not None else []
     try:
         gmodel = pin.buildGeomFromUrdf(robot.model, robot.urdf, pin.COLLISION, package_dirs=dirs)
@@ -186,8 +178,6 @@ class ArmShapes:
     """
 
     def __init__(self, robot: Robot, cell: CellConfig | None = None):
-        import coal
-
         self.robot, self.cell = robot, cell or robot.cell
         sp = self.cell.spatula
         shapes = _mesh_shapes(robot)
@@ -246,8 +236,6 @@ class ArmShapes:
     def _query(self, k: int, R: np.ndarray, p: np.ndarray, b: int, req, res):
         """coal distance of shape k at world placement (R, p) to box b: (d, witness on the
         shape, unit normal from the shape to the box)."""
-        import coal
-
         geom, tf, _, _ = self._box_geoms[b]
         res.clear()
         d = coal.distance(self.shapes[k].geometry, coal.Transform3s(R, p), geom, tf, req, res)
@@ -278,8 +266,6 @@ class ArmShapes:
             (d (n,), ∂d/∂q (n, nq), nearest shape (n,), nearest box (n,)), as :meth:`nearest`
             at each configuration (indices −1 where every pair lies beyond ``cap``).
         """
-        import coal
-
         m, data = self.robot.model, self.robot.data
         qs = np.asarray(qs, float)
         n, nb = len(qs), len(self.boxes)
@@ -323,8 +309,6 @@ class ArmShapes:
 
     def distance(self, q, shape: int, box: int) -> tuple[float, np.ndarray]:
         """Distance (m) of one shape to one box at q and its gradient ∂d/∂q."""
-        import coal
-
         placed = self._place(q)
         M = placed[shape]
         dist, p1, n = self._query(shape, M.rotation, M.translation, box, distance_request(),

@@ -19,8 +19,11 @@ os.environ.setdefault("MUJOCO_GL", "osmesa")
 
 from pathlib import Path  # noqa: E402
 
+import matplotlib  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
+from PIL import Image  # noqa: E402
+from tqdm import tqdm  # noqa: E402
 
 from flipkit.errors import FlipkitError, InvalidChoiceError  # noqa: E402
 
@@ -90,7 +93,6 @@ def render(execution, indices, width: int = 480, height: int = 360, progress: bo
     try:
         it = indices
         if progress:
-            from tqdm import tqdm
             it = tqdm(indices, desc="frames", unit="frame")
         spot = _landing_spot(execution)
         for k in it:
@@ -119,21 +121,17 @@ def write_animation(execution, out, fps: float = 30.0, width: int = 480, height:
         raise InvalidChoiceError("animation format", ext or out.name, FORMATS)
     if ext == ".mp4":
         try:
-            import imageio_ffmpeg  # noqa: F401
+            import imageio_ffmpeg  # optional (not in environment.lock): only .mp4 needs it
         except ImportError:
             raise FlipkitError("MP4 needs imageio-ffmpeg, which is not installed (not in "
                                "environment.lock); write a .gif instead") from None
     frames = render(execution, frame_indices(execution.run.t, fps), width, height, progress)
     try:
         if ext == ".gif":
-            from PIL import Image
-
             imgs = [Image.fromarray(f) for f in frames]
             imgs[0].save(out, save_all=True, append_images=imgs[1:], loop=0,
                          duration=int(round(1000 / fps)))
         else:
-            import imageio_ffmpeg
-
             w = imageio_ffmpeg.write_frames(str(out), (width, height), fps=fps)
             w.send(None)
             for f in frames:
@@ -178,7 +176,7 @@ def filmstrip_figure(execution, width: int = 320, height: int = 240, panel_width
     Returns:
         ``(fig, times)``: the figure and ``{key: time (s) or None}`` of the moments shown.
     """
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # pyplot picks a backend: write_filmstrip chooses Agg first
 
     keys = key_frames(execution)
     last = len(execution.run.t) - 1
@@ -198,10 +196,8 @@ def filmstrip_figure(execution, width: int = 320, height: int = 240, panel_width
 
 def write_filmstrip(execution, out, width: int = 320, height: int = 240) -> Path:
     """A PNG of the key frames (:func:`filmstrip_figure`) side by side."""
-    import matplotlib
-
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after the backend is chosen
 
     fig, _ = filmstrip_figure(execution, width, height)
     try:

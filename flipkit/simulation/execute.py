@@ -36,6 +36,7 @@ from flipkit.planning.plans.servo_command import COMMANDS, command_lead, positio
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
+from flipkit.model.robot import Robot
 from flipkit.simulation.modes import FEEDFORWARD, MODES, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
 
@@ -178,8 +179,6 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     d_ = _check(plan, mode, draw, hold, rate_hz)
     if command not in COMMANDS:
         raise InvalidChoiceError("position command", command, COMMANDS)
-    from flipkit.model.robot import Robot
-
     cell = cell or plan.cell()
     if physics is not None:
         cell = replace(cell, physics=physics)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flipkit.errors import ConfigError
-from flipkit.simulation.run import BLADE_GAP_TOL, GRILL_SEPARATION, BurgerRun, _half_extent
+from flipkit.simulation.run import BLADE_GAP_TOL, GRILL_SEPARATION, BurgerRun, half_extent
 
 UPSIDE_DOWN_Z = -0.9  # up-axis z below this: lying on its other side (within ~26°)
 LANDING_TOL = 0.05  # m, in x and in y (paper Sec. V)
@@ -188,7 +188,7 @@ def judge_serve(run: BurgerRun, spot, table) -> ServeVerdict:
     """
     p, up_z = run.burger_pos[-1], float(run.up_z[-1])
     offset = p[:2] - np.asarray(spot, float)[:2]
-    bottom = p[2] - float(_half_extent(up_z, run.burger_diameter, run.burger_thickness))
+    bottom = p[2] - float(half_extent(up_z, run.burger_diameter, run.burger_thickness))
     inside = (table.x_range[0] <= p[0] <= table.x_range[1]
               and table.y_range[0] <= p[1] <= table.y_range[1])
     on_table = bool(inside and abs(bottom - table.height) <= BLADE_GAP_TOL)

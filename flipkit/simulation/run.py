@@ -19,7 +19,7 @@ BLADE_GAP_TOL = 0.003  # m: burger bottom within 3 mm of the blade's carrying fa
 GRILL_SEPARATION = 0.001  # m: burger bottom more than 1 mm above the grill = lifted off it
 
 
-def _half_extent(axis_z, diameter: float, thickness: float):
+def half_extent(axis_z, diameter: float, thickness: float):
     """Extent of a cylinder below its centre along a unit direction n, where ``axis_z`` is the
     cosine between n and the cylinder axis: r·sin θ + (h/2)·|cos θ|."""
     axis_z = np.clip(np.abs(axis_z), 0.0, 1.0)
@@ -81,12 +81,12 @@ class BurgerRun:
         blade normal (m), N; negative when it sinks into (or lies under) the blade plane."""
         local = self.in_blade_frame()
         axis_z = np.einsum("ni,ni->n", self.burger_rot[:, :, 2], self.spatula_rot[:, :, 2])
-        return local[:, 2] - _half_extent(axis_z, self.burger_diameter, self.burger_thickness)
+        return local[:, 2] - half_extent(axis_z, self.burger_diameter, self.burger_thickness)
 
     def grill_clearance(self) -> np.ndarray:
         """Height of the burger's lowest point above the grill surface (m), N."""
         return (self.burger_pos[:, 2] - self.grill_height
-                - _half_extent(self.up_z, self.burger_diameter, self.burger_thickness))
+                - half_extent(self.up_z, self.burger_diameter, self.burger_thickness))
 
     def over_blade(self) -> np.ndarray:
         """Burger centre over the blade rectangle and on its carrying side (blade frame), N."""

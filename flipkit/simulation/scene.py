@@ -47,6 +47,7 @@ import mujoco
 import numpy as np
 
 from flipkit.config import CellConfig
+from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
 
 NOSLIP_ITERATIONS = 10  # post-solve iterations: static friction holds without creep
@@ -138,7 +139,6 @@ def _joint_axis(joint) -> np.ndarray:
         return np.eye(3)["XYZ".index(name[-1])]
     if name == "JointModelRevoluteUnaligned":
         return np.asarray(joint.extract().axis, float)
-    from flipkit.errors import ConfigError
     raise ConfigError(f"scene supports revolute joints only, got {name}")
 
 
@@ -146,7 +146,6 @@ def _arm_bodies(robot: Robot, sp_xml: str) -> str:
     """Nested <body> elements of the six joints; ``sp_xml`` goes into the last one."""
     m = robot.model
     if m.njoints - 1 != ARM_JOINTS or any(m.parents[j] != j - 1 for j in range(1, m.njoints)):
-        from flipkit.errors import ConfigError
         raise ConfigError(f"scene needs a serial {ARM_JOINTS}-joint arm, got {m.njoints - 1}")
     opened, close = [], []
     for j in range(1, m.njoints):

@@ -8,6 +8,9 @@ leave the figure size, style (:func:`flipkit.figures.style`) and saving to the c
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.patches import Patch
+from mpl_toolkits.mplot3d import proj3d
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
@@ -46,8 +49,6 @@ def _group_locations(locations, tol: float = 1e-3) -> list[tuple[np.ndarray, str
 def _label_spots(ax3d, points, gap: float = 0.04) -> list[np.ndarray]:
     """Label positions (m) beside ``points``, each chosen greedily among five offsets (above,
     ±x, ±y) to lie farthest, on screen, from the markers and the labels already placed."""
-    from mpl_toolkits.mplot3d import proj3d
-
     def screen(xyz):
         x, y, _ = proj3d.proj_transform(*np.asarray(xyz, dtype=float).T, ax3d.get_proj())
         return np.column_stack([x, y])
@@ -92,9 +93,6 @@ def draw_cell(ax3d, robot: Robot, cell: CellConfig, q, locations, legend: bool =
         ``blade`` (4, 3) corners, ``spatula_position`` (3,) blade centre, and
         ``location_labels``, one label per drawn marker (e.g. ``"1,4"``).
     """
-    from matplotlib.patches import Patch
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     q = np.asarray(q, dtype=float)
     if q.shape != (robot.nq,) or not np.all(np.isfinite(q)):
         raise ConfigError(f"q must be {robot.nq} finite joint angles (rad), got {q.tolist()}")

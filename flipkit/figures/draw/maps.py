@@ -4,16 +4,18 @@ grill (locations by outcome, where the burgers landed)."""
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.ticker import MaxNLocator
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from flipkit.errors import ConfigError
 from flipkit.figures.draw.cell import draw_cell
 from flipkit.figures.style import ACTUAL_COLOR, BURGER_COLOR, DESIRED_COLOR
 
+
 def draw_burger(ax3d, center, R, diameter: float, thickness: float, color=BURGER_COLOR,
                 n: int = 32):
     """A burger disc (its two faces) centred at ``center`` with axis R[:, 2], in 3D (m)."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     R = np.asarray(R, float)
     ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
     ring = (diameter / 2) * (np.outer(np.cos(ang), R[:, 0]) + np.outer(np.sin(ang), R[:, 1]))
@@ -69,8 +71,6 @@ def draw_snapshot(ax3d, robot, cell, q, location=None, burger: str | None = None
     ax3d.set_ylim(*lim[1])
     ax3d.set_zlim(*lim[2])
     ax3d.set_box_aspect(lim[:, 1] - lim[:, 0])
-    from matplotlib.ticker import MaxNLocator
-
     for axis in (ax3d.xaxis, ax3d.yaxis, ax3d.zaxis):
         axis.label.set_size(6)
         axis.set_major_locator(MaxNLocator(3))
@@ -97,8 +97,6 @@ def plot_grill_map(ax, cell, points, categories, styles, title: str = "",
         table_locations: Optional Table I locations, drawn as small crosses for reference.
         notes: Optional short text per location (k,), written beside its marker (None: none).
     """
-    from matplotlib.patches import Rectangle
-
     g = cell.grill
     ax.add_patch(Rectangle((g.y_range[0], g.x_range[0]), g.y_range[1] - g.y_range[0],
                            g.x_range[1] - g.x_range[0], facecolor="0.93", edgecolor="0.3",
@@ -151,8 +149,6 @@ def plot_landings(ax, cell, points: dict, targets_xy, radius: float = 0.05, titl
         scenarios: Planned landing points (k×2) (m) of the plans' robust scenarios
             (:func:`flipkit.figures.data.scenario_landings`), drawn as plus signs.
     """
-    from matplotlib.patches import Circle, Rectangle
-
     g = cell.grill
     ax.add_patch(Rectangle((g.y_range[0], g.x_range[0]), g.y_range[1] - g.y_range[0],
                            g.x_range[1] - g.x_range[0], facecolor="0.95", edgecolor="0.3",

@@ -5,6 +5,9 @@ drew (numbers for captions); figure size, style and saving stay with the caller.
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.colors import ListedColormap
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from flipkit.errors import ConfigError
 from flipkit.figures.data import CONE_CLASSES
@@ -225,9 +228,6 @@ def plot_cone_regions(ax, tilts, accels, grid) -> dict:
     Returns:
         The area fraction of each class of :data:`~flipkit.figures.data.CONE_CLASSES`.
     """
-    from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch
-
     deg = np.degrees(np.asarray(tilts, float))
     cat = grid["category"]
     acc = np.asarray(accels, float)
@@ -248,8 +248,6 @@ def plot_cone_regions(ax, tilts, accels, grid) -> dict:
     handles = [Patch(facecolor=c, edgecolor="0.5", lw=0.4, label=lab)
                for c, lab in zip(CONE_CLASS_COLORS, ("both admit", "only physical (5)",
                                                     "only paper (20)", "neither"))]
-    from matplotlib.lines import Line2D
-
     handles.append(Line2D([], [], color="k", ls="--" if admits else "none", lw=0.9,
                           label="(20) as printed ($a$ without $g$)" + (
                               "" if admits else ":\nadmits no point here")))

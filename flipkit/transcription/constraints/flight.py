@@ -22,6 +22,7 @@ from flipkit.errors import ConfigError
 from flipkit.model.flight import (TILT_MIN_DEG, clearance_function, gravity_magnitude,
                                   landing_function, landing_parameters, predict_landing)
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.layout import Evaluation
 
 
 def _release_inputs(ev, r: int):
@@ -96,8 +97,6 @@ class Landing(Block):
 
     def record(self, robot, x) -> tuple[dict, dict]:
         """The plan file's ``release`` and ``landing`` records at the solution ``x``."""
-        from flipkit.transcription.layout import Evaluation
-
         ev = Evaluation(self.layout, robot, np.asarray(x, float))
         r = self.release
         pred = _predictions(ev, robot, r, [self.par])[0]
@@ -150,8 +149,6 @@ class ScenarioLanding(Block):
 
     def record(self, robot, x) -> list[dict]:
         """The plan file's ``landing["scenarios"]`` at the solution ``x``."""
-        from flipkit.transcription.layout import Evaluation
-
         ev = Evaluation(self.layout, robot, np.asarray(x, float))
         return [{"burger_on_blade": list(ob), "r_land": float(self.hi[0]), **pred}
                 for ob, pred in zip(self.scenarios, _predictions(ev, robot, self.release,

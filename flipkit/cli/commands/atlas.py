@@ -1,0 +1,47 @@
+"""``flipkit atlas build`` and ``flipkit atlas info`` (arguments: :mod:`flipkit.cli.atlas`):
+solve the grid and write the atlas, or describe one."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
+from flipkit.config import CellConfig
+from flipkit.experiments.atlas import DEFAULT_GRID, build_atlas
+from flipkit.fileio import check_output
+from flipkit.planning.planners.atlas import Atlas, default_path, options_hash
+
+
+def run_build(args: argparse.Namespace) -> int:
+    """Build, write, summarise."""
+    grid = tuple(args.grid) if args.grid else DEFAULT_GRID
+    for n in grid:
+        check_int("--grid", n, 1, MAX_GRID)
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    out = check_output(args.out or default_path(), "--out", (".npz",))
+    atlas = build_atlas(grid=grid, scheduler=args.scheduler, workers=args.workers,
+                        progress=not args.no_progress)
+    out = atlas.save(out)
+    m = atlas.meta
+    print(f"flipkit atlas: {len(atlas)}/{grid[0] * grid[1]} locations solved "
+          f"({len(m['failed'])} failed), cold median {m['median_wall_s']:.2f} s and "
+          f"{m['median_iterations']:.0f} SQP iterations per chain, built in {m['build_s']:.0f} s;"
+          f" wrote {out}")
+    for loc, why in m["failed"]:
+        print(f"  failed at ({loc[0]:.3f}, {loc[1]:.3f}): {why}", file=sys.stderr)
+    return 0
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """One paragraph about an atlas, and whether it serves today's default options."""
+    path = args.file or default_path()
+    atlas = Atlas.load(path)
+    m = atlas.meta
+    current = m.get("options_hash") == options_hash(CellConfig(), SegmentOptions())
+    print(f"{path}: {len(atlas)} locations on a {m['grid'][0]} x {m['grid'][1]} grid, "
+          f"{len(m['failed'])} failed; built at commit {m.get('flipkit_commit') or '?'}; "
+          f"{'serves' if current else 'does NOT serve'} the default options")
+    return 0

@@ -1,0 +1,36 @@
+"""``flipkit validate`` once its arguments passed :mod:`flipkit.cli.validate`: verify the
+plan, run the trials on the executor, write the JSON, print the table."""
+
+from __future__ import annotations
+
+import argparse
+
+from flipkit.cli.common import write_json
+from flipkit.cli.validate import format_table
+from flipkit.experiments.compare_ik import LOCATION_SETS
+from flipkit.experiments.sweep import make_executor
+from flipkit.experiments.trials import validate_locations, validate_plan_file
+from flipkit.planning.plans.verify import load_verified
+
+
+def run(args: argparse.Namespace) -> int:
+    """Verify the plan, run the trials, write the JSON, print the table."""
+    if args.plan is not None:
+        load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
+    common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
+                  replan=args.replan, command=args.command)
+    with make_executor(args.scheduler, args.workers) as executor:
+        if args.plan is not None:
+            out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
+                                     cache_dir=args.cache, **common)
+        else:
+            out = validate_locations(LOCATION_SETS[args.locations], args.trials, args.solver,
+                                     args.seed, executor=executor, cache_dir=args.cache,
+                                     plans_dir=args.plans, **common)
+    write_json(args.json, out)
+    print(format_table(out))
+    total = out["summary"]
+    print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
+          f"{total['locations']} locations, "
+          f"success {total['success']}; wrote {args.json}")
+    return 0

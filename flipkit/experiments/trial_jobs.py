@@ -1,0 +1,61 @@
+"""The job of one simulated trial, shared by the flip trials (:mod:`flipkit.experiments.trials`)
+and the serve trials (:mod:`flipkit.experiments.serve_trials`): the job dicts a sweep worker
+receives, their cache key, the plan read back from its text, and the spatula tracking errors
+merged over trials."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+
+import numpy as np
+
+from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.sweep import stable_hash
+from flipkit.planning.plans.plan_file import Plan
+from flipkit.simulation.modes import FEEDFORWARD
+
+TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
+HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
+PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
+             "cone", "segments", "created_by")
+
+
+def plan_from_text(text: str) -> Plan:
+    """A plan from the text of a ``flipkit-plan`` file (already checked by Plan.load)."""
+    doc = json.loads(text)
+    return Plan(**{k: doc[k] for k in PLAN_KEYS})
+
+
+def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
+               rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
+               replan: bool = False, physics: dict | None = None,
+               command: str = "compensated") -> list:
+    """The trial jobs of one plan (``physics``: see :func:`flipkit.experiments.trials.run_trial`;
+    the key is left out when empty, so the cache keys of nominal trials do not change)."""
+    extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
+    return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
+             "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
+             "replan": bool(replan), "command": command, **extra} for i in range(trials)]
+
+
+def trial_key(job: dict) -> dict:
+    """Cache key of a trial job: the plan's digest instead of its text."""
+    return {**{k: v for k, v in job.items() if k != "plan_text"},
+            "plan": stable_hash(job["plan_text"])}
+
+
+def merge_tracking(errors: list) -> dict:
+    """Per-segment {"max_m", "rms_m"} (m) over several
+    :func:`flipkit.experiments.trials.track_plan` error dicts."""
+    out = {}
+    for name in dict.fromkeys(k for e in errors for k in e):
+        rows = [e[name] for e in errors if name in e]
+        n = sum(r["n"] for r in rows)
+        out[name] = {"max_m": max(r["max_m"] for r in rows),
+                     "rms_m": float(np.sqrt(sum(r["sum_sq_m2"] for r in rows) / n))}
+    return out
+
+
+__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "merge_tracking", "plan_from_text",
+           "trial_jobs", "trial_key"]
