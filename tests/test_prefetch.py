@@ -44,8 +44,7 @@ def test_prefetched_cook_equals_the_serial_one():
         assert [s.name for s in a.plan.segments] == [s.name for s in b.plan.segments]
         assert b.plan.status == "solved" and verify_plan(b.plan, space=CELL.space).ok
         assert np.abs(b.plan.segments[0].q[0] - q_home).max() == 0.0  # from rest at home
-    # the planning clock follows when plans were in, not the sum of their times
-    assert parallel.planning_time_s <= sum(m.planning_time_s for m in parallel.motions)
+    # (the planning clocks, serial and prefetched: python -m flipkit.experiments.bench flip --cook)
 
 
 @pytest.mark.slow

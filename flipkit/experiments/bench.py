@@ -2,7 +2,8 @@
 
     python -m flipkit.experiments.bench translate [--full] [--jit] [--json OUT]
     python -m flipkit.experiments.bench flip [--locations N] [--batch K] [--atlas FILE]
-                                             [--no-atlas] [--no-ipopt] [--json OUT]
+                                             [--no-atlas] [--no-ipopt] [--baseline] [--cook]
+                                             [--json OUT]
 
 ``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
 NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP and
@@ -15,7 +16,14 @@ starts, the SQP warm-started from the atlas (:mod:`flipkit.planning.planners.atl
 by default) and IPOPT, then
 a batch of the first K locations with the SQP, cold and from the atlas (``flipkit plan
 batch``'s default), one after the other and on one worker process per CPU, beside the paper's budgets (Sec. I: < 20 s
-per trajectory, 4–5 burgers within 90 s). Times are wall-clock seconds of the solver calls
+per trajectory, 4–5 burgers within 90 s). With ``--baseline``, the end-effector-space + IK
+baseline (:func:`flipkit.baseline.run_baseline`, each EE method, placo IK at 200 Hz) at the
+same locations: its EE optimisation and IK times per subbehaviour beside the paper's (Sec. I:
+EE optimisation < 1 s). With ``--cook``, the package's cook order
+(:data:`flipkit.planning.kitchen.cook.EXAMPLE_ORDER`) scheduled with the SQP, its motions planned one
+after another and then ahead on one worker process per CPU
+(:mod:`flipkit.planning.kitchen.prefetch`): the planning clock (to the last plan in) beside the sum
+of the motions' planning times. Times are wall-clock seconds of the solver calls
 (IPOPT's include building its CasADi problem). Before timing, every NLP structure gets one
 SQP iteration, and its hard and elastic QPs are compiled, so that cvxpy's one-off
 canonicalisation (0.01–0.4 s per QP, once per process) is not timed.
@@ -34,6 +42,7 @@ import warnings
 
 import numpy as np
 
+from flipkit.baseline import EE_METHODS, run_baseline
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import flat_pose, transcribe
@@ -42,8 +51,12 @@ from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import Atlas, default_atlas
 from flipkit.behaviors.models import models_for
 from flipkit.planning.planners.chain import solve_segment
+from flipkit.planning.kitchen.cook import EXAMPLE_ORDER, check_cook, read_cook_csv, table_spots
+from flipkit.planning.kitchen.motions import default_planners
 from flipkit.planning.planners.planner import plan_batch, plan_flip
 from flipkit.experiments.bench_replan import bench_replan, load_result, run_validation
+from flipkit.planning.kitchen.prefetch import PrefetchPlanners
+from flipkit.planning.kitchen.schedule import schedule_cook
 from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
@@ -65,6 +78,7 @@ TRANSLATE_KEY_POINTS = (
 )
 PAPER_PER_TRAJECTORY_S = 20.0  # Sec. I: < 20 s per trajectory
 PAPER_FIVE_BURGERS_S = 90.0  # Sec. I: 4–5 burgers within 90 s
+PAPER_EE_OPT_S = 1.0  # Sec. I: the end-effector optimisation takes < 1 s
 
 
 def machine() -> str:
@@ -225,11 +239,12 @@ def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
 
 
 def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
-               ipopt: bool = True) -> dict:
+               ipopt: bool = True, baseline: bool = False, cook: bool = False) -> dict:
     """Full pickup-and-flip at the first ``n_locations`` Table I locations with the SQP from
     cold starts, the SQP warm-started from ``atlas`` (if given) and IPOPT (if ``ipopt``),
-    then a batch of the first ``n_batch`` with the SQP, cold and from ``atlas``; print;
-    return the rows."""
+    then a batch of the first ``n_batch`` with the SQP, cold and from ``atlas``, the EE + IK
+    baseline's times at the same locations (if ``baseline``) and the package's cook order
+    scheduled with and without prefetching (if ``cook``); print; return the rows."""
     models, locs = models_for(cell), TABLE1_LOCATIONS[:n_locations]
     q, qd, structures = models.bare.q_home, None, []
     for name in FLIP_NAMES:  # one NLP per structure, along the initial guesses
@@ -285,7 +300,60 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
         out["batch"] = _bench_batch(cell, n_batch, None)
         if atlas is not None:
             out["batch_atlas"] = _bench_batch(cell, n_batch, atlas)
+    if baseline:
+        out["baseline"] = _bench_baseline(cell, locs)
+    if cook:
+        out["cook"] = _bench_cook(cell, atlas)
     return out
+
+
+def _bench_baseline(cell: CellConfig, locations) -> dict:
+    """The EE + IK baseline at ``locations`` with each EE method (placo IK, 200 Hz): the
+    EE optimisation and IK wall times (s) of every subbehaviour it ran; print; return them."""
+    out = {}
+    print(f"{'EE + IK baseline':<29}{'EE s med':>9}{'EE s max':>9}{'IK s med':>9}"
+          f"{'IK s max':>9}{'solved':>8} | paper budget", flush=True)
+    for ee in EE_METHODS:
+        results = [run_baseline(loc, cell, ee=ee) for loc in locations]
+        ee_s = [s.ee_time_s for r in results for s in r.segments]
+        ik_s = [s.ik_time_s for r in results for s in r.segments]
+        solved = sum(r.status == "solved" for r in results)
+        out[ee] = {"ee_s": ee_s, "ik_s": ik_s, "solved": solved,
+                   "segments": [[s.subbehavior for s in r.segments] for r in results]}
+        print(f"{'  EE ' + ee:<29}{_med(ee_s):9.3f}{max(ee_s, default=float('nan')):9.3f}"
+              f"{_med(ik_s):9.3f}{max(ik_s, default=float('nan')):9.3f}"
+              f"{solved:>5}/{len(results)} | EE < {PAPER_EE_OPT_S:.0f} s", flush=True)
+    print("EE s, IK s = wall time of one subbehaviour's end-effector optimisation and of its "
+          "IK (placo, 200 Hz), over every subbehaviour the baseline ran at these locations")
+    return out
+
+
+def _bench_cook(cell: CellConfig, atlas) -> dict:
+    """The package's cook order (flips and serves, SQP) scheduled with its motions planned one
+    after another and ahead on one worker process per CPU; print; return the record."""
+    burgers, kinds = read_cook_csv(EXAMPLE_ORDER, cell), ("flip", "serve")
+    q_home = cell.robot.q_home
+    runs = {"serial": schedule_cook(burgers, default_planners(kinds, cell, "sqp", atlas), q_home,
+                                    kinds=kinds, cell=cell)}
+    workers = os.cpu_count() or 1
+    executor = make_executor(workers=workers)
+    try:
+        planners = PrefetchPlanners(check_cook(burgers, cell), kinds, q_home, table_spots(cell),
+                                    executor, cell, "sqp", atlas)
+        runs["prefetch"] = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell)
+    finally:
+        executor.shutdown()
+    out = {}
+    for name, tl in runs.items():
+        total = sum(m.planning_time_s for m in tl.motions)
+        out[name] = {"planning_clock_s": tl.planning_time_s, "sum_planning_s": total,
+                     "motions": len(tl.motions), "ok": tl.ok}
+        print(f"cook {EXAMPLE_ORDER.name} ({len(burgers)} burgers, {len(tl.motions)} motions, "
+              f"{'ok' if tl.ok else 'FAILED'}), {name}"
+              f"{f' on {workers} worker processes' if name == 'prefetch' else ''}: planning "
+              f"clock {tl.planning_time_s:.1f} s, sum of the motions' planning times "
+              f"{total:.1f} s", flush=True)
+    return {"workers": workers, **out}
 
 
 def _bench_batch(cell: CellConfig, n_batch: int, atlas) -> dict:
@@ -361,6 +429,11 @@ def main(argv=None) -> int:
                              "the package's, when it serves the default options)")
     parser.add_argument("--no-atlas", action="store_true", help="flip: no atlas column")
     parser.add_argument("--no-ipopt", action="store_true", help="flip: no IPOPT column")
+    parser.add_argument("--baseline", action="store_true",
+                        help="flip: also time the EE + IK baseline at the same locations")
+    parser.add_argument("--cook", action="store_true",
+                        help="flip: also schedule the package's cook order, serial and "
+                             "prefetched, and compare the planning clocks")
     parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
     args = parser.parse_args(argv)
     if not 1 <= args.locations <= len(TABLE1_LOCATIONS) or not 0 <= args.batch <= 5:
@@ -377,7 +450,8 @@ def main(argv=None) -> int:
         if not args.no_atlas:
             atlas = (Atlas.load(args.atlas, cell, SegmentOptions()) if args.atlas
                      else default_atlas(cell))
-        result = bench_flip(cell, args.locations, args.batch, atlas, not args.no_ipopt)
+        result = bench_flip(cell, args.locations, args.batch, atlas, not args.no_ipopt,
+                            args.baseline, args.cook)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(_plain(result), fh, indent=1)
