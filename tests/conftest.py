@@ -10,12 +10,13 @@ from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
 
 
-@pytest.fixture(scope="session")
+# Scope "package": the tests/ directory (not a package), so once per test run.
+@pytest.fixture(scope="package")
 def cell():
     return CellConfig()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def robot(cell):
     return Robot(cell, with_burger=True)
 
@@ -61,9 +62,9 @@ def random_states(robot, seed, n=5):
         yield q, rng.uniform(-1.5, 1.5, robot.nq), rng.uniform(-5, 5, robot.nq)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def flip_plan():
-    """One solved SQP flip plan at a Table I location, planned once per session (≈ 5 s).
+    """One solved SQP flip plan at a Table I location, planned once per test run (≈ 5 s).
 
     ``FLIPKIT_TEST_PLAN=path.json`` reuses a plan file instead (e.g. while iterating on the
     simulation side); the default plans it with the current planner.
@@ -77,6 +78,6 @@ def flip_plan():
     return plan
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def flip_plan_file(flip_plan, tmp_path_factory):
     return flip_plan.to_json(tmp_path_factory.mktemp("flip_plan") / "plan.json")

@@ -101,7 +101,7 @@ def test_real_entry_point_prints_one_line(tmp_path):
 def flip_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("flip") / "flip.json"
     # the CLI's defaults (solver auto, the package's atlas). IPOPT alone at this location
-    # (0.76, 0.09) stretched the flip to 0.9 s and then found no turn back (session 7); the
+    # (0.76, 0.09) stretched the flip to 0.9 s and then found no turn back (2026-11-23); the
     # IPOPT cross-check is bench flip's ipopt column.
     loc = TABLE1_LOCATIONS[2]
     rc = main(["plan", "flip", "--burger", *map(str, loc), "--json", str(path)])

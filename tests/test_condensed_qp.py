@@ -104,19 +104,19 @@ def test_warm_start_cuts_iterations(segments):
 
 def test_sqp_condensed_and_full_space_agree(segments):
     """The SQP reaches the same optimum with either form of the subproblem on a smooth NLP (the
-    translate without the arm's clearance rows), to 1e-4 of Σu². Until session 8 the two forms
+    translate without the arm's clearance rows), to 1e-4 of Σu². Until 2026-11-23 the two forms
     took the same iterations to the same point to rounding; since the joint limits hold between
     the nodes (InterpolantLimits, active along the cruise at 2.16 rad/s) OSQP's tolerance on the
     full-space form's active rows sends it another way through a flat valley: measured 6
     (condensed) vs 8 (full) iterations to Σu² 13 264.31 vs 13 263.90, joint paths up to 0.07
     rad apart. With the clearance rows (piecewise smooth where the nearest pair changes) the
     forms' rounding differences can switch a nearest pair and the path: measured 11 vs 6
-    iterations to objectives 1.5e-3 apart (session 7)."""
+    iterations to objectives 1.5e-3 apart (2026-11-23)."""
     models = Models(CellConfig())
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
     smooth = transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)),
                            options=SegmentOptions(arm_clearance=False))
-    # converged as tightly as before session 12 (ftol 1e-4): the forms, not the stopping
+    # converged as tightly as before 2026-11-24 (ftol 1e-4): the forms, not the stopping
     # rule, are compared (at the default 1e-3 each stops where its own model's gain is small)
     tight = TerminationOptions(ftol=1e-4)
     a = solve_sqp(smooth, options=SQPOptions(tight, qp=QPOptions(condense=True)))

@@ -100,7 +100,7 @@ def test_task_constraints_hold_at_fine_samples(chain, cell):
             floor[s < 1 - 1e-9] = hg
             floor[s > 1 - 1 / (SAMPLES - 1)] = hg - SCOOP_PRESS - SCOOP_TIP_BAND
         # imposed at the SAMPLES only, like collocation's nodes: between them an edge may dip
-        # (measured: 1.1 mm in the turn back's first sixth, session 9)
+        # (measured 2026-11-23: 1.1 mm in the turn back's first sixth)
         assert np.all(heights.min(axis=1) >= floor - 2e-3), name
         assert np.all(np.abs(tr.v) <= lim.v_max + 1e-6) and np.all(np.abs(tr.a) <= lim.a_max + 1e-6)
         assert np.all(tr.o[:, 1] >= lim.pitch_range[0] - 1e-6)

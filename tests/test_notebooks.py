@@ -1,5 +1,5 @@
 """The figure notebooks end to end (quick mode, through papermill) and the report that cites
-them: every DESIGN.md figure has a notebook that runs and saves a non-empty PDF and PNG into
+them: every figure of the report has a notebook that runs and saves a non-empty PDF and PNG into
 the manifest; paper/main.tex includes and names every figure; the macro file generated from
 the manifest has one macro per number and defines every number the report quotes."""
 
@@ -12,8 +12,8 @@ import pytest
 
 from flipkit import figures
 
-# The figure table of DESIGN.md ("The figures"), in its order.
-DESIGN_FIGURE_IDS = ("cell", "forces", "subbehaviors", "defects", "translate", "flip", "table1",
+# The figures of the report (paper/main.tex), in its order.
+REPORT_FIGURE_IDS = ("cell", "forces", "subbehaviors", "defects", "translate", "flip", "table1",
                      "ik_failure", "solve_times", "cone_forms", "landing", "filmstrip",
                      "sensitivity", "schedule")
 PAPER_DIR = figures.REPO_ROOT / "paper"
@@ -35,8 +35,8 @@ def uses(fig_id=None):
 
 # ---------------------------------------------------------------- fast checks
 def test_design_figures_have_notebooks():
-    assert figures.FIGURE_IDS == DESIGN_FIGURE_IDS
-    for fig_id in DESIGN_FIGURE_IDS:
+    assert figures.FIGURE_IDS == REPORT_FIGURE_IDS
+    for fig_id in REPORT_FIGURE_IDS:
         path = figures.NOTEBOOKS_DIR / figures.FIGURES[fig_id]
         assert path.is_file(), f"no notebook for figure {fig_id!r}"
         text = path.read_text()
@@ -46,8 +46,8 @@ def test_design_figures_have_notebooks():
 def test_every_figure_is_included_and_named_in_the_paper():
     text = tex()
     targets = INCLUDE.findall(text)
-    assert sorted(targets) == sorted(f"../figures/{i}.pdf" for i in DESIGN_FIGURE_IDS)
-    for fig_id in DESIGN_FIGURE_IDS:
+    assert sorted(targets) == sorted(f"../figures/{i}.pdf" for i in REPORT_FIGURE_IDS)
+    for fig_id in REPORT_FIGURE_IDS:
         notebook = "notebooks/" + figures.FIGURES[fig_id]
         assert notebook.replace("notebooks/", r"\nb{").replace("_", r"\_") + "}" in text, notebook
         assert f"\\fkcaption{{{fig_id}}}" in text
@@ -57,7 +57,7 @@ def test_every_figure_is_included_and_named_in_the_paper():
 def test_paper_quotes_only_numbers_of_known_figures():
     found = uses()
     assert len(found) > 40
-    assert {f for _, f, _ in found} <= set(DESIGN_FIGURE_IDS)
+    assert {f for _, f, _ in found} <= set(REPORT_FIGURE_IDS)
     assert (PAPER_DIR / "main.tex").read_text().count(r"\input{numbers}") == 1
 
 
@@ -71,7 +71,7 @@ def test_paper_has_the_differences_section():
 
 # ---------------------------------------------------------------- notebooks, quick mode
 @pytest.mark.slow
-@pytest.mark.parametrize("fig_id", DESIGN_FIGURE_IDS)
+@pytest.mark.parametrize("fig_id", REPORT_FIGURE_IDS)
 def test_notebook_runs_quick_and_feeds_the_paper(fig_id, tmp_path):
     out = tmp_path / "figures"
     report = figures.run_notebooks(quick=True, only=[fig_id], out_dir=out,
@@ -117,7 +117,7 @@ def test_paper_compiles_with_the_current_figures(tmp_path):
     if not manifest_path.is_file():
         pytest.skip("no figures/manifest.json (run make figures)")
     manifest = json.loads(manifest_path.read_text())
-    if set(manifest["figures"]) != set(DESIGN_FIGURE_IDS):
+    if set(manifest["figures"]) != set(REPORT_FIGURE_IDS):
         pytest.skip("figures/ is incomplete (run make figures)")
     paper = tmp_path / "paper"
     paper.mkdir()

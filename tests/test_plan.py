@@ -42,7 +42,7 @@ def cubic_segment(name, q0, q1, T, robot, N=20, goal=True):
                    SolverInfo("synthetic", "solved", 0, 0.0, float((u**2).sum()), 0.0), pose)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def models():
     return Models(CellConfig())
 

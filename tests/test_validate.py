@@ -1,4 +1,4 @@
-"""``flipkit validate`` on one plan (the session's SQP flip plan) with two trials: schema, seeded determinism,
+"""``flipkit validate`` on one plan (conftest's SQP flip plan) with two trials: schema, seeded determinism,
 perturbations, and one-line errors (exit 2) on bad input."""
 
 import json

@@ -71,7 +71,7 @@ class Thresholds:
         rate_tolerance: Relative tolerance on the velocity, acceleration and torque limits,
             for the error of their finite differences: at h = 2 ms (500 Hz) the one-sided
             difference at a segment's end is off by up to h²|q⃛|/3, 4e-4 rad/s for a jerk of
-            300 rad/s³ (measured, session 9: a turn back that starts exactly at q̇_max = 3.2
+            300 rad/s³ (measured 2026-11-23: a turn back that starts exactly at q̇_max = 3.2
             rad/s reads 3.20012 rad/s there). The IK holds a saturated joint at qd_max; its
             finite difference is qd_max to rounding.
         sigma_min: Smallest singular value of the 6×6 spatula Jacobian (linear part in m/rad,

@@ -82,7 +82,7 @@ GOLDEN_STEPS = 3  # golden-section reductions of the duration interval
 # The duration search first solves at the upper bound and just below it (PROBE_FRACTION of the
 # range): when the cost is no lower there, the minimum of a unimodal cost lies within that
 # tenth of the range, finer than the golden section's final bracket (0.618⁴ = 0.15), and the
-# search stops. Measured (session 9, Table I location 6): the cost fell with T in all five
+# search stops. Measured (2026-11-23, Table I location 6): the cost fell with T in all five
 # subbehaviours, and the golden section spent 3.7 of the flip's 4.3 s on shorter durations.
 PROBE_FRACTION = 0.1
 EDGES = np.array([[0.5, 0, 0], [-0.5, 0, 0], [0, 0.5, 0], [0, -0.5, 0]])  # × (l, w, ·)

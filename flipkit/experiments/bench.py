@@ -232,7 +232,7 @@ def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
     the call. A plan runs on one thread, so CPU ≈ wall on an idle machine, and wall > CPU
     says the machine was busy. (On the project's shared virtual machine identical solves,
     same iterations and plans, took up to 30 % longer from one minute to the next in CPU
-    time as in wall time, measured in session 11: compare runs made side by side.)"""
+    time as in wall time, measured 2026-11-23: compare runs made side by side.)"""
     t0 = time.process_time()
     plan = plan_flip(location, cell=cell, **kw)
     return {**_flip_row(plan), "cpu_s": time.process_time() - t0}

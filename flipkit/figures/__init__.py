@@ -1,4 +1,4 @@
-"""Figure layer: every figure of DESIGN.md made by a papermill notebook.
+"""Figure layer: every figure of the report (paper/main.tex) made by a papermill notebook.
 
 * :mod:`~flipkit.figures.catalog`: the figure ids and their notebooks;
 * :mod:`~flipkit.figures.style`: one matplotlib style, and :func:`save` (PDF, PNG, sidecar);

@@ -1,4 +1,4 @@
-"""The figures of DESIGN.md and the notebooks that make them."""
+"""The figures of the report (paper/main.tex) and the notebooks that make them."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS_DIR = REPO_ROOT / "notebooks"
-FIGURES = {  # figure id -> notebook that makes it (DESIGN.md, "The figures"), in paper order
+FIGURES = {  # figure id -> notebook that makes it, in the report's order
     "cell": "cell.ipynb", "forces": "forces.ipynb", "subbehaviors": "subbehaviors.ipynb",
     "defects": "defects.ipynb", "translate": "translate.ipynb", "flip": "flip.ipynb",
     "table1": "table1.ipynb", "ik_failure": "ik_failure.ipynb",

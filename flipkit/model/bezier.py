@@ -1,8 +1,8 @@
 """Bezier polynomials of degree 6 in s = t/T (paper eq. 15, with binomial coefficients).
 
 P(t) = Σ_k α_k C(M, k) s^k (1 − s)^(M−k), s = t/T. Eq. (15) as printed omits the binomial
-coefficients C(M, k) (DESIGN.md); with them, P(0) = α_0, P(T) = α_M and the curve lies in the
-convex hull of the coefficients.
+coefficients C(M, k) (docs/conventions.md); with them, P(0) = α_0, P(T) = α_M and the curve
+lies in the convex hull of the coefficients.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ from flipkit.model.robot import skew
 
 
 def rpy(R: np.ndarray) -> np.ndarray:
-    """o = (o_x, o_y, o_z) (rad) with R = R_z(o_z) R_y(o_y) R_x(o_x) (DESIGN.md)."""
+    """o = (o_x, o_y, o_z) (rad) with R = R_z(o_z) R_y(o_y) R_x(o_x) (docs/conventions.md)."""
     return np.array(pin.rpy.matrixToRpy(np.asarray(R, dtype=float)))
 
 

@@ -1,11 +1,11 @@
 """MuJoCo burger physics under a prescribed spatula motion (the blade alone, no arm).
 
 The model is built in code: the grill is a plane whose surface is at h_g, the spatula blade a
-thin box, the burger a free cylinder. Frames follow DESIGN.md: the blade frame has x along the
-blade toward the tip and z along its normal; its origin is the blade centre **on the top
-(carrying) face** — the box extends a thickness below it. The planner treats the blade as a
-zero-thickness plate through the spatula frame (the scoop puts ``p_z − (l/2) sin o_y = h_g``),
-so with this choice the carrying face meets the grill exactly at the tip and the burger's rim
+thin box, the burger a free cylinder. Frames follow docs/conventions.md: the blade frame has
+x along the blade toward the tip and z along its normal; its origin is the blade centre **on
+the top (carrying) face** — the box extends a thickness below it. The planner treats the
+blade as a zero-thickness plate through the spatula frame (the scoop puts
+``p_z − (l/2) sin o_y = h_g``), so with this choice the carrying face meets the grill exactly at the tip and the burger's rim
 rides up the blade without a step. The blade does not collide with the grill: its motion is
 prescribed, and the planned scoop puts it flush with the grill surface.
 

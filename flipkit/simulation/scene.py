@@ -6,7 +6,7 @@ the burger payload (the burger is its own free body here): one body per joint, p
 (the spatula's mass is already lumped into the last one). Inverse dynamics of the two models
 agree to round-off (tests/test_scene.py), so the planner's torques mean the same here.
 
-Geometry (DESIGN.md conventions): the spatula frame has x along the blade toward the tip and z
+Geometry (docs/conventions.md): the spatula frame has x along the blade toward the tip and z
 along its normal; its xy-plane is the blade's top (carrying) face — the zero-thickness plate of
 the planner. The blade is a convex mesh below that plane: ``blade_thickness`` thick, its
 leading edge (x = +l/2) ground on the underside over ``bevel_length`` down to
