@@ -48,25 +48,24 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     """
     # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
     # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
-    if solver == "sqp":
-        from flipkit.solvers.sqp import solve_sqp
+    from flipkit.solvers import ipopt, sqp
 
+    if solver == "sqp":
         try:
-            return solve_sqp(nlp, x0, raise_on_failure=False)
+            return sqp.solve_sqp(nlp, x0, raise_on_failure=False)
         except SolverError:  # OSQP or a factorisation broke down inside a subproblem
             x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
             return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
                                objective=nlp.objective(x), max_violation=float(
                                    nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0)))
-    if solver in ("ipopt", "auto"):
-        from flipkit.solvers.ipopt import IpoptOptions, solve_ipopt
     if solver == "ipopt":
-        return solve_ipopt(nlp, x0, raise_on_failure=False)
+        return ipopt.solve_ipopt(nlp, x0, raise_on_failure=False)
     if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
         first = solve_segment(nlp, "sqp", x0)
         if first.success:
             return first
-        second = solve_ipopt(nlp, x0, IpoptOptions(**FALLBACK_IPOPT), raise_on_failure=False)
+        second = ipopt.solve_ipopt(nlp, x0, ipopt.IpoptOptions(**FALLBACK_IPOPT),
+                                   raise_on_failure=False)
         second.wall_time_s += first.wall_time_s
         return second
     raise InvalidChoiceError("solver", solver, SOLVERS)
