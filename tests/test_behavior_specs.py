@@ -114,3 +114,21 @@ def test_the_plan_format_names_every_registered_subbehaviour():
         "plan-format.schema.json").read_text())
     names = schema["$defs"]["segment"]["properties"]["name"]["enum"]
     assert sorted(names) == sorted(library.SUBBEHAVIORS)
+
+
+def test_a_planner_with_its_own_workspace_plans_the_same():
+    """The SQP's workspace is the planner's when given one: its compiled subproblems are
+    used, with the same plan."""
+    from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
+
+    goal = Task(goal=flat_pose((0.70, 0.05, 0.30)))
+    shared = Planner(CELL, solver="sqp")
+    robot = shared.models.loaded
+    q0 = solve_pose(robot, (0.62, -0.10, 0.25), (0.0, 0.0, 0.0), robot.q_home)
+    qd0 = np.zeros(robot.nq)
+    a = shared.chain("translate", goal, q0, qd0)
+    own = SQPWorkspace()
+    b = Planner(CELL, solver="sqp", workspace=own).chain("translate", goal, q0, qd0)
+    assert a.status == b.status == "solved"
+    np.testing.assert_allclose(a.segments[0].q, b.segments[0].q, atol=1e-9)
+    assert own is not DEFAULT_WORKSPACE and own._built  # its own compiled subproblems

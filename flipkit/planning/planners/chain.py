@@ -33,12 +33,14 @@ from flipkit.solvers.result import SolveResult, Status
 FALLBACK_IPOPT = {"max_wall_time": 60.0, "max_iter": 1000}
 
 
-def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
+def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResult:
     """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
 
     ``auto`` runs the SQP and, when it fails, IPOPT from the same start within
     :data:`FALLBACK_IPOPT`'s budget (60 s, 1000 iterations); the segment's ``solver.name`` in
     the plan file records which one produced it and the wall time counts both.
+
+    ``sqp_kwargs`` go to :func:`~flipkit.solvers.sqp.solve_sqp` (e.g. ``workspace``).
 
     Returns the result whatever its status (``result.success`` tells); the worst constraint
     group of a failure is ``nlp.worst_group(result.x)``.
@@ -52,7 +54,7 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
 
     if solver == "sqp":
         try:
-            return sqp.solve_sqp(nlp, x0, raise_on_failure=False)
+            return sqp.solve_sqp(nlp, x0, raise_on_failure=False, **sqp_kwargs)
         except SolverError:  # OSQP or a factorisation broke down inside a subproblem
             x = np.clip(np.asarray(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
             return SolveResult(x=x, status=Status.QP_SOLVER_ERROR, iterations=0, wall_time_s=0.0,
@@ -61,7 +63,7 @@ def solve_segment(nlp, solver: str = "sqp", x0=None) -> SolveResult:
     if solver == "ipopt":
         return ipopt.solve_ipopt(nlp, x0, raise_on_failure=False)
     if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
-        first = solve_segment(nlp, "sqp", x0)
+        first = solve_segment(nlp, "sqp", x0, **sqp_kwargs)
         if first.success:
             return first
         second = ipopt.solve_ipopt(nlp, x0, ipopt.IpoptOptions(**FALLBACK_IPOPT),
@@ -93,7 +95,7 @@ def solver_failure(name: str, nlp, result) -> str:
     return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status}{budget})"
 
 
-def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
+def solve_stretched(build, options: SegmentOptions, solver: str, guess=None, **sqp_kwargs):
     """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
     duration bound, build and solve it once more with the bound stretched (SegmentOptions
     ``stretch``, :data:`~flipkit.behaviors.options.T_STRETCH`). Returns (nlp, result): the
@@ -118,12 +120,12 @@ def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
     x0 = None if guess is None or solver == "ipopt" else guess(nlp)
     deferred = False  # the cold solve within the bound, put off until the stretch fails
     if x0 is None:
-        result = solve_segment(nlp, solver)
+        result = solve_segment(nlp, solver, **sqp_kwargs)
     else:  # the SQP from the warm start; failing that, the usual cold solve (auto: + IPOPT)
-        result = solve_segment(nlp, "sqp", x0)
+        result = solve_segment(nlp, "sqp", x0, **sqp_kwargs)
         deferred = result.status == Status.INFEASIBLE and not options.stretch
         if not result.success and not deferred:
-            result = _counting(solve_segment(nlp, solver), result)
+            result = _counting(solve_segment(nlp, solver, **sqp_kwargs), result)
     if result.success or options.stretch:
         return nlp, result
     try:
@@ -131,12 +133,12 @@ def solve_stretched(build, options: SegmentOptions, solver: str, guess=None):
     except FlipkitError:
         longer = None
     if longer is not None:
-        second = solve_segment(longer, solver)
+        second = solve_segment(longer, solver, **sqp_kwargs)
         if second.success:
             second.wall_time_s += result.wall_time_s
             return longer, second
     if deferred:
-        result = _counting(solve_segment(nlp, solver), result)
+        result = _counting(solve_segment(nlp, solver, **sqp_kwargs), result)
     return nlp, result
 
 
@@ -157,18 +159,25 @@ class Planner:
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
         solver: One of :data:`SOLVERS`.
         options: Transcription options.
+        workspace: The SQP's compiled subproblems
+            (:class:`~flipkit.solvers.compiled.SQPWorkspace`) this planner solves in; ``None``
+            shares the process's default, so that planners made one after another (every
+            ``plan_flip`` call) compile each subproblem structure once. A planner given its
+            own workspace keeps its warm starts and compiled problems to itself, e.g. one per
+            thread of a cell that plans while it executes.
 
     Raises:
         InvalidChoiceError: Unknown solver.
     """
 
     def __init__(self, cell: CellConfig | None = None, *, solver: str = "auto",
-                 options: SegmentOptions = SegmentOptions()):
+                 options: SegmentOptions = SegmentOptions(), workspace=None):
         if solver not in SOLVERS:
             raise InvalidChoiceError("solver", solver, SOLVERS)
         self.cell = cell or CellConfig()
         self.solver, self.options = solver, options
         self.models = models_for(self.cell)
+        self.workspace = workspace
 
     def chain(self, behavior: Behavior | str, task: Task, q, qd, *, done=(), guess=None,
               t0: float | None = None) -> Plan:
@@ -225,11 +234,12 @@ class Planner:
         def build(options):
             return transcribe(spec, self.models, q, qd, options=options, task=task)
 
+        own = {} if self.workspace is None else {"workspace": self.workspace}
         if not stretch:
             nlp = build(self.options)
-            return nlp, solve_segment(nlp, self.solver)
+            return nlp, solve_segment(nlp, self.solver, **own)
         seed = None if guess is None else (lambda nlp: guess(spec.name, nlp, q, qd))
-        return solve_stretched(build, self.options, self.solver, seed)
+        return solve_stretched(build, self.options, self.solver, seed, **own)
 
 
 __all__ = ["SOLVERS", "Planner", "finish_plan", "solve_segment", "solve_stretched",
