@@ -323,7 +323,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
             end, or the pose at q_start at rest).
         home: Home spatula pose (``turn_back`` only).
         rate: Sample rate of the output (Hz).
-        T_bounds: Duration bounds (s); default collocation's :data:`T_BOUNDS`.
+        T_bounds: Duration bounds (s); default collocation's (the specs' ``duration``).
 
     Returns:
         The trajectory; ``solve_time_s`` is the whole duration search (all QP solves, their

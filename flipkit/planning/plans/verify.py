@@ -4,8 +4,8 @@ Nothing here uses :mod:`flipkit.transcription.nlp` or
 :mod:`flipkit.transcription.constraints`; kinematics and dynamics come from pinocchio through
 :class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
 bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
-:mod:`flipkit.behaviors` only the duration bounds of the specs, SCOOP_PRESS, SCOOP_TIP_BAND and
-grill_floor, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
+:mod:`flipkit.behaviors` only the specs' duration bounds, floors (``blade_floor``) and exempt
+shape pairs, SCOOP_PRESS and SCOOP_TIP_BAND, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
 poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
@@ -34,7 +34,7 @@ cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes    
                    place: nodes ≤ 0.7 N)
 grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m):  tol
                    h_g, pressed SCOOP_PRESS into it on scoop and pickup,
-                   a burger's thickness above it on turn back (grill_floor)
+                   a burger's thickness above it on turn back (blade_floor)
 placing            serve: the table spot on the table, and the rest point        1 mm
                    predicted from the place's end pose (FK) at the spot
                    (:func:`flipkit.behaviors.serve.predicted_rest`)
@@ -43,7 +43,7 @@ landing            flip: landing recomputed (:mod:`flipkit.planning.plans.verify
 flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
 arm_clearance      every link (URDF collision hull), the handle and the blade  tol
                    keep cell.space.margin (2 cm) from grill, table and walls,
-                   but the pairs the segment exempts (clearance_excluded);
+                   but the pairs the segment exempts (the spec's exempt);
                    coal distances, :mod:`flipkit.planning.plans.verify_clearance` (m)
 orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     tol
 singularity        q3 and q5 at every node within the band of q_home held      tol
