@@ -76,6 +76,13 @@ def read_text(path, what: str, max_bytes: int = MAX_INPUT_BYTES) -> str:
         raise InputFileError(f"{what} {p}: cannot read ({exc.strerror or exc})") from None
 
 
+def data_lines(text: str) -> list[tuple[int, str]]:
+    """The lines of a CSV-like text that hold data, with their line numbers (from 1): blank
+    lines and ``#`` comments left out."""
+    return [(n, line) for n, line in enumerate(text.splitlines(), 1)
+            if line.strip() and not line.lstrip().startswith("#")]
+
+
 def _same_file(a: Path, b) -> bool:
     """Whether ``a`` and ``b`` name the same file (resolved; by inode where both exist)."""
     b = Path(b)
@@ -199,4 +206,4 @@ def write_text(path, text: str) -> Path:
 
 
 __all__ = ["MAX_INPUT_BYTES", "InputFileError", "OutputPathError", "check_input",
-           "check_output", "check_output_dir", "read_text", "replace_with", "write_text"]
+           "check_output", "check_output_dir", "data_lines", "read_text", "replace_with", "write_text"]

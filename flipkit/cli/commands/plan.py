@@ -19,7 +19,8 @@ from flipkit.cli.common import MAX_WORKERS, check_int
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.experiments.sweep import make_executor
-from flipkit.fileio import InputFileError, check_output, check_output_dir, read_text, write_text
+from flipkit.fileio import (InputFileError, check_output, check_output_dir, data_lines, read_text,
+                            write_text)
 from flipkit.model.singular import check_start
 from flipkit.planning.planners.atlas import Atlas, default_atlas
 from flipkit.planning.planners.inputs import check_joint_vector, check_spacing
@@ -100,8 +101,7 @@ def read_locations(path) -> list[tuple[float, float, float]]:
     except InputFileError as exc:
         raise ConfigError(f"--burgers {path}: cannot read burger CSV "
                           f"({str(exc).split(': ', 1)[-1]})") from None
-    lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
-             if line.strip() and not line.lstrip().startswith("#")]
+    lines = data_lines(text)
     if not lines:
         raise ConfigError(f"{path}: no header and no burger rows")
     header = [h.strip().lower() for h in next(csv.reader([lines[0][1]]))]

@@ -21,7 +21,7 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.fileio import InputFileError, read_text
+from flipkit.fileio import InputFileError, data_lines, read_text
 
 FIRST_SIDE_S = 90.0  # s on the first side (paper Sec. I)
 SECOND_SIDE_S = 60.0  # s on the second side (paper Sec. I)
@@ -145,8 +145,7 @@ def read_cook_csv(path, cell: CellConfig | None = None, serve: bool = True) -> l
     except InputFileError as exc:
         raise CookOrderError(f"{path}: cannot read the cook order "
                              f"({str(exc).split(': ', 1)[-1]})") from None
-    lines = [(n, line) for n, line in enumerate(text.splitlines(), 1)
-             if line.strip() and not line.lstrip().startswith("#")]
+    lines = data_lines(text)
     if not lines:
         raise CookOrderError(f"{path}: empty; expected the header {','.join(CSV_HEADER)}")
     n0, first = lines[0]

@@ -80,3 +80,12 @@ def check_on_blade(on_blade, cell: CellConfig) -> np.ndarray:
         raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
                           f", ±{sp.width / 2} m, got {on_blade!r}")
     return xy
+
+
+def check_replan(plan, behavior: str, on_blade) -> tuple:
+    """The cell of a solved ``behavior`` plan to re-plan, and the sensed ``on_blade`` (x, y)
+    (m) checked on its blade; one-line ConfigError otherwise."""
+    if plan.behavior != behavior or plan.status != "solved":
+        raise ConfigError(f"replan_{behavior} needs a solved {behavior} plan")
+    cell = plan.cell()
+    return cell, check_on_blade(on_blade, cell)

@@ -35,7 +35,8 @@ from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import check_joint_vector, check_on_blade, check_position, check_start
+from flipkit.planning.planners.inputs import (check_joint_vector, check_on_blade, check_position,
+                                              check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_flight import TILT_MIN_DEG, recompute_landing
 
@@ -200,11 +201,8 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
     """
     t0 = time.perf_counter()
-    if plan.behavior != "flip" or plan.status != "solved":
-        raise ConfigError("replan_flip needs a solved flip plan")
-    cell = plan.cell()
+    cell, on_blade = check_replan(plan, "flip", on_blade)
     flip = next(s for s in plan.segments if s.name == "flip")
-    on_blade = check_on_blade(on_blade, cell)
     planner = Planner(cell, solver=solver,
                       options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
     radius = max((row["r_land"] for row in flip.landing.get("scenarios", ())),

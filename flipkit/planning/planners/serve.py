@@ -21,11 +21,11 @@ from flipkit.behaviors.library import SERVE_NAMES
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, FlipkitError, UnreachableError
+from flipkit.errors import FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import check_on_blade, check_start
+from flipkit.planning.planners.inputs import check_on_blade, check_replan, check_start
 from flipkit.planning.plans.plan_file import Plan
 
 
@@ -102,10 +102,7 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
         ConfigError: ``plan`` is not a solved serve plan, or ``on_blade`` is off the blade.
     """
     t0 = time.perf_counter()
-    if plan.behavior != "serve" or plan.status != "solved":
-        raise ConfigError("replan_serve needs a solved serve plan")
-    cell = plan.cell()
-    on_blade = check_on_blade(on_blade, cell)
+    cell, on_blade = check_replan(plan, "serve", on_blade)
     planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone))
     done = [s for s in plan.segments if s.name in SERVE_NAMES[:4]]
     task = Task(location=np.asarray(plan.burger["location"], float), spot=table_spot(plan),
