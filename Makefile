@@ -4,7 +4,7 @@ PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.flipkit-installed
-APT_PACKAGES := libosmesa6
+APT_PACKAGES := libosmesa6 chromium
 export MPLBACKEND := Agg
 export OMP_NUM_THREADS := 1
 
