@@ -6,22 +6,24 @@
 * function-local imports only where a heavy optional dependency needs them, at most
   :data:`MAX_LOCAL_IMPORTS` in the package.
 
-Every import is read from the source with ``ast`` — at module level and inside functions alike
-(a lazy import that runs up a layer, or closes a cycle, is still a dependency).
+Every import is read from the source with ``ast`` by :mod:`flipkit.import_graph` — at module
+level and inside functions alike (a lazy import that runs up a layer, or closes a cycle, is
+still a dependency); the figure runner hashes the sources a notebook imports with the same
+graph.
 """
 
 from __future__ import annotations
 
-import ast
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "flipkit"
+from flipkit.import_graph import PACKAGE, flipkit_imports, import_graph, local_imports
+from flipkit.import_graph import module_name, package_files
+
 # Lowest first. A module may import its own layer and the layers below it.
 LAYERS = (
-    ("errors", "provenance", "fileio"),
+    ("errors", "provenance", "fileio", "import_graph"),
     ("config", ""),  # "" is the package root (flipkit/__init__.py: version, CellConfig)
     ("model",),
     ("transcription",),
@@ -36,6 +38,7 @@ LAYERS = (
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 MAX_LOCAL_IMPORTS = 15  # function-local imports in the whole package
+FILES = package_files()
 
 
 def layer_of(module: str) -> str:
@@ -44,105 +47,9 @@ def layer_of(module: str) -> str:
     return parts[1] if len(parts) > 1 else ""
 
 
-def module_name(path: Path) -> str:
-    rel = path.relative_to(PACKAGE.parent).with_suffix("")
-    parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
-    return ".".join(parts)
-
-
-FILES = sorted(PACKAGE.rglob("*.py"))
-MODULES = {module_name(f) for f in FILES}
-
-
-@dataclass(frozen=True)
-class Import:
-    """One name brought in by an import statement of a flipkit module.
-
-    ``target`` is the flipkit module the name comes from — the submodule itself for
-    ``from flipkit.x import y`` when ``y`` is a module — and ``name`` the imported attribute
-    (``None`` for a module). ``local``: inside a function. ``typing_only``: under
-    ``if TYPE_CHECKING:`` (never executed).
-    """
-
-    line: int
-    target: str
-    name: str | None
-    local: bool
-    typing_only: bool
-
-
-def _is_type_checking(test: ast.expr) -> bool:
-    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
-        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
-
-
-def _statements(tree: ast.AST):
-    """(import statement, inside a function, under ``if TYPE_CHECKING``) of every import."""
-    def walk(node, local, typing_only):
-        for child in ast.iter_child_nodes(node):
-            if isinstance(child, (ast.Import, ast.ImportFrom)):
-                yield child, local, typing_only
-            in_function = isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
-            guarded = isinstance(child, ast.If) and _is_type_checking(child.test)
-            if guarded:  # the else branch runs
-                for stmt in child.body:
-                    yield from walk(ast.Module(body=[stmt], type_ignores=[]), local, True)
-                for stmt in child.orelse:
-                    yield from walk(ast.Module(body=[stmt], type_ignores=[]), local,
-                                    typing_only)
-                continue
-            yield from walk(child, local or in_function, typing_only)
-
-    yield from walk(tree, False, False)
-
-
-def _resolve(dotted: str) -> str:
-    """The longest prefix of ``dotted`` that is a module of the package."""
-    while dotted not in MODULES and "." in dotted:
-        dotted = dotted.rpartition(".")[0]
-    return dotted
-
-
-def flipkit_imports(path: Path) -> list[Import]:
-    """Every flipkit name imported by the file, with the module it comes from."""
-    mod = module_name(path)
-    package = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
-    out = []
-    for node, local, typing_only in _statements(ast.parse(path.read_text())):
-        if isinstance(node, ast.Import):
-            out += [Import(node.lineno, _resolve(a.name), None, local, typing_only)
-                    for a in node.names if a.name.split(".")[0] == "flipkit"]
-            continue
-        if node.level:
-            base = package.split(".")[: len(package.split(".")) - node.level + 1]
-            target = ".".join(base + ([node.module] if node.module else []))
-        else:
-            target = node.module or ""
-        if target.split(".")[0] != "flipkit":
-            continue
-        for a in node.names:
-            sub = f"{target}.{a.name}"
-            out.append(Import(node.lineno, sub, None, local, typing_only) if sub in MODULES
-                       else Import(node.lineno, _resolve(target), a.name, local, typing_only))
-    return out
-
-
 def imports(path: Path) -> list[tuple[int, str]]:
     """(line, absolute module) of every flipkit import in the file."""
     return [(i.line, i.target) for i in flipkit_imports(path)]
-
-
-def local_imports(path: Path) -> list[int]:
-    """Lines of the import statements (of any package) inside a function of the file."""
-    return [node.lineno for node, local, _ in _statements(ast.parse(path.read_text())) if local]
-
-
-def import_graph() -> dict[str, set[str]]:
-    """Module → the other flipkit modules it imports when it runs (``TYPE_CHECKING`` imports
-    are annotations, not dependencies)."""
-    return {module_name(f): {i.target for i in flipkit_imports(f)
-                             if not i.typing_only and i.target != module_name(f)}
-            for f in FILES}
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
