@@ -10,7 +10,7 @@ import pytest
 
 from flipkit import cli
 from flipkit import figures
-from flipkit.figures import pipeline
+from flipkit.figures import execute
 from flipkit.errors import InvalidChoiceError
 
 NOTEBOOKS = sorted(figures.NOTEBOOKS_DIR.glob("*.ipynb"))
@@ -48,6 +48,7 @@ def test_cell_figure_and_manifest(made):
     assert entry["files"] == ["cell.pdf", "cell.png"]
     assert entry["notebook"] == "notebooks/cell.ipynb"
     assert entry["parameters"]["quick"] is True
+    assert entry["inputs"]["hash"].startswith("sha256:") and entry["inputs"]["modules"] > 10
     assert len(entry["caption"]) > 40
     assert entry["numbers"]["n_locations"] == 10
     assert entry["numbers"]["spatula_home_clearance_m"] > 0.05  # spatula above the grill
@@ -58,7 +59,8 @@ def test_second_run_is_reproducible(made):
     _, work, out = made
     first = json.loads((out / "manifest.json").read_text())
     pdf = (out / "cell.pdf").read_bytes()
-    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out)], work) == 0
+    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--force"],
+                   work) == 0
     second = json.loads((out / "manifest.json").read_text())
     assert second == first
     assert (out / "cell.pdf").read_bytes() == pdf  # no dates: byte-identical PDF
@@ -103,8 +105,8 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
         nbformat.v4.new_code_cell("quick = False", metadata={"tags": ["parameters"]}),
         nbformat.v4.new_code_cell("raise ValueError('burnt\\nbadly')")]), notebook)
     with pytest.raises(figures.NotebookError) as info:
-        pipeline._execute(notebook, tmp_path / "executed.ipynb", {"quick": True},
-                         figures.kernel_name())
+        execute.execute_notebook(notebook, tmp_path / "executed.ipynb", {"quick": True},
+                                 figures.kernel_name())
     message = str(info.value)
     assert "\n" not in message
     assert "broken.ipynb" in message and "ValueError: burnt badly" in message

@@ -16,7 +16,11 @@ def register(subparsers) -> None:
         "figures", help="run the notebooks and write figures/*.pdf, *.png and manifest.json",
         description="Execute the figure notebooks with papermill (executed copies in "
                     "build/notebooks/) and write each figure as PDF and PNG with "
-                    "manifest.json. Figures whose notebook does not exist yet are reported "
+                    "manifest.json. A notebook runs only if the hash of its inputs (its "
+                    "cells, the flipkit modules it imports, the package data, the "
+                    "parameters, environment.lock) differs from the one recorded with its "
+                    "figures, or a figure is missing; each notebook skipped is printed with "
+                    "the reason. Figures whose notebook does not exist yet are reported "
                     "as missing.")
     parser.add_argument("--quick", action="store_true",
                         help="smaller runs (fewer trials and locations) for a fast check")
@@ -26,19 +30,24 @@ def register(subparsers) -> None:
                         help="Dask scheduler address for sweeps (default: local processes)")
     parser.add_argument("--out", default="figures", metavar="DIR",
                         help="output directory (default: figures)")
+    parser.add_argument("--force", action="store_true",
+                        help="run every selected notebook, even if its figures are up to date")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Make the figures; print what was made, what is missing, and the manifest path."""
+    """Make the figures; print each notebook run or skipped and why (one line each), then a
+    summary: what was made, how many were skipped, what is missing, the manifest path."""
     check_output_dir(args.out, "--out")  # before any notebook runs
     for fig_id in args.only or ():
         if fig_id not in FIGURE_IDS:
             raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)
     report = run_notebooks(quick=args.quick, only=args.only, scheduler=args.scheduler,
-                           out_dir=args.out)
+                           out_dir=args.out, force=args.force,
+                           log=lambda line: print(f"flipkit figures: {line}", flush=True))
     made = ", ".join(report.made) or "none"
-    print(f"flipkit figures: made {made} in {report.wall_time_s:.1f} s; "
+    print(f"flipkit figures: ran {len(report.ran)} notebooks, skipped {len(report.skipped)} "
+          f"up to date; made {made} in {report.wall_time_s:.1f} s; "
           f"manifest {report.manifest}")
     if report.missing:
         print(f"flipkit figures: no notebook yet for {', '.join(report.missing)} (skipped)",

@@ -5,7 +5,10 @@
 * :mod:`~flipkit.figures.draw`: the drawing functions (panels, maps, statistics, the cell);
 * :mod:`~flipkit.figures.data` and :mod:`~flipkit.figures.runs`: the numbers a figure shows,
   computed from plans and runs;
-* :mod:`~flipkit.figures.pipeline`: the notebook runner and ``manifest.json``;
+* :mod:`~flipkit.figures.inputs`: the hash of what a notebook's figures are made from;
+* :mod:`~flipkit.figures.execute`: one notebook through papermill, in the venv's kernel;
+* :mod:`~flipkit.figures.pipeline`: the runner (only notebooks whose inputs changed) and
+  ``manifest.json``;
 * :mod:`~flipkit.figures.macros`: ``paper/numbers.tex`` from the manifest.
 
 A notebook imports ``from flipkit import figures`` and calls ``figures.style()`` and
@@ -14,10 +17,12 @@ A notebook imports ``from flipkit import figures`` and calls ``figures.style()``
 
 from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR, REPO_ROOT
 from flipkit.figures.macros import flatten_numbers, format_number, tex_escape, write_macros
-from flipkit.figures.pipeline import NotebookError, RunReport, kernel_name, run_notebooks, write_manifest
+from flipkit.figures.execute import NotebookError, kernel_name
+from flipkit.figures.inputs import Inputs, NotebookInputsError, hash_inputs
+from flipkit.figures.pipeline import RunReport, run_notebooks, write_manifest
 from flipkit.figures.style import COLORS, COLUMN_WIDTH, PAGE_WIDTH, PNG_DPI, save, style
 
 __all__ = ["COLORS", "COLUMN_WIDTH", "FIGURES", "FIGURE_IDS", "NOTEBOOKS_DIR", "PAGE_WIDTH",
-           "PNG_DPI", "REPO_ROOT", "NotebookError", "RunReport", "flatten_numbers",
-           "format_number", "kernel_name", "run_notebooks", "save", "style", "tex_escape",
-           "write_macros", "write_manifest"]
+           "PNG_DPI", "REPO_ROOT", "Inputs", "NotebookError", "NotebookInputsError",
+           "RunReport", "flatten_numbers", "format_number", "hash_inputs", "kernel_name",
+           "run_notebooks", "save", "style", "tex_escape", "write_macros", "write_manifest"]

@@ -1,8 +1,10 @@
 """The notebook runner: every figure made by its papermill notebook, and the manifest.
 
 :func:`run_notebooks` executes the notebooks of :mod:`flipkit.figures.catalog` with
-papermill and merges the figures' sidecars (:func:`flipkit.figures.style.save`) into
-``manifest.json``: every figure, its caption, notebook, parameters and numbers.
+papermill (:mod:`flipkit.figures.execute`) and merges the figures' sidecars
+(:func:`flipkit.figures.style.save`) into ``manifest.json``: every figure, its caption,
+notebook, parameters, numbers and the hash of its inputs (:mod:`flipkit.figures.inputs`).
+A notebook whose figures exist and carry the current hash is skipped, not re-executed.
 """
 
 from __future__ import annotations
@@ -12,46 +14,17 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 from tqdm import tqdm
 
 from flipkit import __version__
-from flipkit.errors import FlipkitError, InvalidChoiceError
-from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR, REPO_ROOT
+from flipkit.errors import InvalidChoiceError
+from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR
+from flipkit.figures.execute import NotebookError, execute_notebook, kernel_name
+from flipkit.figures.inputs import UNHASHED_PARAMETERS, Inputs, changed, hash_inputs
+from flipkit.import_graph import import_graph
 from flipkit.provenance import git_commit
-
-# The kernel's own log (plain-TCP warning, interrupt on shutdown) is noise here; cell errors
-# still reach us through the notebook, a dead kernel through nbclient.
-KERNEL_QUIET = ["--IPKernelApp.log_level=CRITICAL"]
-
-
-class NotebookError(FlipkitError):
-    """A figure notebook that failed to execute or did not save its figure."""
-
-def kernel_name() -> str:
-    """Name of a Jupyter kernelspec that runs this Python (the venv's).
-
-    ``python3`` if it resolves to this interpreter (argv ``python`` is replaced by
-    ``sys.executable`` by jupyter_client); otherwise a ``flipkit-python3`` kernelspec, installed
-    into ``sys.prefix/share/jupyter/kernels`` on first use.
-    """
-    # Jupyter and papermill load in 0.3-1.5 s, and `flipkit --help` imports this module.
-    from jupyter_client.kernelspec import KernelSpecManager, NoSuchKernel
-
-    manager = KernelSpecManager()
-    generic = {"python", f"python{sys.version_info[0]}", "python%d.%d" % sys.version_info[:2]}
-    for name in ("python3", "flipkit-python3"):
-        try:
-            argv0 = manager.get_kernel_spec(name).argv[0]
-        except NoSuchKernel:
-            continue
-        if argv0 in generic or Path(argv0).absolute() == Path(sys.executable).absolute():
-            return name
-    from ipykernel.kernelspec import install  # only when no kernelspec runs this Python
-
-    install(kernel_spec_manager=manager, kernel_name="flipkit-python3", prefix=sys.prefix,
-            display_name="Python 3 (flipkit)")
-    return "flipkit-python3"
 
 
 @dataclass
@@ -60,86 +33,110 @@ class RunReport:
 
     Attributes:
         made: Figure ids made in this run. missing: Requested ids whose notebook does not exist.
+        ran: Notebook name → why it ran. skipped: Notebook name → why it was skipped.
         manifest: Path of the manifest written. wall_time_s: Wall time of the run (s).
     """
 
     made: list[str] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
+    ran: dict[str, str] = field(default_factory=dict)
+    skipped: dict[str, str] = field(default_factory=dict)
     manifest: Path | None = None
     wall_time_s: float = 0.0
 
 
-def _one_line(text) -> str:
-    return " ".join(str(text).split())
-
-
-def _execute(notebook: Path, executed: Path, parameters: dict, kernel: str) -> None:
-    """Run one notebook with papermill; any failure becomes a one-line NotebookError."""
-    import papermill  # 1.5 s to import, and `flipkit --help` imports this module
-
-    try:
-        papermill.execute_notebook(str(notebook), str(executed), parameters=parameters,
-                                   kernel_name=kernel, language="python", cwd=str(REPO_ROOT),
-                                   progress_bar=False, extra_arguments=KERNEL_QUIET)
-    except papermill.PapermillExecutionError as exc:
-        raise NotebookError(
-            f"notebook {notebook.name} failed at cell In [{exc.exec_count}]: {exc.ename}: "
-            f"{_one_line(exc.evalue)} (executed copy: {executed})") from None
-    except Exception as exc:  # kernel died, missing kernel, unreadable notebook, ...
-        raise NotebookError(f"notebook {notebook.name} could not run: {type(exc).__name__}: "
-                            f"{_one_line(exc)}") from exc
+def stale_reason(out: Path, ids, inputs: Inputs, parameters: dict) -> str | None:
+    """Why the figures ``ids`` of one notebook in ``out`` must be made again, or None if each
+    exists (its sidecar and files) and was made from ``inputs``."""
+    for fig_id in ids:
+        try:
+            entry = json.loads((out / f"{fig_id}.json").read_text())
+        except (OSError, ValueError):
+            return f"no figure {fig_id!r} in {out}"
+        lost = [name for name in entry.get("files", []) if not (out / name).is_file()]
+        if lost:
+            return f"{lost[0]} is missing"
+        if not entry.get("inputs"):
+            return f"{fig_id!r} has no inputs hash (made before incremental builds)"
+        parts = changed(entry["inputs"], inputs)
+        if "parameters" in parts:
+            old = entry.get("parameters") or {}
+            parts[parts.index("parameters")] = "parameters (" + ", ".join(
+                f"{k} {old.get(k)!r} -> {v!r}" for k, v in parameters.items()
+                if k not in UNHASHED_PARAMETERS and old.get(k) != v) + ")"
+        if parts or entry["inputs"].get("hash") != inputs.digest:
+            return "changed: " + (", ".join(parts) or "inputs hash")
+    return None
 
 
 def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
-                  out_dir="figures", build_dir="build/notebooks") -> RunReport:
-    """Execute the figure notebooks and write ``<out_dir>/manifest.json``.
+                  out_dir="figures", build_dir="build/notebooks", force: bool = False,
+                  log: Callable[[str], None] | None = None,
+                  notebooks_dir: Path = NOTEBOOKS_DIR) -> RunReport:
+    """Execute the figure notebooks whose inputs changed and write ``<out_dir>/manifest.json``.
 
     Args:
         quick: Passed to the notebooks: fewer nodes, trials and locations (minutes, not hours).
-        only: Figure ids to make (default: all); their notebooks run once each.
+        only: Figure ids to make (default: all); their notebooks run once each, and a
+            notebook makes all its figures.
         scheduler: Dask scheduler address passed to the notebooks (None: local processes).
         out_dir: Figure directory (relative to the current directory).
         build_dir: Where the executed notebooks are written.
+        force: Execute every selected notebook, up to date or not.
+        log: Called with one line per notebook, before any runs: skipped and why, or to
+            run and why.
+        notebooks_dir: Where the notebooks of :data:`~flipkit.figures.catalog.FIGURES` are.
 
     Returns:
         A :class:`RunReport`; ids whose notebook does not exist yet are in ``missing``.
         The manifest also keeps the figures of earlier runs into ``out_dir`` (each entry with
-        its own parameters) as long as their files exist.
+        its own parameters and inputs hash) as long as their files exist.
 
     Raises:
         InvalidChoiceError: An unknown figure id in ``only``.
         NotebookError: A notebook failed (its name and the failing cell's error, one line)
             or did not save the figure it is listed for.
+        NotebookInputsError: A notebook's cells cannot be read to hash them.
     """
-    start = time.perf_counter()
+    start, log = time.perf_counter(), log or (lambda line: None)
     wanted = list(dict.fromkeys(only)) if only else list(FIGURE_IDS)
     for fig_id in wanted:
         if fig_id not in FIGURES:
             raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)
     out, build = Path(out_dir).absolute(), Path(build_dir).absolute()
-    report = RunReport(missing=[i for i in wanted if not (NOTEBOOKS_DIR / FIGURES[i]).is_file()])
-    jobs: dict[str, list[str]] = {}
-    for fig_id in wanted:
-        if fig_id not in report.missing:
-            jobs.setdefault(FIGURES[fig_id], []).append(fig_id)
+    report = RunReport(missing=[i for i in wanted
+                                if not (notebooks_dir / FIGURES[i]).is_file()])
+    recorded = {"quick": bool(quick), "out_dir": str(out_dir), "scheduler": scheduler}
+    graph, jobs = import_graph(), {}
+    for notebook in dict.fromkeys(FIGURES[i] for i in wanted if i not in report.missing):
+        ids = [i for i in FIGURE_IDS if FIGURES[i] == notebook]
+        inputs = hash_inputs(notebooks_dir / notebook, recorded, graph)
+        reason = "--force" if force else stale_reason(out, ids, inputs, recorded)
+        if reason is None:
+            report.skipped[notebook] = (f"up to date (inputs {inputs.digest[:19]}, "
+                                        f"{len(inputs.modules)} flipkit modules)")
+            log(f"skip {notebook}: {report.skipped[notebook]}")
+        else:
+            jobs[notebook], report.ran[notebook] = (ids, inputs), reason
+            log(f"run  {notebook}: {reason}")
     out.mkdir(parents=True, exist_ok=True)
     build.mkdir(parents=True, exist_ok=True)
     params = {"quick": bool(quick), "out_dir": str(out), "scheduler": scheduler}
-    recorded = {"quick": bool(quick), "out_dir": str(out_dir), "scheduler": scheduler}
     kernel = kernel_name() if jobs else "python3"
     bar = tqdm(jobs.items(), desc="notebooks", unit="nb", disable=not jobs, file=sys.stderr)
-    for notebook, ids in bar:
+    for notebook, (ids, inputs) in bar:
         bar.set_postfix_str(notebook)
         for fig_id in ids:
             (out / f"{fig_id}.json").unlink(missing_ok=True)
-        _execute(NOTEBOOKS_DIR / notebook, build / notebook, params, kernel)
+        execute_notebook(notebooks_dir / notebook, build / notebook, params, kernel)
         for fig_id in ids:
             sidecar = out / f"{fig_id}.json"
             if not sidecar.is_file():
                 raise NotebookError(f"notebook {notebook} ran but did not save figure "
                                     f"{fig_id!r} (no figures.save(fig, {fig_id!r}, ...))")
             entry = json.loads(sidecar.read_text())
-            entry.update(notebook=f"notebooks/{notebook}", parameters=recorded)
+            entry.update(notebook=f"notebooks/{notebook}", parameters=recorded,
+                         inputs=inputs.record())
             sidecar.write_text(json.dumps(entry, indent=2, sort_keys=True) + "\n")
             report.made.append(fig_id)
     report.manifest = write_manifest(out)
