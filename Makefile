@@ -8,7 +8,7 @@ APT_PACKAGES := libosmesa6 chromium
 export MPLBACKEND := Agg
 export OMP_NUM_THREADS := 1
 
-.PHONY: test figures figures-quick paper bench venv lock clean
+.PHONY: test figures figures-quick lab paper bench venv lock clean
 
 venv: $(STAMP)
 
@@ -24,11 +24,17 @@ $(STAMP): environment.lock pyproject.toml
 test: $(STAMP)
 	$(PY) -m pytest -n 2 -q
 
+# Only notebooks whose inputs changed run (flipkit.figures.inputs); FIGURES_ARGS=--force runs all.
 figures: $(STAMP)
 	$(VENV)/bin/flipkit figures $(FIGURES_ARGS)
 
 figures-quick: $(STAMP)
-	$(VENV)/bin/flipkit figures --quick
+	$(VENV)/bin/flipkit figures --quick $(FIGURES_ARGS)
+
+# JupyterLab on notebooks/ with this venv's kernel, registered as "Python 3 (flipkit)".
+lab: $(STAMP)
+	$(PY) -m ipykernel install --sys-prefix --name flipkit-python3 --display-name "Python 3 (flipkit)"
+	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
 
 # The reproduction report: LaTeX (installed with apt-get if latexmk is missing), the number
 # macros regenerated from figures/manifest.json, then latexmk in paper/.
