@@ -83,3 +83,9 @@ class NoSymbolicFormError(FlipkitError):
 class AtlasError(FlipkitError):
     """A warm-start atlas that cannot be read, or was built for other planning options, another
     cell or an NLP that has changed since (rebuild it with ``flipkit atlas build``)."""
+
+
+class ExportError(FlipkitError):
+    """A verified plan that cannot be written in the asked export format: a streamed joint
+    command outside the model's position limits, or a robot whose joints the format cannot
+    name."""

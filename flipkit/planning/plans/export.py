@@ -10,7 +10,10 @@ nodes q is the cubic Hermite interpolant of (q, q̇) and q̇ that of (q̇, q̈)
 which Hermite–Simpson collocation represents exactly — is reproduced exactly. Segments are
 concatenated on a global clock; a sample on a segment boundary is taken from the later
 segment (both agree on a continuous plan). Samples are at t_j = j / rate, j = 0 ..
-⌊T_total · rate⌋; the last one is at most 1/rate before the end.
+⌊T_total · rate⌋; the last one is at most 1/rate before the end. :func:`evaluate` gives the
+same interpolant (and u, linear between nodes) at any times; the URScript and ROS 2 writers
+(:mod:`~flipkit.planning.plans.export_urscript`, :mod:`~flipkit.planning.plans.export_ros2`)
+build on these two.
 """
 
 from __future__ import annotations
@@ -59,9 +62,7 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     if plan.status != "solved" and not force:
         raise FlipkitError(f"plan status is {plan.status!r}, not 'solved'; "
                            "use --force to export it anyway")
-    durations = np.array([s.T for s in plan.segments])
-    starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
-    total = float(durations.sum())
+    total = float(np.array([s.T for s in plan.segments]).sum())
     n = int(math.floor(total * rate + _EPS * rate)) + 1
     if n < 2:
         raise FlipkitError(f"export at {rate:g} Hz gives {n} row over the plan's {total:.3f} s; "
@@ -70,9 +71,28 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
         raise FlipkitError(f"export would write {n} rows ({total:.3f} s at {rate:g} Hz); "
                            f"the limit is {MAX_ROWS}")
     t = np.arange(n) / rate
+    q, qd, _ = evaluate(plan, t)
+    return t, q, qd
+
+
+def evaluate(plan: Plan, t):
+    """The plan's interpolant at times ``t`` (s, from the plan's start).
+
+    q and q̇ are as in :func:`resample`, u (N·m) is linear between nodes (as the simulation's
+    feed-forward). A time outside [0, T_total] takes the first or last node's values.
+
+    Args:
+        plan: The plan. t: Times (n,) (s), any order.
+
+    Returns:
+        (q, qd, u): positions (n, nq) (rad), velocities (n, nq) (rad/s), torques (n, nq) (N·m).
+    """
+    t = np.asarray(t, float)
+    durations = np.array([s.T for s in plan.segments])
+    starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
     which = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(durations) - 1)
     nq = plan.segments[0].q.shape[1]
-    q, qd = np.empty((n, nq)), np.empty((n, nq))
+    q, qd, u = np.empty((t.size, nq)), np.empty((t.size, nq)), np.empty((t.size, nq))
     for k, seg in enumerate(plan.segments):
         rows = which == k
         if not rows.any():
@@ -80,7 +100,8 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
         local = np.clip(t[rows] - starts[k], 0.0, seg.T)
         q[rows] = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(local)
         qd[rows] = CubicHermiteSpline(seg.t, seg.qd, seg.qdd, axis=0)(local)
-    return t, q, qd
+        u[rows] = np.column_stack([np.interp(local, seg.t, seg.u[:, j]) for j in range(nq)])
+    return q, qd, u
 
 
 def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL,

@@ -1,0 +1,259 @@
+"""Export formats a robot cell loads (issue 33, item 1): every output is parsed back.
+
+URScript: the header and the def ... end structure, the start guard, one servoj per
+resampled sample, its numbers equal to the stream to the printed precision and inside the
+joint limits; the compensated stream against the servo model recomputed here. ROS 2: the
+YAML loads, its joint names are ur_description's, its times increase strictly and its
+positions are the resampled ones. A tampered plan and bad options are refused by every
+format in one line, nothing written. The plans are test_plan's synthetic translate (no
+optimiser) and, once, conftest's flip.
+"""
+
+import json
+import re
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+from test_plan import translate_plan
+
+from flipkit.cli import export as cli_export
+from flipkit.behaviors.models import Models
+from flipkit.cli import main
+from flipkit.config import CellConfig, PhysicsConfig
+from flipkit.errors import ExportError, VerificationError
+from flipkit.model.robot import Robot
+from flipkit.planning.plans import export, export_ros2, export_urscript, servo_command
+from flipkit.planning.plans.export_ros2 import write_ros2
+from flipkit.planning.plans.export_urscript import ServoOptions, write_urscript
+from flipkit.planning.plans.plan_file import Plan
+
+# ur_description (ROS-Industrial universal_robot, Universal_Robots_ROS2_Description), base first
+UR_JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+             "wrist_2_joint", "wrist_3_joint"]
+HALF_ULP = 0.5e-8 + 1e-12  # rad: the program prints 8 decimals
+NUM = r"-?\d+(?:\.\d+)?(?:e-?\d+)?"
+VEC = rf"\[({NUM}(?:, {NUM}){{5}})\]"
+SERVOJ = re.compile(rf"^  servoj\({VEC}, 0, 0, ({NUM}), ({NUM}), ({NUM})\)$")
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return translate_plan(Models(CellConfig()))  # 1.0 + 0.8 s, carries the burger; 0.1 s
+
+
+@pytest.fixture(scope="module")
+def robot(plan):
+    return Robot(plan.cell(), with_burger=False)
+
+
+def vector(text):
+    return np.array([float(x) for x in text.split(", ")])
+
+
+def parse_urscript(text: str) -> dict:
+    """The program's parts; asserts its shape: comments, one def ... end with balanced
+    blocks, two-space indentation, the guard before the first servoj, stopj last."""
+    lines = text.rstrip("\n").split("\n")
+    head = [ln for ln in lines if ln.startswith("#")]
+    assert lines[:len(head)] == head and len(head) >= 3
+    body = lines[len(head):]
+    match = re.fullmatch(r"def (flipkit_\w+)\(\):", body[0])
+    assert match and body[-1] == "end" and body[-2].startswith("  stopj(")
+    depth = 0
+    for ln in body:
+        stripped = ln.strip()
+        indent = len(ln) - len(ln.lstrip(" "))
+        if stripped == "end":
+            depth -= 1
+        assert indent == 2 * depth, ln
+        if re.match(r"(def|while|if) .*:$", stripped):
+            depth += 1
+    assert depth == 0
+    where = [i for i, ln in enumerate(body) if "servoj(" in ln]
+    first, servo = where[0], [body[i] for i in where]
+    assert where == list(range(first, first + len(where)))  # one block, then stopj
+    parsed = [SERVOJ.match(ln) for ln in servo]
+    assert all(parsed), [ln for ln, m in zip(servo, parsed) if not m][:1]
+    guard = body[1:first]
+    start = re.fullmatch(rf"  q_start = {VEC}", guard[0])
+    tol = re.fullmatch(rf"    if norm\(q_now\[j\] - q_start\[j\]\) > ({NUM}):", guard[4])
+    assert start and tol, guard
+    assert guard[1:4] == ["  q_now = get_actual_joint_positions()", "  j = 0", "  while j < 6:"]
+    assert guard[5].startswith('      popup("flipkit: the arm is not at the plan') \
+        and "error=True" in guard[5]
+    assert guard[6:10] == ["      halt", "    end", "    j = j + 1", "  end"]
+    return {"name": match.group(1), "head": head, "q_start": vector(start.group(1)),
+            "tol": float(tol.group(1)), "q": np.array([vector(m.group(1)) for m in parsed]),
+            "t": {float(m.group(2)) for m in parsed}, "lookahead": {float(m.group(3)) for m in parsed},
+            "gain": {float(m.group(4)) for m in parsed}}
+
+
+def within_limits(robot, q):
+    assert np.all(q >= robot.q_min) and np.all(q <= robot.q_max)
+
+
+# ------------------------------------------------------------------ URScript
+def test_urscript_raw_streams_the_resampled_q(plan, robot, tmp_path):
+    path = tmp_path / "flip.script"
+    options = ServoOptions(command="raw")
+    assert write_urscript(plan, path, 125.0, options) == 226
+    prog = parse_urscript(path.read_text())
+    t, q, _ = export.resample(plan, 125.0)
+    assert prog["name"] == "flipkit_translate" and prog["q"].shape == q.shape == (226, 6)
+    assert np.abs(prog["q"] - q).max() <= HALF_ULP
+    assert np.abs(prog["q_start"] - plan.segments[0].q[0]).max() <= HALF_ULP
+    assert prog["tol"] == 0.01 and prog["t"] == {0.008}
+    assert prog["lookahead"] == {0.1} and prog["gain"] == {300.0}
+    assert "command raw" in "\n".join(prog["head"])
+    within_limits(robot, prog["q"])
+
+
+def test_urscript_options_and_rate(plan, tmp_path):
+    path = tmp_path / "flip.urscript"
+    options = ServoOptions(lookahead=0.05, gain=1000, command="raw", start_tol=0.02)
+    write_urscript(plan, path, 500.0, options)
+    prog = parse_urscript(path.read_text())
+    assert prog["q"].shape[0] == export.resample(plan, 500.0)[0].size == 901
+    assert prog["t"] == {0.002} and prog["lookahead"] == {0.05} and prog["gain"] == {1000.0}
+    assert prog["tol"] == 0.02
+
+
+@pytest.mark.parametrize("rate", [125.0, 500.0])
+def test_the_default_command_is_the_position_modes_compensation(plan, robot, tmp_path, rate):
+    """The first segment is a cubic: the plan 8 ms (latency) + half a servo period ahead is
+    known in closed form, u between nodes is linear, and Kp (q_c − q_d) + g_c(q_d)
+    must give back the plan's torque u_d (the burger's weight, which the controller's model
+    lacks, makes the offset non-zero)."""
+    out = tmp_path / "c.script"
+    rate_args = [] if rate == 125.0 else ["--rate", f"{rate:g}"]  # the default: 125 Hz
+    assert main(["export", str(plan.to_json(tmp_path / "p.json")), "--format", "urscript",
+                 "--out", str(out), *rate_args]) == 0
+    prog = parse_urscript(out.read_text())
+    assert "command compensated" in "\n".join(prog["head"])
+    physics, seg = PhysicsConfig(), plan.segments[0]
+    lead = physics.latency_s + 0.5 / rate
+    t = np.arange(prog["q"].shape[0]) / rate + lead
+    first = t <= seg.T
+    s, d = t[first] / seg.T, seg.q[-1] - seg.q[0]
+    q_d = seg.q[0] + np.outer(3 * s**2 - 2 * s**3, d)
+    u_d = np.column_stack([np.interp(t[first], seg.t, seg.u[:, j]) for j in range(6)])
+    data = robot.model.createData()
+    g_c = np.array([pin.computeGeneralizedGravity(robot.model, data, x) for x in q_d])
+    offset = prog["q"][first] - q_d
+    kp = np.asarray(physics.kp)
+    np.testing.assert_allclose(offset * kp + g_c, u_d, atol=HALF_ULP * kp.max() + 1e-6)
+    assert np.abs(offset).max() > 1e-4
+    within_limits(robot, prog["q"])
+
+
+def test_a_flip_streams_within_the_limits(flip_plan, tmp_path):
+    path = tmp_path / "flip.script"
+    n = write_urscript(flip_plan, path, 500.0)
+    prog = parse_urscript(path.read_text())
+    assert prog["q"].shape == (n, 6) and n == export.resample(flip_plan, 500.0)[0].size
+    assert np.abs(prog["q_start"] - flip_plan.segments[0].q[0]).max() <= HALF_ULP
+    within_limits(Robot(flip_plan.cell(), with_burger=False), prog["q"])
+    raw = export.evaluate(flip_plan, np.arange(n) / 500.0 + 0.008 + 0.5 / 500.0)[0]
+    assert 1e-3 < np.abs(prog["q"] - raw).max() < 0.1  # rad: the compensation, small
+
+
+def test_a_command_outside_the_limits_is_refused(plan):
+    t, q, _ = export.resample(plan, 125.0)
+    q[40, 2] = 3.2
+    with pytest.raises(ExportError, match=r"t = 0\.320 s puts q3 at 3\.2000 rad"):
+        export_urscript.check_limits(plan, t, q)
+
+
+# ------------------------------------------------------------------ ROS 2
+def test_ros2_yaml_is_the_resampled_trajectory(plan, robot, tmp_path):
+    path = tmp_path / "flip.yaml"
+    assert write_ros2(plan, path, 126.0) == 228  # 227 samples to 1.794 s and the plan's end
+    doc = yaml.safe_load(path.read_text())
+    assert list(doc) == ["header", "joint_names", "points"]
+    assert doc["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}
+    assert doc["joint_names"] == UR_JOINTS == list(robot.model.names)[1:]
+    pts = doc["points"]
+    assert all(set(p) == {"positions", "velocities", "time_from_start"} for p in pts)
+    stamp = [p["time_from_start"] for p in pts]
+    assert all(isinstance(s["sec"], int) and 0 <= s["nanosec"] < 10**9 for s in stamp)
+    ns = np.array([s["sec"] * 10**9 + s["nanosec"] for s in stamp])
+    assert ns[0] == 0 and np.all(np.diff(ns) > 0) and ns[-1] == 1_800_000_000
+    t, q, qd = export.resample(plan, 126.0)
+    np.testing.assert_array_equal(ns[:-1], np.round(t * 1e9))
+    pos, vel = (np.array([p[k] for p in pts]) for k in ("positions", "velocities"))
+    np.testing.assert_array_equal(pos[:-1], q)  # repr: round-trip exact
+    np.testing.assert_array_equal(vel[:-1], qd)
+    np.testing.assert_array_equal(pos[-1], plan.segments[-1].q[-1])
+    assert np.abs(vel[-1]).max() < 1e-9  # ends at rest
+    within_limits(robot, pos)
+
+
+def test_ros2_without_an_extra_end_point_when_a_sample_is_on_it(plan, tmp_path):
+    message = export_ros2.trajectory(plan, 125.0)  # 1.8 s: sample 225 is the end
+    assert len(message["points"]) == 226
+    assert message["points"][-1]["time_from_start"] == {"sec": 1, "nanosec": 800_000_000}
+
+
+# ------------------------------------------------------------------ refusals
+@pytest.fixture(scope="module")
+def tampered(plan, tmp_path_factory):
+    """One joint angle moved by 0.01 rad: verify fails the plan."""
+    path = plan.to_json(tmp_path_factory.mktemp("tampered") / "plan.json")
+    doc = json.loads(path.read_text())
+    doc["segments"][0]["q"][7][2] += 0.01
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.mark.parametrize("fmt, name", [("csv", "o.csv"), ("urscript", "o.script"),
+                                       ("ros2", "o.yaml")])
+def test_a_tampered_plan_is_refused_by_every_format(tampered, tmp_path, capsys, fmt, name):
+    out = tmp_path / name
+    for extra in ([], ["--force"]):
+        assert main(["export", str(tampered), "--format", fmt, "--out", str(out), *extra]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and "plan fails" in err and "refused" in err
+        assert not out.exists()
+    write = {"csv": export.write_csv, "urscript": write_urscript, "ros2": write_ros2}[fmt]
+    with pytest.raises(VerificationError, match="plan fails"):
+        write(Plan.load(tampered), out, 125.0)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--format", "pdf", "--out", "o.pdf"], ["export format 'pdf'", "'csv', 'urscript', 'ros2'"]),
+    (["--format", "urscript", "--out", "o.script", "--rate", "fast"], ["--rate", "'fast'"]),
+    (["--format", "ros2", "--out", "o.yaml", "--rate", "0"], ["--rate", "[1, 10000] Hz"]),
+    (["--format", "urscript", "--out", "o.script", "--rate", "300"], ["500/k Hz"]),
+    (["--format", "urscript", "--out", "o.script", "--gain", "50"], ["--gain", "[100, 2000]"]),
+    (["--format", "urscript", "--out", "o.script", "--gain", "big"], ["--gain", "'big'"]),
+    (["--format", "urscript", "--out", "o.script", "--lookahead", "0.5"], ["--lookahead", "0.2"]),
+    (["--format", "urscript", "--out", "o.script", "--start-tol", "nan"], ["--start-tol"]),
+    (["--format", "urscript", "--out", "o.script", "--command", "comp"],
+     ["position command 'comp'", "'compensated', 'raw'"]),
+    (["--format", "ros2", "--out", "o.yaml", "--gain", "300"], ["--gain", "urscript only"]),
+    (["--format", "ros2", "--out", "o.script"], ["--out", ".yaml"]),
+    (["--format", "urscript"], ["--out"]),
+    (["--format", "urscript", "--csv", "o.csv"], ["--csv"]),
+])
+def test_bad_options_one_line_nothing_written(plan, tmp_path, capsys, monkeypatch, args, words):
+    path = plan.to_json(tmp_path / "plan.json")
+    monkeypatch.chdir(tmp_path)
+    assert main(["export", str(path), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("flipkit: error:") and "\n" not in err and "Traceback" not in err
+    assert all(w in err for w in words), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plan.json"]
+
+
+def test_the_command_lines_constants_are_the_librarys():
+    """The CLI states ranges and defaults without importing the models; they must agree."""
+    defaults = ServoOptions()
+    for key, (_, rng, _, default, _) in cli_export.SERVO.items():
+        assert default == getattr(defaults, key)
+        assert rng == getattr(export_urscript, {"lookahead": "LOOKAHEAD_RANGE", "gain": "GAIN_RANGE",
+                                                "start_tol": "START_TOL_RANGE"}[key])
+    assert cli_export.COMMANDS == servo_command.COMMANDS and defaults.command == "compensated"
+    assert cli_export.RATE_RANGE == export.RATE_RANGE
