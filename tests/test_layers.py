@@ -30,6 +30,7 @@ LAYERS = (
     ("behaviors",),
     ("solvers",),
     ("planning",),
+    ("viz",),
     ("baseline",),
     ("simulation",),
     ("experiments",),

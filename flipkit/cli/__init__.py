@@ -13,7 +13,7 @@ import sys
 from flipkit.errors import FlipkitError
 
 COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate",
-            "schedule", "atlas")
+            "view", "schedule", "atlas")
 
 
 def build_parser() -> argparse.ArgumentParser:
