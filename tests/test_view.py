@@ -151,3 +151,9 @@ def test_a_stopped_server_is_an_error_not_a_hang(flip_plan):
     server.close_visualizer(vis)
     with pytest.raises(server.ViewerError, match="did not answer"):
         server.page(vis)
+
+
+def test_inline_puts_the_page_in_an_iframe(flip_plan, monkeypatch):
+    monkeypatch.setattr(viewer, "static_html", lambda plan, **o: '<p class="a">&</p>')
+    cell = viewer.inline(flip_plan, height=300).data
+    assert 'srcdoc="&lt;p class=&quot;a&quot;&gt;&amp;&lt;/p&gt;"' in cell and "300px" in cell

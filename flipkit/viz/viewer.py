@@ -150,5 +150,6 @@ def inline(plan: Plan, height: int = 480, **options) -> HTML:
     """The view for a notebook cell: :func:`static_html` in an iframe ``height`` pixels high,
     which needs no server and is kept in the saved notebook."""
     page = html.escape(static_html(plan, **options), quote=True)
-    return HTML(f'<iframe srcdoc="{page}" style="width: 100%; height: {int(height)}px; '
-                'border: none"></iframe>')
+    return HTML(f'<div style="height: {int(height)}px; resize: vertical; overflow: hidden">'
+                f'<iframe srcdoc="{page}" style="width: 100%; height: 100%; border: none">'
+                '</iframe></div>')
