@@ -5,6 +5,8 @@ import base64
 from dataclasses import replace
 import json
 import re
+import subprocess
+import sys
 import urllib.request
 from html.parser import HTMLParser
 
@@ -157,3 +159,16 @@ def test_inline_puts_the_page_in_an_iframe(flip_plan, monkeypatch):
     monkeypatch.setattr(viewer, "static_html", lambda plan, **o: '<p class="a">&</p>')
     cell = viewer.inline(flip_plan, height=300).data
     assert 'srcdoc="&lt;p class=&quot;a&quot;&gt;&amp;&lt;/p&gt;"' in cell and "300px" in cell
+
+
+def test_a_malformed_plan_is_refused_before_meshcat_is_imported(tmp_path):
+    """In a fresh interpreter: `flipkit view` parses and refuses a malformed file without
+    importing MeshCat or pinocchio (``flipkit --help`` stays as fast)."""
+    bad = tmp_path / "bad.json"
+    bad.write_text("{oops")
+    script = ("import sys; from flipkit.cli import main; rc = main(sys.argv[1:]); "
+              "print(rc, 'meshcat' in sys.modules, 'pinocchio' in sys.modules)")
+    run = subprocess.run([sys.executable, "-c", script, "view", str(bad), "--html",
+                          str(tmp_path / "v.html")], capture_output=True, text=True, timeout=60)
+    assert run.stdout.split() == ["2", "False", "False"], run.stdout + run.stderr
+    assert not (tmp_path / "v.html").exists()
