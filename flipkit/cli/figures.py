@@ -45,9 +45,9 @@ def run(args: argparse.Namespace) -> int:
     report = run_notebooks(quick=args.quick, only=args.only, scheduler=args.scheduler,
                            out_dir=args.out, force=args.force,
                            log=lambda line: print(f"flipkit figures: {line}", flush=True))
-    made = ", ".join(report.made) or "none"
-    print(f"flipkit figures: ran {len(report.ran)} notebooks, skipped {len(report.skipped)} "
-          f"up to date; made {made} in {report.wall_time_s:.1f} s; "
+    made, ran = ", ".join(report.made) or "none", len(report.ran)
+    print(f"flipkit figures: ran {ran} notebook{'s' * (ran != 1)}, skipped "
+          f"{len(report.skipped)} up to date; made {made} in {report.wall_time_s:.1f} s; "
           f"manifest {report.manifest}")
     if report.missing:
         print(f"flipkit figures: no notebook yet for {', '.join(report.missing)} (skipped)",
