@@ -31,10 +31,11 @@ figures: $(STAMP)
 figures-quick: $(STAMP)
 	$(VENV)/bin/flipkit figures --quick $(FIGURES_ARGS)
 
-# JupyterLab on notebooks/ with this venv's kernel, registered as "Python 3 (flipkit)".
+# JupyterLab on notebooks/ with this venv's kernel, registered as "Python 3 (flipkit)"
+# (--allow-root in a root container); e.g. LAB_ARGS="--no-browser --port 8890".
 lab: $(STAMP)
 	$(PY) -m ipykernel install --sys-prefix --name flipkit-python3 --display-name "Python 3 (flipkit)"
-	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
+	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $$([ "$$(id -u)" = 0 ] && echo --allow-root) $(LAB_ARGS)
 
 # The reproduction report: LaTeX (installed with apt-get if latexmk is missing), the number
 # macros regenerated from figures/manifest.json, then latexmk in paper/.
