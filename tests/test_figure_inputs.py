@@ -197,3 +197,26 @@ def test_the_command_prints_each_skip_and_a_summary(tmp_path, monkeypatch, capsy
     assert lines[0].startswith("flipkit figures: skip cell.ipynb: up to date (inputs sha256:")
     assert lines[1].startswith("flipkit figures: ran 0 notebooks, skipped 1 up to date;")
     assert len(lines) == 2 and os.path.isfile(tmp_path / "figs" / "manifest.json")
+
+
+def test_a_notebook_of_two_figures_records_both_and_reports_the_one_asked_for(tmp_path,
+                                                                             monkeypatch):
+    notebooks = tmp_path / "notebooks"
+    notebooks.mkdir()
+    write_notebook(notebooks / "landing.ipynb", "from flipkit.figures import catalog")
+
+    def fake_execute(notebook, executed, parameters, kernel):
+        out = Path(parameters["out_dir"])
+        for fig_id in ("landing", "filmstrip"):
+            (out / f"{fig_id}.pdf").write_bytes(b"figure")
+            (out / f"{fig_id}.json").write_text(json.dumps({"files": [f"{fig_id}.pdf"]}))
+
+    monkeypatch.setattr(pipeline, "execute_notebook", fake_execute)
+    monkeypatch.setattr(pipeline, "kernel_name", lambda: "python3")
+    kwargs = dict(only=["filmstrip"], out_dir=tmp_path / "f", build_dir=tmp_path / "b",
+                  notebooks_dir=notebooks)
+    assert pipeline.run_notebooks(**kwargs).made == ["filmstrip"]
+    manifest = json.loads((tmp_path / "f" / "manifest.json").read_text())["figures"]
+    assert manifest["landing"]["inputs"] == manifest["filmstrip"]["inputs"]
+    assert list(pipeline.run_notebooks(**{**kwargs, "only": ["landing"]}).skipped) == [
+        "landing.ipynb"]

@@ -32,7 +32,8 @@ class RunReport:
     """What :func:`run_notebooks` did.
 
     Attributes:
-        made: Figure ids made in this run. missing: Requested ids whose notebook does not exist.
+        made: Requested figure ids made in this run (a notebook's other figures are
+            remade and recorded too). missing: Requested ids whose notebook does not exist.
         ran: Notebook name → why it ran. skipped: Notebook name → why it was skipped.
         manifest: Path of the manifest written. wall_time_s: Wall time of the run (s).
     """
@@ -77,8 +78,8 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
 
     Args:
         quick: Passed to the notebooks: fewer nodes, trials and locations (minutes, not hours).
-        only: Figure ids to make (default: all); their notebooks run once each, and a
-            notebook makes all its figures.
+        only: Figure ids to make (default: all); their notebooks run once each (a
+            notebook that runs remakes all its figures, ``landing`` and ``filmstrip``).
         scheduler: Dask scheduler address passed to the notebooks (None: local processes).
         out_dir: Figure directory (relative to the current directory).
         build_dir: Where the executed notebooks are written.
@@ -138,7 +139,8 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
             entry.update(notebook=f"notebooks/{notebook}", parameters=recorded,
                          inputs=inputs.record())
             sidecar.write_text(json.dumps(entry, indent=2, sort_keys=True) + "\n")
-            report.made.append(fig_id)
+            if fig_id in wanted:
+                report.made.append(fig_id)
     report.manifest = write_manifest(out)
     report.wall_time_s = time.perf_counter() - start
     return report
