@@ -14,6 +14,7 @@ from flipkit.model.scoop import GRAVITY, ScoopPath, footprint_share
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import command_lead, position_command
 from flipkit.planning.plans.verify import verify_plan
+from flipkit.planning.plans.verify_flight import LANDING_TOL
 from flipkit.transcription.constraints.flight import ScenarioLanding
 from conftest import check_block_jacobian
 
@@ -99,7 +100,8 @@ def test_robust_plan_records_and_verifies_every_scenario(flip_plan, tmp_path):
     xs = [r["burger_on_blade"][0] for r in rows]
     assert min(xs) < flip.landing["burger_on_blade"][0] < max(xs)
     for r in rows:
-        assert r["offset"] <= r["r_land"] + 1e-6 and r["tilt_deg"] >= 150.0 - 1e-6
+        assert r["offset"] <= r["r_land"] + LANDING_TOL["m"]  # the verification's tolerances
+        assert r["tilt_deg"] >= 150.0 - LANDING_TOL["deg"]
     again = Plan.load(flip_plan.to_json(tmp_path / "p.json"))
     assert next(s for s in again.segments if s.name == "flip").landing["scenarios"] == rows
     assert verify_plan(again).ok
@@ -289,3 +291,74 @@ def test_a_place_the_plan_already_lands_needs_no_replan(flip_plan):
     far = nominal - (0.06, 0.0)  # 6 cm further back: it lands short by more than r
     assert landing_miss(flip, far, models) > r
     assert replan_flip(flip_plan, near, keep=False) is not flip_plan
+
+
+# ------------------------------------------------------------------ friction and release
+def test_cone_friction_is_the_least_sticky_burger_except_the_scoops_braking():
+    from flipkit.behaviors.options import MU_PLAN, SegmentOptions
+    from flipkit.config import PHYSICAL_RANGES
+
+    o = SegmentOptions()
+    assert MU_PLAN == pytest.approx(PHYSICAL_RANGES["burger.mu"][0] * 0.8)
+    assert o.cone_mu(0.5, True) == pytest.approx(MU_PLAN)
+    assert o.cone_mu(0.5, False) == pytest.approx(0.5 * o.mu_safety)
+    assert o.cone_mu(0.1, True) == pytest.approx(0.1 * o.mu_safety)  # a slicker burger: its own
+    with pytest.raises(ConfigError, match="release_press"):
+        SegmentOptions(release_press=-1.0)
+    with pytest.raises(ConfigError, match="mu_plan"):
+        SegmentOptions(mu_plan=float("nan"))
+
+
+def _specific_forces(plan, flip, place):
+    from flipkit.model.contact import specific_force
+
+    robot = plan.robot_for(flip)
+    return np.array([specific_force(st.R, st.a, plan.gravity) for st in
+                     (robot.state(flip.q[i], flip.qd[i], flip.qdd[i], (*place, 0.0))
+                      for i in range(len(flip.t)))])
+
+
+def test_every_scenario_is_held_by_the_planned_cone_and_pressed_before_the_release(flip_plan):
+    """At every place (nominal and scenarios): the cone with μ_plan on the nodes before the
+    release node r, and f_z ≥ RELEASE_PRESS at r − 1 — a plan of the cone at the nominal
+    μ alone (no scenario cone, no press) fails this."""
+    from flipkit.behaviors.options import MU_PLAN, RELEASE_PRESS
+
+    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    r = flip.release["node"]
+    places = [flip.landing["burger_on_blade"]] + [
+        row["burger_on_blade"] for row in flip.landing["scenarios"]]
+    tol = 1e-4  # m/s², the solver's constraint tolerance after row scaling
+    for place in places:
+        f = _specific_forces(flip_plan, flip, place)[1:r]  # node 0 is the pickup's end
+        assert np.all(f[:, 2] >= -tol)
+        assert np.all(np.abs(f[:, :2]) <= MU_PLAN * f[:, 2:3] + tol)
+        assert f[-1, 2] >= RELEASE_PRESS - tol
+
+
+def test_flip_nlp_carries_the_release_blocks():
+    """The flip NLP has a cone per scenario and the press at r − 1; release_press=0 drops the
+    press, and a task without scenarios has neither scenario cone."""
+    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.options import SegmentOptions
+    from flipkit.behaviors.transcribe import transcribe
+
+    models = models_for(CellConfig())
+    q, qd = models.bare.q_home, np.zeros(6)
+    kw = {"location": (0.69, -0.16, 0.072), "on_blade": (0.03, 0.0)}
+    scen = ((0.01, 0.0), (0.05, 0.0))
+
+    def names(options=SegmentOptions(), scenarios=scen):
+        nlp = transcribe("flip", models, q, qd, options=options, scenarios=scenarios, **kw)
+        return [b.name for b in nlp.blocks]
+
+    r = SegmentOptions().release_node()
+    got = names()
+    assert {"cone", "cone_scenario_0", "cone_scenario_1", "release_press"} <= set(got)
+    nlp = transcribe("flip", models, q, qd, scenarios=scen, **kw)
+    press = next(b for b in nlp.blocks if b.name == "release_press")
+    assert press.nodes == [r - 1]
+    scenario = next(b for b in nlp.blocks if b.name == "cone_scenario_1")
+    assert max(scenario.nodes) == r - 1
+    assert "release_press" not in names(SegmentOptions(release_press=0.0))
+    assert not any(n.startswith("cone_scenario") for n in names(scenarios=()))

@@ -19,7 +19,9 @@ from flipkit.behaviors.options import FLIGHT_MARGIN
 from flipkit.behaviors.pick import GO_TO_BURGER, PICKUP, SCOOP
 from flipkit.behaviors.spec import Behavior, Subbehavior
 from flipkit.config import CellConfig
+from flipkit.model.contact import make_cone
 from flipkit.transcription.constraints import KinematicBlock
+from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.transcription.constraints.flight import FlightClearance, Landing, ScenarioLanding
 
 
@@ -34,8 +36,37 @@ def flip_cone(ctx) -> list[int]:
     return [i for i in range(ctx.layout.n_nodes) if i <= max(r, tg.FLIP_CONE_FRACTION * ctx.layout.N)]
 
 
+def release_blocks(ctx) -> list:
+    """A decisive release wherever the burger lies: the cone at every scenario's place on
+    the nodes before the release node r (the nominal place's is the segment's own cone), and
+    at node r − 1 the normal specific force f_z ≥ ``options.release_press`` at the nominal
+    place and at every scenario's, so the contact lets go within the last interval before r
+    (:data:`~flipkit.config.task.RELEASE_PRESS`). The press needs the ``physical`` cone (its
+    first row is f_z); the ``paper`` cone gets the scenario cones alone."""
+    L, cell, task, o = ctx.layout, ctx.cell, ctx.task, ctx.options
+    r = release_node(ctx)
+    if r < 1:
+        return []
+    form = make_cone(o.cone, o.cone_mu(cell.burger.mu, True), cell.gravity)
+    before = [i for i in flip_cone(ctx) if i < r]
+    press = o.release_press if o.cone == "physical" else 0.0
+    blocks = []
+    for k, place in enumerate(task.scenarios):
+        lo = np.zeros((len(before), form.rows))
+        lo[-1, 0] = press  # node r − 1 is the last of ``before``
+        blocks.append(KinematicBlock(f"cone_scenario_{k}", L, Cone(form, (*place, 0.0)),
+                                     before, lo, np.inf, scale=0.1))
+    if press > 0:
+        lo = np.zeros((1, form.rows))
+        lo[0, 0] = press
+        blocks.append(KinematicBlock("release_press", L, Cone(form, (*task.blade_point(), 0.0)),
+                                     [r - 1], lo, np.inf, scale=0.1))
+    return blocks
+
+
 def flip_path(ctx) -> list:
-    """Release, flight clearance and landing (nominal and scenarios), then the end set of
+    """Release (:func:`release_blocks`), flight clearance and landing (nominal and
+    scenarios), then the end set of
     eq. (26): the blade's normal, its x axis on every node, the height at the end."""
     L, cell, task, o = ctx.layout, ctx.cell, ctx.task, ctx.options
     r, hg, bg = release_node(ctx), cell.grill.height, cell.burger
@@ -54,6 +85,7 @@ def flip_path(ctx) -> list:
             blocks.append(ScenarioLanding(L, r, spot, o.r_scenario, task.scenarios,
                                           thickness=bg.thickness, grill_height=hg,
                                           gravity=cell.gravity))
+        blocks += release_blocks(ctx)
     (lo_n, hi_n), (lo_x, hi_x), band = tg.FLIP_NORMAL_BOUNDS, tg.FLIP_XAXIS_BOUNDS, tg.FLIP_HEIGHT_BAND
     return blocks + [
         KinematicBlock("flip_normal", L, "normal", [L.N], lo_n, hi_n),
@@ -71,7 +103,7 @@ TURN_BACK = Subbehavior(
     "turn_back", duration=(0.4, 1.2), carries_burger=False, end="home", floor=above_burger,
     guess=turn_back_guess, doc="eq. (27): back to q_home at rest")
 FLIP = Subbehavior(
-    "flip", duration=(0.2, 0.6), carries_burger=True, end="moving", needs=("location",),
+    "flip", duration=(0.2, 0.9), carries_burger=True, end="moving", needs=("location",),
     exempt=tool_leaves_grill, path=flip_path, cone=flip_cone, cone_on_blade=True,
     guess=flip_guess, end_allowance=FLIP_END_ALLOWANCE, coast_into=TURN_BACK.name,
     doc="eq. (26) with release, flight and landing")

@@ -13,9 +13,10 @@ from flipkit.errors import ConfigError
 from flipkit.model.contact import make_cone
 from flipkit.model.singular import SINGULARITY_MARGIN
 
-from flipkit.config.task import (BRAKING_FRACTION, FLIGHT_MARGIN, MU_SAFETY,  # noqa: F401
-                                 R_LAND, R_SCENARIO, RELEASE_FRACTION, SCOOP_ANGLE_BAND,
-                                 SCOOP_LATERAL_BAND, SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH)
+from flipkit.config.task import (BRAKING_FRACTION, FLIGHT_MARGIN, MU_PLAN,  # noqa: F401
+                                 MU_SAFETY, R_LAND, R_SCENARIO, RELEASE_FRACTION,
+                                 RELEASE_PRESS, SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND,
+                                 SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH)
 
 
 @dataclass(frozen=True)
@@ -34,9 +35,14 @@ class SegmentOptions:
             (:class:`~flipkit.config.ScoopUncertainty`), not only the predicted one.
         release_fraction: Flip: the release node is ⌈release_fraction · N⌉; the cone holds up
             to it, the flying burger clears the blade after it.
-        mu_safety: The friction cone is planned with μ × mu_safety (a friction safety
-            factor): the friction a burger actually has is uncertain, and a plan that uses the
-            nominal μ to its limit lets a less sticky burger slide.
+        mu_plan: Friction coefficient the cones of the segments that carry the burger are
+            planned with (:data:`~flipkit.config.task.MU_PLAN`: the least sticky burger of
+            the sourced range); a burger whose nominal μ × mu_safety is lower gets that.
+        mu_safety: The scoop's cone (it limits the braking under the burger) is planned with
+            the nominal μ × mu_safety.
+        release_press: Flip: specific force (m/s²) that still presses the burger onto the
+            blade one node before the release, at its place and at every scenario's
+            (:data:`~flipkit.config.task.RELEASE_PRESS`); 0 leaves the release to the cone.
         landing: Flip: impose the release, flight and landing (default). ``False`` gives the
             paper's flip (26) alone, cone on i ≤ 0.6 N — a baseline whose burgers miss
             (``flipkit verify`` then fails its ``landing`` group).
@@ -59,7 +65,9 @@ class SegmentOptions:
     robust: bool = True
     release_fraction: float = RELEASE_FRACTION
     landing: bool = True
+    mu_plan: float = MU_PLAN
     mu_safety: float = MU_SAFETY
+    release_press: float = RELEASE_PRESS
     stretch: bool = False
     arm_clearance: bool = True
     singularity_margin: float = SINGULARITY_MARGIN
@@ -73,6 +81,11 @@ class SegmentOptions:
             raise ConfigError(f"r_scenario must be in [r_land, 0.1] m, got {self.r_scenario!r}")
         if not (np.isfinite(self.mu_safety) and 0 < self.mu_safety <= 1):
             raise ConfigError(f"mu_safety must be in (0, 1], got {self.mu_safety!r}")
+        if not (np.isfinite(self.mu_plan) and 0 < self.mu_plan <= 2):
+            raise ConfigError(f"mu_plan must be in (0, 2], got {self.mu_plan!r}")
+        if not (np.isfinite(self.release_press) and 0 <= self.release_press <= 9.81):
+            raise ConfigError(f"release_press must be in [0, 9.81] m/s², got "
+                              f"{self.release_press!r}")
         if not (np.isfinite(self.release_fraction) and 0.3 <= self.release_fraction <= 0.9):
             raise ConfigError(f"release_fraction must be in [0.3, 0.9], got "
                               f"{self.release_fraction!r}")
@@ -80,6 +93,13 @@ class SegmentOptions:
         if not (np.isfinite(self.singularity_margin) and 0 <= self.singularity_margin < 1.5):
             raise ConfigError(f"singularity_margin must be in [0, 1.5) rad, got "
                               f"{self.singularity_margin!r}")
+
+    def cone_mu(self, mu: float, carries_burger: bool) -> float:
+        """Friction coefficient of a segment's planned cone for a burger of nominal ``mu``:
+        :attr:`mu_plan` (capped at ``mu`` × :attr:`mu_safety`) when the segment carries the
+        burger, ``mu`` × :attr:`mu_safety` for the scoop's braking cone."""
+        braking = float(mu) * self.mu_safety
+        return min(self.mu_plan, braking) if carries_burger else braking
 
     def release_node(self) -> int:
         """The flip's release node r = ⌈release_fraction · N⌉."""

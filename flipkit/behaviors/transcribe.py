@@ -77,7 +77,8 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
     cone_nodes = spec.cone(ctx)
     if cone_nodes:
         on_point = (*task.blade_point(), 0.0) if spec.cone_on_blade else None
-        cone = Cone(make_cone(options.cone, cell.burger.mu * options.mu_safety, cell.gravity),
+        mu = options.cone_mu(cell.burger.mu, spec.carries_burger)
+        cone = Cone(make_cone(options.cone, mu, cell.gravity),
                     on_point)
         blocks.append(KinematicBlock("cone", L, cone, cone_nodes, 0.0, np.inf, scale=0.1))
     T_lo, T_hi = spec.duration

@@ -7,6 +7,9 @@ the paper is silent. The behaviour layer (:mod:`flipkit.behaviors`) reads them f
 
 from __future__ import annotations
 
+from flipkit.config.physics import PHYSICAL_RANGES
+from flipkit.config.uncertainty import ScoopUncertainty
+
 # --- the paper's targets, eqs. (22)–(26) -----------------------------------------------------
 SCOOP_PITCH = 0.314  # rad, o_y* of the blade going to the burger, eq. (22)
 PICKUP_OFFSET = (0.02, 0.0, 0.05)  # m, the pickup's end from p^b, eq. (25)
@@ -38,10 +41,24 @@ R_LAND = 0.005  # m
 # paper's success square (5 cm in x and y), which holds the disc.
 R_SCENARIO = 0.04  # m
 FLIGHT_MARGIN = 0.002  # m, the blade plane below the flying burger from node r + 2 on
-# Friction safety factor of the planned cone: the burger–blade friction is known to ±20 %
-# (the Table I trials draw it × U(0.8, 1.2)); a cone planned at the nominal μ is active, and a
-# less sticky burger then slides.
+# The cones of the segments that carry the burger (pickup, flip, translate, carry, place) are
+# planned for the least sticky burger the cell may meet, since it cannot measure μ: the low
+# end of the sourced burger–blade range (PHYSICAL_RANGES["burger.mu"], 0.2) times the low end
+# of the per-burger spread (ScoopUncertainty.mu_scale, × 0.8): 0.16. A cone planned at the
+# nominal μ is active, and a less sticky burger then slides off (in the sensitivity study, a
+# flip planned with μ 0.4 succeeded 0/100 with the burger's μ at 0.2).
+MU_PLAN = PHYSICAL_RANGES["burger.mu"][0] * ScoopUncertainty().mu_scale[0]
+# The scoop's cone only limits how hard the blade brakes under the burger (what any burger
+# does on the blade is the scoop model's, with its scenarios): nominal μ × MU_SAFETY.
 MU_SAFETY = 0.8
+# A decisive release: one node before the release node the contact still presses the burger
+# onto the blade with this specific force (m/s²) at its predicted place and at every
+# scenario's, so the force falls to zero within the last node interval (≥ 3 m/s² / 0.045 s =
+# 67 m/s³ for a flip of up to 0.9 s). An error of 1 m/s² in the specific force, or a burger a
+# little off its place, then moves the release by less than a third of an interval (15 ms),
+# well inside the 10 % of the flip between the release node (70 %) and the paper's contact
+# criterion (60 %). Ours: 3 m/s² ≈ 0.3 g.
+RELEASE_PRESS = 3.0
 
 # --- segment ends and durations ---------------------------------------------------------------
 # A moving segment end keeps the stopping distance at this share of q̈_max: the next segment's

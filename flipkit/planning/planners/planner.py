@@ -38,7 +38,7 @@ from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import (check_joint_vector, check_on_blade, check_position,
                                               check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.plans.verify_flight import TILT_MIN_DEG, recompute_landing
+from flipkit.planning.plans.verify_flight import LANDING_TOL, TILT_MIN_DEG, recompute_landing
 
 MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
@@ -163,9 +163,10 @@ def landing_miss(flip, on_blade, models) -> float:
     """How far (m) the solved ``flip`` segment lands a burger lying at ``on_blade`` (x, y)
     (m, blade frame) from its target: its own release state and a ballistic flight
     (:func:`~flipkit.planning.plans.verify_flight.recompute_landing`); ``inf`` when the
-    burger would not land upside down or has no release."""
+    burger would not land upside down (within the verification's tolerance) or has no
+    release."""
     pred = recompute_landing(models.loaded, flip, models.cell, on_blade)
-    if pred is None or pred["tilt_deg"] < TILT_MIN_DEG:
+    if pred is None or pred["tilt_deg"] < TILT_MIN_DEG - LANDING_TOL["deg"]:
         return math.inf
     return float(np.hypot(*(pred["point"][:2] - np.asarray(flip.landing["target"], float))))
 

@@ -11,7 +11,7 @@ pinocchio.
 
 Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt short
 of :data:`TILT_MIN_DEG` (deg), and the recorded prediction against the recomputed one (point
-m, tilt deg, time of flight s; tolerances :data:`~flipkit.planning.plans.verify.LANDING_TOL`).
+m, tilt deg, time of flight s; tolerances :data:`LANDING_TOL`).
 Group ``landing_scenarios`` (robust flips): the same rows for every recorded scenario of the
 burger's place on the blade, each against its own ``r_land``. Group
 ``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes
@@ -30,7 +30,7 @@ from scipy.spatial.transform import Rotation
 from flipkit.model.collision import pin_box_support
 
 TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
-_LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
+LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
 
 
 def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
@@ -88,7 +88,7 @@ def blade_burger_distance(blade_pose, burger_pose, cell) -> float:
 
 def check_flight(report, k, seg, robot, cell, states) -> None:
     """Add the ``landing`` and ``flight_clearance`` rows of flip segment k to ``report``."""
-    add, tol = report.add, _LANDING_TOL
+    add, tol = report.add, LANDING_TOL
     rec = seg.landing
     pred = recompute_landing(robot, seg, cell)
     if rec is None or pred is None:  # no release recorded, or a burger that never comes down
