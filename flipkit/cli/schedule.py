@@ -1,12 +1,17 @@
-"""``flipkit schedule``: order, time and plan one arm's flips and serves for a cook order.
+"""``flipkit schedule``: order, time and plan one arm's flips and serves for a cook order, or
+measure a stream of drops (``--stream RATE --minutes M``).
 
-Exit status: 0 every motion planned, solved and verified; 1 a motion's plan failed — one
-line per failure on stderr; the timeline and the plan files (the failed one with
-``"status": "failed"``) are still written; 2 bad input (unreadable or malformed CSV, wrong
+Exit status: 0 every motion planned, solved and verified, every event within its window;
+1 a motion's plan failed — one line per failure on stderr; the timeline and the plan files
+(the failed one with ``"status": "failed"``) are still written — or no schedule keeps every
+event in its window — one line naming the worst burger, its event and by how much; for a
+cook nothing is written and nothing runs, for a modelled stream its report is still
+written; 2 bad input (unreadable or malformed CSV, wrong
 header, a non-finite number, a drop time outside [0, 86400] s, a burger off the grill,
 duplicate ids, two burgers closer than one diameter on the grill at once, more burgers to
-serve than table spots), an output that is not writable, of an unknown format or the cook
-order itself, or a motion kind without a planner (``flipkit.planning.planners.planner.plan_serve``
+a malformed ``--window``, ``--dwell``, ``--time-limit``, ``--stream`` or ``--minutes``, a
+stream whose grill fills up), an output that is not writable, of an unknown format or the
+cook order itself, or a motion kind without a planner (``flipkit.planning.planners.planner.plan_serve``
 missing) — one line on stderr, nothing planned, nothing written.
 """
 
@@ -14,26 +19,38 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import MAX_WORKERS, SOLVER_CHOICES, check_int, deferred
+from flipkit.cli.common import MAX_WORKERS, SOLVER_CHOICES, check_float, check_int, deferred
+from flipkit.errors import ConfigError
 from flipkit.fileio import check_output
+from flipkit.planning.kitchen.stream import check_stream
+from flipkit.planning.kitchen.table import DWELL_S, check_dwell
+from flipkit.planning.kitchen.windows import parse_windows
 
 FIGURE_FORMATS = (".pdf", ".png", ".svg")  # --figure, by suffix
+POLICIES = ("cpsat", "greedy")
+MAX_TIME_LIMIT_S = 3600.0
 DESCRIPTION = (
-    "Flip every burger of a cook order at its 90 s mark and serve it to a table spot after "
-    "60 s on its second side, with one arm: the motions are ordered earliest deadline "
-    "first and each is planned from where the previous one ends, ahead of its start. "
-    "Writes the timeline (JSON), one plan file per motion, and optionally a Gantt chart. "
-    "Exit 0: all solved. Exit 1: a plan failed (everything still written). Exit 2: bad "
-    "input or a missing planner; nothing written.")
+    "Flip every burger of a cook order at its 90 s mark and serve it to a table spot 60 s "
+    "after it landed, with one arm, each event within its window. Every motion is planned "
+    "from rest at home; --policy cpsat (default) then orders and times them with OR-Tools "
+    "CP-SAT for the least largest, then least total, deviation from the marks; --policy "
+    "greedy takes them earliest deadline first. Writes the timeline (JSON), one plan file "
+    "per motion, and optionally a Gantt chart. With --stream RATE --minutes M, a stream of "
+    "drops at random places is scheduled on the durations of a few representative plans "
+    "(--plan: every motion planned) and its throughput reported. Exit 0: all solved, every "
+    "event in its window. Exit 1: a plan failed (everything still written) or the windows "
+    "cannot be met (one line; for a cook nothing written). Exit 2: bad input or a missing "
+    "planner; nothing written.")
 
 
 def register(subparsers) -> None:
     """Add the ``schedule`` sub-command to the parser."""
     p = subparsers.add_parser("schedule", help="schedule and plan the flips and serves of a "
                                                 "cook (one arm)", description=DESCRIPTION)
-    p.add_argument("burgers", metavar="BURGERS.csv",
+    p.add_argument("burgers", metavar="BURGERS.csv", nargs="?",
                    help="cook order: header burger,t_drop,x,y (id, drop time s in [0, "
-                        "86400], grill position m); lines starting with # skipped")
+                        "86400], grill position m); lines starting with # skipped; "
+                        "omitted with --stream")
     p.add_argument("--json", required=True, metavar="TIMELINE.json",
                    help="timeline output (.json; not the cook order)")
     p.add_argument("--figure", metavar="PATH", help="Gantt chart (.pdf, .png or .svg)")
@@ -52,16 +69,63 @@ def register(subparsers) -> None:
                    help="flips from cold starts (default: warm-started from the package's "
                         "atlas, `flipkit atlas build`, when it serves the default options)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--policy", choices=POLICIES, default="cpsat",
+                   help="cpsat (default): CP-SAT over orders and start times; greedy: "
+                        "earliest deadline first, no motion before its mark (the baseline)")
+    p.add_argument("--window", action="append", metavar="EVENT=EARLY,LATE",
+                   help="an event's window, s before and after its mark, each in [0, 30]: "
+                        "flip=EARLY,LATE (mark: drop + 90 s) or serve=EARLY,LATE (mark: "
+                        "landing + 60 s); repeat for both; default flip=0,2 and serve=0,2")
+    p.add_argument("--dwell", type=float, default=DWELL_S, metavar="S",
+                   help=f"s a served plate stays on the table before its spot is free "
+                        f"again, in [0, 3600] (default {DWELL_S:g})")
+    p.add_argument("--time-limit", type=float, default=10.0, metavar="S",
+                   help="CP-SAT's wall-time limit, s in (0, 3600] (default 10); one search "
+                        "worker and a fixed seed")
+    p.add_argument("--stream", type=float, metavar="RATE",
+                   help="instead of BURGERS.csv, a stream of drops: RATE burgers per hour, "
+                        "evenly spaced from t = 0, each at a random free place on the grill")
+    p.add_argument("--minutes", type=float, metavar="M",
+                   help="the stream's length, min (with --stream)")
+    p.add_argument("--seed", type=int, default=0, metavar="N",
+                   help="seed of the stream's places and of CP-SAT, in [0, 2**31-1] "
+                        "(default 0)")
+    p.add_argument("--plan", action="store_true",
+                   help="with --stream: plan every motion (minutes for hundreds) instead of "
+                        "scheduling on the durations of six representative plans")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Check the outputs and the options, then read, plan, write and report
     (:mod:`flipkit.cli.commands.schedule`)."""
-    check_output(args.json, "--json", (".json",), inputs=[args.burgers])
+    if (args.burgers is None) == (args.stream is None):
+        raise ConfigError("give a cook order BURGERS.csv or --stream RATE"
+                          + (", not both" if args.burgers else ""))
+    if args.stream is not None:
+        if args.minutes is None:
+            raise ConfigError("--stream RATE needs --minutes M")
+        check_stream(args.stream, args.minutes)
+        if args.flip_only and not args.plan:
+            raise ConfigError("--flip-only with --stream needs --plan (a modelled stream "
+                              "flips and serves)")
+        if args.figure and not args.plan:
+            raise ConfigError("--figure draws a planned cook: add --plan (the throughput of "
+                              "streams: notebooks/throughput.ipynb)")
+    elif args.minutes is not None or args.plan:
+        raise ConfigError("--minutes and --plan go with --stream")
+    inputs = [args.burgers] if args.burgers else []
+    check_output(args.json, "--json", (".json",), inputs=inputs)
     if args.figure:
-        check_output(args.figure, "--figure", FIGURE_FORMATS, inputs=[args.burgers],
+        check_output(args.figure, "--figure", FIGURE_FORMATS, inputs=inputs,
                      outputs=[args.json])
     if args.workers is not None:
         check_int("--workers", args.workers, 1, MAX_WORKERS)
+    args.windows = parse_windows(args.window)
+    check_dwell(args.dwell, "--dwell")
+    if args.time_limit is None or not args.time_limit > 0:
+        raise ConfigError(f"--time-limit must be a number in (0, {MAX_TIME_LIMIT_S:g}] s, "
+                          f"got {args.time_limit!r}")
+    check_float("--time-limit", args.time_limit, 0.0, MAX_TIME_LIMIT_S, "s")
+    check_int("--seed", args.seed, 0, 2**31 - 1)
     return deferred("schedule")(args)

@@ -20,43 +20,70 @@ from flipkit.experiments.sweep import make_executor
 from flipkit.figures.draw import plot_schedule
 from flipkit.fileio import check_output_dir, replace_with
 from flipkit.planning.kitchen import motions
-from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.kitchen.cook import check_cook, read_cook_csv, table_spots
+from flipkit.planning.kitchen.durations import plan_model, representative_order
+from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 from flipkit.planning.kitchen.schedule import format_timeline, schedule_cook
+from flipkit.planning.kitchen.stream import stream_order
+from flipkit.planning.kitchen.table import assign_spots
+from flipkit.planning.kitchen.throughput import run_stream, stream_report
+from flipkit.planning.kitchen.windows import WindowsBrokenError, worst_break
+from flipkit.planning.planners.atlas import default_atlas
 
 
 def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:40] or "burger"
 
 
+def _planners(order, kinds, cell, args, atlas, spots, executor):
+    """The real planners, prefetching in ``executor``'s workers when there is one."""
+    if executor is None:
+        return motions.default_planners(kinds, cell, args.solver, atlas)
+    return PrefetchPlanners(order, kinds, cell.robot.q_home, spots, executor, cell,
+                            args.solver, atlas)
+
+
 def run(args: argparse.Namespace) -> int:
-    """Read, check, plan, write, report."""
+    """Read (or make the stream), plan, schedule, check the windows, write, report."""
     warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-    inputs = [args.burgers]
     cell = CellConfig()
-    burgers = read_cook_csv(args.burgers, cell, serve=not args.flip_only)
     kinds = ("flip",) if args.flip_only else ("flip", "serve")
+    stream = args.stream is not None
+    burgers = (stream_order(args.stream, args.minutes, args.seed, cell, args.windows)
+               if stream else read_cook_csv(args.burgers, cell))
     atlas = None if args.no_atlas else default_atlas(cell)
-    planners = motions.default_planners(kinds, cell, args.solver, atlas)
     timeline_path = Path(args.json)
     plans = Path(args.plans) if args.plans else timeline_path.with_name(
         timeline_path.stem + "_plans")
-    check_output_dir(plans, "--plans", inputs=inputs + [args.json, args.figure])
-    q_home = cell.robot.q_home
+    if not stream or args.plan:
+        check_output_dir(plans, "--plans", inputs=[p for p in (args.burgers,) if p]
+                         + [args.json, args.figure])
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    executor = None
-    if workers > 1:
-        executor = make_executor(workers=workers)
-        planners = PrefetchPlanners(check_cook(burgers, cell, serve=not args.flip_only),
-                                    kinds, q_home,
-                                    table_spots(cell), executor, cell, args.solver, atlas)
+    executor = make_executor(workers=workers) if workers > 1 else None
     try:
-        timeline = schedule_cook(burgers, planners, q_home, kinds=kinds, cell=cell,
-                                 progress=not args.no_progress)
+        if stream and not args.plan:
+            return _modelled_stream(args, cell, atlas, executor, timeline_path)
+        order = check_cook(burgers, cell)
+        spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
+        planners = _planners(order, kinds, cell, args, atlas, spots, executor)
+        common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
+        if args.policy == "cpsat":
+            timeline = schedule_cook_cpsat(burgers, planners, cell.robot.q_home, **common,
+                                           time_limit_s=args.time_limit, seed=args.seed)
+        else:
+            timeline = schedule_cook(burgers, planners, cell.robot.q_home, **common,
+                                     progress=not args.no_progress)
     finally:
         if executor is not None:
             executor.shutdown(cancel_futures=True)
+    breach = worst_break(timeline.burgers, args.windows)
+    if timeline.ok and breach is not None:  # refused before any motion runs: nothing written
+        why = ("the greedy schedule; --policy cpsat searches the others"
+               if args.policy == "greedy" else _cpsat_why(timeline.solver))
+        print(f"flipkit: error: {WindowsBrokenError(breach, args.policy, why)}",
+              file=sys.stderr)
+        return 1
     try:
         plans.mkdir(parents=True, exist_ok=True)
         for k, m in enumerate(timeline.motions, 1):
@@ -71,19 +98,60 @@ def run(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise FlipkitError(f"{plans}: cannot write plans ({exc.strerror or exc})") from None
     doc = timeline.to_dict()
+    if stream:
+        doc["stream"] = stream_report(timeline, args.policy, args.stream,
+                                      args.minutes).to_dict()
     write_json(timeline_path, doc)
     if args.figure:
         _figure(doc, args.figure)
-    print(format_timeline(timeline))
+    if not stream:
+        print(format_timeline(timeline))
     late = doc["max_lateness_s"]
     print(f"flipkit schedule: {len(timeline.burgers)} burgers, {len(timeline.motions)} "
-          f"motions ({'+'.join(kinds)}), {doc['status']}; planning {doc['planning_time_s']:.1f}"
+          f"motions ({'+'.join(kinds)}), {doc['status']}, policy {args.policy}"
+          f"{_solver_note(timeline.solver)}; planning {doc['planning_time_s']:.1f}"
           f" s, min slack {doc['slack_s']['min']:.1f} s, max lateness flip "
-          f"{_s(late['flip'])}, serve {_s(late['serve'])}; wrote {timeline_path}")
+          f"{_s(late['flip'])}, serve {_s(late['serve'])}; windows "
+          f"{args.windows.describe()} met; wrote {timeline_path}")
     for b in timeline.burgers:
         if b.failure:
             print(f"flipkit: error: burger {b.burger.burger}: {b.failure}", file=sys.stderr)
     return 0 if timeline.ok else 1
+
+
+def _modelled_stream(args, cell, atlas, executor, timeline_path: Path) -> int:
+    """A stream scheduled on the durations of representative plans: report and JSON."""
+    rep, rep_spots = representative_order(cell)
+    model = plan_model(_planners(rep, ("flip", "serve"), cell, args, atlas, rep_spots,
+                                 executor), cell.robot.q_home, cell)
+    timeline, report = run_stream(args.stream, args.minutes, model, policy=args.policy,
+                                  windows=args.windows, dwell_s=args.dwell, seed=args.seed,
+                                  cell=cell, time_limit_s=args.time_limit)
+    doc = timeline.to_dict()
+    doc["stream"], doc["motion_model"] = report.to_dict(), model.to_dict()
+    write_json(timeline_path, doc)
+    print(f"flipkit schedule: stream of {report.n_burgers} burgers ({args.stream:g} per hour "
+          f"for {args.minutes:g} min), durations modelled on {model.source}; "
+          f"{report.summary()}{_solver_note(timeline.solver)}; wrote {timeline_path}")
+    breach = worst_break(timeline.burgers, args.windows)
+    if breach is not None:
+        print(f"flipkit: error: {WindowsBrokenError(breach, args.policy, 'in this stream')}",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def _cpsat_why(solver: dict | None) -> str:
+    if solver and solver.get("proved_infeasible"):
+        return ("CP-SAT proved that no schedule keeps every event in its window, and no "
+                "schedule breaks them by less")
+    return (f"CP-SAT found no schedule within the windows in its {solver['time_limit_s']:g} s "
+            f"(status {solver['status']}); --time-limit gives it longer") if solver else ""
+
+
+def _solver_note(solver: dict | None) -> str:
+    return "" if not solver else (f" (CP-SAT {solver['status']} in "
+                                  f"{solver['wall_s']:.2f} s)")
 
 
 def _s(v) -> str:

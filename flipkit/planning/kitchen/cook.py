@@ -65,20 +65,20 @@ class CookBurger:
         return (self.x, self.y, cell.grill.height)
 
 
-def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order",
-               serve: bool = True) -> list[CookBurger]:
+def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order"
+               ) -> list[CookBurger]:
     """Check a cook order; return it sorted by drop time (ties: as given).
 
     Checks: at least one burger; ids non-empty and unique; drop times finite and in
     [0, :data:`MAX_T_DROP`] s; positions finite and on the grill
     (:meth:`~flipkit.config.GrillConfig.contains`); two burgers on the grill at once (nominal
-    stays [t_drop, t_drop + 150 s] overlapping) at least one burger diameter apart; with
-    ``serve``, no more burgers than table spots.
+    stays [t_drop, t_drop + 150 s] overlapping) at least one burger diameter apart. The
+    table does not cap the order: served spots free up after a dwell
+    (:mod:`flipkit.planning.kitchen.table`).
 
     Args:
         burgers: :class:`CookBurger` rows. cell: The cell (default
             :class:`~flipkit.config.CellConfig`). where: Prefix of error messages.
-        serve: Whether the burgers are served (the table's capacity applies).
 
     Raises:
         CookOrderError: The first problem found, one line naming the burger.
@@ -119,18 +119,13 @@ def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order
                     f"{where}: burgers {a.burger!r} and {b.burger!r} are {gap * 1e3:.0f} mm "
                     f"apart on the grill at the same time; they need one burger diameter "
                     f"({d * 1e3:.0f} mm)")
-    capacity = len(table_spots(cell))
-    if serve and len(rows) > capacity:
-        raise CookOrderError(f"{where}: {len(rows)} burgers, but the table holds "
-                             f"{capacity} served burgers; split the order or plan the flips "
-                             f"alone (--flip-only)")
     return sorted(rows, key=lambda b: b.t_drop)
 
 
-def read_cook_csv(path, cell: CellConfig | None = None, serve: bool = True) -> list[CookBurger]:
+def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
     """Read a cook order CSV (UTF-8, with or without a byte-order mark): header
     ``burger,t_drop,x,y`` (in that order), one row per burger; blank lines and lines starting
-    with ``#`` are skipped. ``serve`` as :func:`check_cook`.
+    with ``#`` are skipped.
 
     Returns:
         The burgers sorted by drop time (:func:`check_cook`).
@@ -167,7 +162,7 @@ def read_cook_csv(path, cell: CellConfig | None = None, serve: bool = True) -> l
             raise CookOrderError(f"{path}: line {n}: t_drop, x and y must be numbers, got "
                                  f"{','.join(cells[1:])}") from None
         burgers.append(CookBurger(cells[0], t_drop, x, y))
-    return check_cook(burgers, cell, where=str(path), serve=serve)
+    return check_cook(burgers, cell, where=str(path))
 
 
 def table_spots(cell: CellConfig | None = None, gap: float = SPOT_GAP) -> list[tuple]:

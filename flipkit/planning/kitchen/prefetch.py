@@ -4,11 +4,11 @@ Every flip and serve starts at rest at the rest configuration (q_home) and ends 
 back and return home end at it), so the flips of a cook order are independent of one another
 and each serve depends only on its flip's predicted landing and its table spot.
 :class:`PrefetchPlanners` submits every flip to an executor as soon as it is made, and each
-serve as soon as its flip's plan is in, with the spot the scheduler will give it when every
-serve succeeds and they come in drop order (the k-th burger dropped, the k-th spot). The
+serve as soon as its flip's plan is in, with the spot the scheduler gives it (``spots``, one
+per burger in drop order: :func:`~flipkit.planning.kitchen.table.assign_spots`). The
 scheduler (:func:`~flipkit.planning.kitchen.schedule.schedule_cook`) asks for motions as before; a
 request whose job and start configuration match a prefetched one gets that plan, any other
-(a spot shifted by a failed serve, a start elsewhere) is planned on demand, in this process.
+(a start elsewhere) is planned on demand, in this process.
 
 The plans are those of the serial run: the same planner with the same inputs, each in its
 own process (the solvers are deterministic and start from nothing a previous solve left;
@@ -42,7 +42,7 @@ class PrefetchPlanners(Mapping):
         order: The cook's burgers (:class:`~flipkit.planning.kitchen.cook.CookBurger`), checked.
         kinds: Motion kinds planned (``("flip",)`` or ``("flip", "serve")``).
         q_rest: The rest configuration every motion starts and ends at (rad).
-        spots: Table spots (x, y) (m), handed out in drop order.
+        spots: Table spots (x, y) (m), the k-th for the k-th burger of ``order``.
         executor: A :class:`concurrent.futures.Executor` (worker processes or Dask).
         cell, solver, atlas: As :func:`~flipkit.planning.kitchen.motions.default_planners`.
     """

@@ -15,8 +15,10 @@ Policy — earliest deadline first, one arm, no early starts:
    from ``q_start``; an end within 1e-6 rad of ``q_start`` is taken as ``q_start`` itself,
    the rest configuration every motion returns to, to the solver's tolerance), which gives its duration and the time from its start to the event.
 3. It starts when the arm is free, but never so early that its event comes before the mark
-   (so no side is cooked shorter than 90 s / 60 s), and never before its plan exists
-   (below).
+   (so no side is cooked shorter than 90 s / 60 s), never before its plan exists (below),
+   and a serve never lifts off before its table spot is free (the spots are assigned
+   before planning and freed :data:`~flipkit.planning.kitchen.table.DWELL_S` after the
+   previous serve to them ends: :mod:`flipkit.planning.kitchen.table`).
 
 Lateness, reported per burger: landing − (``t_drop`` + 90 s) and lift-off − (``t_drop`` +
 150 s); both ≥ 0 (overcooking), the second ≥ the first.
@@ -37,8 +39,10 @@ serves differ in duration and lead, and then another order, or a deliberate wait
 a smaller largest lateness (single-machine L_max with release times is NP-hard in general);
 the greedy choice does not look ahead, trades nothing between burgers and does not minimise
 total lateness. Durations are known only once a motion is planned from where the previous
-one ended, so orders are not searched (every flip and serve ends at q_home, so a search
-over orders with durations from planning each motion once would be possible).
+one ended, so this rule searches no orders; every flip and serve ends at q_home, and
+:mod:`flipkit.planning.kitchen.optimal` plans each motion once and searches the orders and
+start times with CP-SAT (``flipkit schedule --policy cpsat``, the default). This rule stays
+as the fallback and the baseline (``--policy greedy``).
 """
 
 from __future__ import annotations
@@ -54,9 +58,12 @@ from flipkit.planning.kitchen.cook import SECOND_SIDE_S, CookBurger, check_cook,
 from flipkit.planning.planners.planner import REST_TOL
 from flipkit.planning.kitchen.motions import (KINDS, MissingPlannerError, MotionJob,
                                      MotionPlanner)
+from flipkit.planning.kitchen.table import DWELL_S, assign_spots
+from flipkit.planning.kitchen.windows import Windows, event_deviations
 from tqdm import tqdm
 
 FORMAT = "flipkit-timeline/1"
+GREEDY = "earliest-deadline-first, one arm, no motion before its mark"  # the policy's text
 
 
 @dataclass
@@ -111,12 +118,20 @@ class Timeline:
         motions: The arm's motions in execution order.
         kinds: The motion kinds planned (``("flip",)`` for a flips-only timeline).
         plan_start: When planning began (s, order clock).
+        policy: How the motions were ordered and timed (one line).
+        windows: The event windows the deviations are judged against.
+        dwell_s: The table dwell (s).
+        solver: The optimiser's record (status, objectives, wall time), or ``None``.
     """
 
     burgers: list[BurgerRecord]
     motions: list[MotionRecord]
     kinds: tuple
     plan_start: float
+    policy: str = GREEDY
+    windows: Windows = field(default_factory=Windows)
+    dwell_s: float = DWELL_S
+    solver: dict | None = None
 
     @property
     def ok(self) -> bool:
@@ -148,14 +163,18 @@ class Timeline:
             return None if v is None else round(float(v), 6)
         return {
             "format": FORMAT,
-            "policy": "earliest-deadline-first, one arm, no motion before its mark",
+            "policy": self.policy,
             "kinds": list(self.kinds),
+            "windows": self.windows.to_dict(),
+            "dwell_s": self.dwell_s,
+            "solver": self.solver,
             "status": "solved" if self.ok else "failed",
             "burgers": [{
                 "burger": b.burger.burger, "t_drop": b.burger.t_drop,
                 "position": [b.burger.x, b.burger.y],
                 "flip_time": r(b.flip_time), "serve_time": r(b.serve_time),
                 "lateness_s": {k: r(v) for k, v in b.lateness().items()},
+                "deviation_s": {k: r(v) for k, v in event_deviations(b).items()},
                 "table_spot": None if b.table_spot is None else list(b.table_spot),
                 "landing": None if b.landing is None else [r(v) for v in b.landing],
                 "failure": b.failure} for b in self.burgers],
@@ -175,7 +194,8 @@ class Timeline:
 
 def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
                   kinds=KINDS, cell: CellConfig | None = None, spots=None,
-                  plan_start: float | None = None, progress: bool = False) -> Timeline:
+                  plan_start: float | None = None, progress: bool = False,
+                  dwell_s: float = DWELL_S, windows: Windows = Windows()) -> Timeline:
     """Order, time and plan the arm's motions for a cook order (policy: module docstring).
 
     Args:
@@ -187,10 +207,13 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
         kinds: Motions to plan: ``("flip", "serve")`` (the cook) or ``("flip",)`` (flips
             only; burgers are left on the grill and ``serve_time`` stays ``None``).
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
-        spots: Table spots (x, y) (m), taken in serve order (default
-            :func:`~flipkit.planning.kitchen.cook.table_spots`).
+        spots: Table spots (x, y) (m) (default
+            :func:`~flipkit.planning.kitchen.cook.table_spots`), assigned by
+            :func:`~flipkit.planning.kitchen.table.assign_spots`.
         plan_start: When planning begins (s, order clock); default the first drop.
         progress: Show a tqdm progress bar (stderr), one step per motion.
+        dwell_s: Table dwell (s): a spot is free again this long after a serve to it ended.
+        windows: The event windows, recorded in the timeline (this rule does not use them).
 
     Returns:
         The timeline. A motion whose plan failed is recorded (``ok`` False) and not
@@ -207,10 +230,11 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
     for kind in kinds:
         if kind not in planners:
             raise MissingPlannerError(f"no planner given for the {kind!r} motions")
-    order = check_cook(burgers, cell, serve="serve" in kinds)
+    order = check_cook(burgers, cell)
     spots = list(table_spots(cell) if spots is None else spots)
-    if "serve" in kinds and len(spots) < len(order):
-        raise ConfigError(f"{len(order)} burgers but {len(spots)} table spots")
+    assigned = {a.burger: a for a in assign_spots(order, spots, dwell_s)} if (
+        "serve" in kinds) else {}
+    serve_end: dict[str, float] = {}
     records = [BurgerRecord(b) for b in order]
     clock = min(b.t_drop for b in order) if plan_start is None else float(plan_start)
     if not np.isfinite(clock):
@@ -228,17 +252,20 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
         due, _, _, k, kind = pending.pop(0)
         rec = records[k]
         b = rec.burger
+        spot_free = -np.inf
         if kind == "flip":
             job = MotionJob("flip", b.burger, b.location(cell))
         else:
-            rec.table_spot = tuple(spots[sum(m.kind == "serve" and m.ok for m in motions)])
+            rec.table_spot = tuple(assigned[b.burger].spot)
             job = MotionJob("serve", b.burger, (*rec.landing, cell.grill.height),
                             rec.table_spot)
+            spot_free = serve_end.get(assigned[b.burger].previous, -np.inf) + dwell_s
         pm = planners[kind](job, q)
         ready = getattr(pm, "ready_s", None)  # planned ahead, in parallel: when it was in
         clock = (max(clock, t0 + ready) if ready is not None
                  else clock + float(pm.planning_time_s))
-        wanted = max(arm_free, due - pm.event_s)  # arm free, and the event not early
+        wanted = max(arm_free, due - pm.event_s,  # arm free, and the event not early,
+                     spot_free - pm.event_s)  # and a serve's spot free at its lift-off
         start = max(wanted, clock)  # and the plan ready
         run = pm.duration_s if pm.ok else 0.0  # a failed plan is not executed
         m = MotionRecord(kind, b.burger, due, start, start + run,
@@ -264,21 +291,24 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
                 pending.append((m.event + SECOND_SIDE_S, k, 1, k, "serve"))
         else:
             rec.serve_time = m.event
+            serve_end[b.burger] = m.end
     bar.close()
-    return Timeline(records, motions, kinds, t0)
+    return Timeline(records, motions, kinds, t0, windows=windows, dwell_s=dwell_s)
 
 
 def format_timeline(timeline: Timeline) -> str:
-    """The lateness table and the motions, as aligned text."""
+    """The lateness table and the motions, as aligned text: per burger its flip and its
+    lateness (= its deviation from the 90 s mark), its serve, its lateness against the 150 s
+    mark and its deviation from its own mark (landing + 60 s), which its window judges."""
     def f(v):
         return "-" if v is None else f"{v:.2f}"
-    lines = [f"{'burger':<10}{'t_drop':>8}{'flip':>9}{'late':>7}{'serve':>9}{'late':>7}  "
-             "failure"]
+    lines = [f"{'burger':<10}{'t_drop':>8}{'flip':>9}{'late':>7}{'serve':>9}{'late':>7}"
+             f"{'dev':>7}  failure"]
     for b in timeline.burgers:
-        late = b.lateness()
+        late, dev = b.lateness(), event_deviations(b)
         lines.append(f"{b.burger.burger:<10}{b.burger.t_drop:>8.2f}{f(b.flip_time):>9}"
-                     f"{f(late['flip']):>7}{f(b.serve_time):>9}{f(late['serve']):>7}  "
-                     f"{b.failure or ''}")
+                     f"{f(late['flip']):>7}{f(b.serve_time):>9}{f(late['serve']):>7}"
+                     f"{f(dev['serve']):>7}  {b.failure or ''}")
     lines.append(f"{'motion':<16}{'start':>9}{'end':>9}{'event':>9}{'plan s':>8}{'slack':>9}")
     for m in timeline.motions:
         lines.append(f"{m.key:<16}{m.start:>9.2f}{m.end:>9.2f}{f(m.event):>9}"

@@ -1,0 +1,268 @@
+"""The cook as a constraint program: the order and start times of one arm's flips and serves
+that keep every event closest to its mark, solved with OR-Tools CP-SAT.
+
+Every motion starts and ends at rest at the same configuration (q_home), so its duration
+and the time from its start to its burger event do not depend on the motions before it;
+they are given (:class:`MotionTimes`, from the motions' plans or a model of them). Time is
+integer, in ms. Per burger k with drop ``t_k``:
+
+* variables: the start of its flip ``f_k`` and of its serve ``s_k``, each an interval of
+  the motion's duration; one ``NoOverlap`` over all intervals (one arm);
+* deviations: flip ``df_k = f_k + e_f − (t_k + 90 s)``, serve
+  ``ds_k = s_k + e_s − (f_k + e_f + 60 s)`` (the serve's mark follows its flip's landing);
+* no flip before the drop nor before ``earliest_s`` (the plans are in); the serve after its
+  flip ends; a serve to a spot used before lifts off ``dwell_s`` after the previous serve to
+  that spot ended (:mod:`~flipkit.planning.kitchen.table`);
+* no event earlier than its window allows (a side cooked short is never traded); the
+  excess beyond the window ``x ≥ d − late``, ``x ≥ 0``.
+
+Objectives, lexicographic, one solve each, with the previous optimum as a bound and the
+previous solution as a hint (the first hint: :func:`edf_hint`, the greedy rule):
+
+* first with every event in its window (``x = 0``): (B) the largest absolute deviation,
+  then (C) the total absolute deviation;
+* when that is infeasible (or undecided within the time limit), with lateness beyond the
+  windows allowed, and first (``relax="max"``, a cook) (A) the largest excess — how much
+  the worst event must break its window at the least — then the number of burgers beyond
+  their windows, B and C; or (``relax="count"``, a stream) the number of burgers beyond
+  their windows first, then A, B and C. Several events often share the least largest
+  excess; the one named (:class:`~flipkit.planning.kitchen.windows.WindowBreak`) is a late
+  one of the last burger among them.
+
+One worker and a fixed seed make the result deterministic when every stage is proved
+optimal within the time limit; a stage stopped by the limit keeps its best solution, and
+the status says ``feasible`` instead of ``optimal``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+from ortools.sat.python import cp_model
+
+from flipkit.errors import FlipkitError, InvalidChoiceError
+from flipkit.planning.kitchen.cook import FIRST_SIDE_S, SECOND_SIDE_S
+from flipkit.planning.kitchen.windows import WindowBreak, Windows
+
+MS = 1000  # model time units per s
+RELAX = ("max", "count")  # the first objective when the windows cannot be met
+
+
+class ScheduleTimeoutError(FlipkitError):
+    """CP-SAT found no schedule at all within its time limit."""
+
+
+@dataclass(frozen=True)
+class MotionTimes:
+    """A planned motion's duration and the time from its start to its burger event (s)."""
+
+    duration_s: float
+    event_s: float
+
+
+@dataclass(frozen=True)
+class BurgerJob:
+    """One burger as the model sees it.
+
+    Attributes:
+        burger: Its id. t_drop: Its drop time (s).
+        flip: Its flip's times. serve: Its serve's times (``None``: not served).
+        previous: Index (in the job list) of the burger served to the same table spot
+            before it (``None``: none).
+    """
+
+    burger: str
+    t_drop: float
+    flip: MotionTimes
+    serve: MotionTimes | None = None
+    previous: int | None = None
+
+
+@dataclass
+class CpSatSchedule:
+    """The solved schedule.
+
+    Attributes:
+        starts: ``(kind, job index)`` → start (s).
+        status: ``"optimal"`` (every stage proved) or ``"feasible"`` (a stage hit the limit).
+        max_excess_s, max_deviation_s, total_deviation_s: The three objectives (s).
+        breach: The event furthest beyond its window when ``max_excess_s`` > 0, else ``None``.
+        wall_s: Solver wall time (s), all stages.
+        proved_infeasible: CP-SAT proved that no schedule keeps every event in its window
+            (``False`` when the windows are met, or when it ran out of time deciding).
+    """
+
+    starts: dict
+    status: str
+    max_excess_s: float
+    max_deviation_s: float
+    total_deviation_s: float
+    breach: WindowBreak | None
+    wall_s: float
+    proved_infeasible: bool = False
+
+
+def _ms(seconds: float) -> int:
+    return int(round(seconds * MS))
+
+
+class _Model:
+    """The CP-SAT model of ``jobs``; ``hard``: every deviation within its window, else
+    lateness beyond it is allowed (and measured by the excess variables)."""
+
+    def __init__(self, jobs, windows: Windows, dwell_s: float, earliest_s: float, hard: bool):
+        self.m = m = cp_model.CpModel()
+        work = sum(j.flip.duration_s + (j.serve.duration_s if j.serve else 0.0) for j in jobs)
+        horizon = _ms(max(j.t_drop for j in jobs) + FIRST_SIDE_S + SECOND_SIDE_S + work
+                      + dwell_s * (1 + len(jobs)) + 120.0)
+        self.starts, self.events, intervals = {}, [], []
+        floor = _ms(earliest_s) if math.isfinite(earliest_s) else 0
+        for k, j in enumerate(jobs):
+            for kind, t in (("flip", j.flip), ("serve", j.serve)):
+                if t is not None:
+                    s = m.NewIntVar(max(_ms(j.t_drop), floor), horizon, f"{kind}_{k}")
+                    dur = int(math.ceil(t.duration_s * MS - 1e-6))
+                    intervals.append(m.NewFixedSizeIntervalVar(s, dur, f"{kind}_{k}_iv"))
+                    self.starts[kind, k] = (s, dur, _ms(t.event_s))
+            f, fdur, fev = self.starts["flip", k]
+            devs = {"flip": f + fev - _ms(j.t_drop + FIRST_SIDE_S)}
+            if j.serve is not None:
+                s, _, sev = self.starts["serve", k]
+                m.Add(s >= f + fdur)
+                devs["serve"] = s + sev - f - fev - _ms(SECOND_SIDE_S)
+            for event, dev in devs.items():
+                early, late = (_ms(v) for v in windows.of(event))  # never early beyond it
+                d = m.NewIntVar(-early, late if hard else horizon, f"d_{event}_{k}")
+                m.Add(d == dev)
+                x = m.NewIntVar(0, 0 if hard else horizon, f"x_{event}_{k}")
+                m.Add(x >= d - late)
+                self.events.append((k, event, x, d))
+            prev = j.previous
+            if j.serve is not None and prev is not None and ("serve", prev) in self.starts:
+                p, pdur, _ = self.starts["serve", prev]
+                m.Add(s + sev >= p + pdur + _ms(dwell_s))
+        m.AddNoOverlap(intervals)
+        self.max_x = m.NewIntVar(0, horizon, "max_x")
+        self.max_d = m.NewIntVar(0, horizon, "max_d")
+        m.AddMaxEquality(self.max_x, [e[2] for e in self.events])
+        self.n_late = 0  # burgers with an event beyond its window
+        if not hard:
+            late_b = [m.NewBoolVar(f"late_{k}") for k in range(len(jobs))]
+            for k, _, x, _ in self.events:
+                m.Add(x == 0).OnlyEnforceIf(late_b[k].Not())
+            self.n_late = sum(late_b)
+        abs_d = []
+        for _, _, _, d in self.events:
+            a = m.NewIntVar(0, horizon, "")
+            m.AddAbsEquality(a, d)
+            abs_d.append(a)
+        m.AddMaxEquality(self.max_d, abs_d)
+        self.total = sum(abs_d)
+
+    def hint(self, values: dict) -> None:
+        self.m.ClearHints()
+        for key, (s, _, _) in self.starts.items():
+            self.m.AddHint(s, values[key])
+
+
+def edf_hint(jobs, dwell_s: float, earliest_s: float = -math.inf) -> dict:
+    """Starts (ms) by earliest deadline first, none before its mark (the greedy rule of
+    :mod:`~flipkit.planning.kitchen.schedule` on given times): CP-SAT's first solution."""
+    out, ends, free = {}, {}, -math.inf
+    pending = [(j.t_drop + FIRST_SIDE_S, k, "flip") for k, j in enumerate(jobs)]
+    while pending:
+        pending.sort()
+        due, k, kind = pending.pop(0)
+        j = jobs[k]
+        t = j.flip if kind == "flip" else j.serve
+        start = max(free, due - t.event_s, j.t_drop, earliest_s)
+        if kind == "serve" and j.previous in ends:
+            start = max(start, ends[j.previous] + dwell_s - t.event_s)
+        out[kind, k] = _ms(start)
+        free = start + t.duration_s
+        if kind == "flip" and j.serve is not None:
+            pending.append((start + t.event_s + SECOND_SIDE_S, k, "serve"))
+        elif kind == "serve":
+            ends[k] = free
+    return out
+
+
+def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
+                   earliest_s: float = -math.inf, time_limit_s: float = 10.0,
+                   workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
+    """Order and time the motions of ``jobs`` (:class:`BurgerJob`, any order); module docstring.
+
+    First with every event in its window (the stages B and C); when that is infeasible (or
+    not decided within the limit), with lateness beyond the windows allowed (A, B, C). No
+    event is ever earlier than its window allows. The first solution is hinted by
+    :func:`edf_hint`.
+
+    Args:
+        windows: Event windows. dwell_s: Table dwell (s). earliest_s: No motion before (s).
+        time_limit_s: Wall-time limit for all solves together (s).
+        workers: CP-SAT search workers. seed: CP-SAT random seed.
+
+    Raises:
+        ScheduleTimeoutError: No schedule found within ``time_limit_s``.
+        FlipkitError: No jobs.
+    """
+    jobs = list(jobs)
+    if relax not in RELAX:
+        raise InvalidChoiceError("relaxed objective", relax, RELAX)
+    if not jobs:
+        raise FlipkitError("no burgers to schedule")
+    solver = cp_model.CpSolver()
+    solver.parameters.num_search_workers = int(workers)
+    solver.parameters.random_seed = int(seed)
+    t0, proved, last = time.perf_counter(), True, edf_hint(jobs, dwell_s, earliest_s)
+    found = infeasible = False
+    for hard in (True, False):
+        model = _Model(jobs, windows, dwell_s, earliest_s, hard)
+        stages = ((model.max_d, model.total) if hard else
+                  (model.max_x, model.n_late, model.max_d, model.total) if relax == "max" else
+                  (model.n_late, model.max_x, model.max_d, model.total))
+        for objective in stages:
+            solver.parameters.max_time_in_seconds = max(
+                0.05, time_limit_s - (time.perf_counter() - t0))
+            model.hint(last)
+            model.m.Minimize(objective)
+            code = solver.Solve(model.m)
+            infeasible = infeasible or (hard and code == cp_model.INFEASIBLE)
+            if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+                proved = proved and found  # a later stage stopped: keep what was found
+                break
+            found, proved = True, proved and code == cp_model.OPTIMAL
+            last = {key: solver.Value(v[0]) for key, v in model.starts.items()}
+            events = [(k, e, _excess(windows, e, solver.Value(d)), solver.Value(d))
+                      for k, e, _, d in model.events]  # x is only bounded below: from d
+            model.m.Add(objective <= int(solver.Value(objective)))
+        if found:
+            break
+        proved = True  # the hard model's infeasibility is not a stage of the answer
+    if not found:
+        raise ScheduleTimeoutError(
+            f"CP-SAT found no schedule within {time_limit_s:g} s; raise --time-limit or use "
+            "--policy greedy")
+    # the worst event; among ties (a min-max spreads the excess), a late one, the last burger
+    worst = max(events, key=lambda e: (e[2], e[3] > 0, e[0], e[1] == "serve"))
+    breach = None
+    if worst[2] > 0:
+        k, event, x, d = worst
+        breach = WindowBreak(jobs[k].burger, event, d / MS, x / MS, windows.of(event),
+                             sum(e[2] == x for e in events) - 1)
+    return CpSatSchedule({key: v / MS for key, v in last.items()},
+                         "optimal" if proved else "feasible",
+                         max(e[2] for e in events) / MS, max(abs(e[3]) for e in events) / MS,
+                         sum(abs(e[3]) for e in events) / MS, breach,
+                         time.perf_counter() - t0, infeasible)
+
+
+def _excess(windows: Windows, event: str, dev_ms: int) -> int:
+    early, late = (_ms(v) for v in windows.of(event))
+    return max(0, dev_ms - late, -early - dev_ms)
+
+
+__all__ = ["MS", "BurgerJob", "CpSatSchedule", "MotionTimes", "ScheduleTimeoutError",
+           "solve_schedule"]
