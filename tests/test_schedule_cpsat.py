@@ -253,3 +253,19 @@ def test_cli_refuses_a_cook_that_breaks_its_windows_in_one_line(policy, excess, 
     assert code == 1 and "\n" not in err and err.startswith(f"flipkit: error: {policy}: ")
     assert f"burger b5: its serve" in err and f"{excess} s beyond its window" in err
     assert not out.exists() and not (tmp_path / "t_plans").exists()  # nothing written
+
+
+def test_cpsat_runs_in_its_own_process_beside_cvxpy():
+    """OR-Tools and highspy (imported by cvxpy) ship clashing libhighs.so.1: CP-SAT runs in a
+    child process, so a process that plans with cvxpy keeps HiGHS and still schedules."""
+    import sys
+
+    import cvxpy
+
+    assert "HIGHS" in cvxpy.installed_solvers()
+    result = solve_schedule([BurgerJob("b1", 0.0, FLIP, SERVE)])
+    assert result.status == "optimal" and result.breach is None
+    assert result.starts["flip", 0] == pytest.approx(90 - FLIP.event_s)
+    assert result.solve_s < result.wall_s  # the child's start-up counted in wall_s
+    assert "ortools.sat.python.cp_model" not in sys.modules
+    assert "HIGHS" in cvxpy.installed_solvers()

@@ -32,15 +32,23 @@ previous solution as a hint (the first hint: :func:`edf_hint`, the greedy rule):
 One worker and a fixed seed make the result deterministic when every stage is proved
 optimal within the time limit; a stage stopped by the limit keeps its best solution, and
 the status says ``feasible`` instead of ``optimal``.
+
+CP-SAT runs in a child process (``python -m flipkit.planning.kitchen.cpsat``, the problem
+and the answer as JSON on its standard streams; :func:`solve_schedule`), never in the
+caller's: the OR-Tools wheel ships its own ``libhighs.so.1``, older than the one of
+``highspy`` (which cvxpy imports), and one process cannot load both (whichever comes second
+fails to load: google/or-tools issue #5246). The planners load cvxpy; the child loads only
+OR-Tools. :func:`solve_here` is the solve itself, given the ``cp_model`` module.
 """
 
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
 import time
-from dataclasses import dataclass
-
-from ortools.sat.python import cp_model
+from dataclasses import asdict, dataclass
 
 from flipkit.errors import FlipkitError, InvalidChoiceError
 from flipkit.planning.kitchen.cook import FIRST_SIDE_S, SECOND_SIDE_S
@@ -50,8 +58,15 @@ MS = 1000  # model time units per s
 RELAX = ("max", "count")  # the first objective when the windows cannot be met
 
 
+CHILD_MARGIN_S = 60.0  # s the child process may take beyond the time limit (start-up)
+
+
 class ScheduleTimeoutError(FlipkitError):
     """CP-SAT found no schedule at all within its time limit."""
+
+
+class CpSatProcessError(FlipkitError):
+    """The CP-SAT child process failed (its last error line) or did not answer in time."""
 
 
 @dataclass(frozen=True)
@@ -89,7 +104,8 @@ class CpSatSchedule:
         status: ``"optimal"`` (every stage proved) or ``"feasible"`` (a stage hit the limit).
         max_excess_s, max_deviation_s, total_deviation_s: The three objectives (s).
         breach: The event furthest beyond its window when ``max_excess_s`` > 0, else ``None``.
-        wall_s: Solver wall time (s), all stages.
+        wall_s: Wall time (s), all stages (with :func:`solve_schedule`: and the child
+            process's start).
         proved_infeasible: CP-SAT proved that no schedule keeps every event in its window
             (``False`` when the windows are met, or when it ran out of time deciding).
     """
@@ -102,6 +118,7 @@ class CpSatSchedule:
     breach: WindowBreak | None
     wall_s: float
     proved_infeasible: bool = False
+    solve_s: float | None = None  # the solves alone, in the child process (s)
 
 
 def _ms(seconds: float) -> int:
@@ -109,11 +126,12 @@ def _ms(seconds: float) -> int:
 
 
 class _Model:
-    """The CP-SAT model of ``jobs``; ``hard``: every deviation within its window, else
-    lateness beyond it is allowed (and measured by the excess variables)."""
+    """The CP-SAT model of ``jobs`` (``cp``: OR-Tools' ``cp_model`` module); ``hard``: every
+    deviation within its window, else lateness beyond it is allowed (the excess variables)."""
 
-    def __init__(self, jobs, windows: Windows, dwell_s: float, earliest_s: float, hard: bool):
-        self.m = m = cp_model.CpModel()
+    def __init__(self, cp, jobs, windows: Windows, dwell_s: float, earliest_s: float,
+                 hard: bool):
+        self.m = m = cp.CpModel()
         work = sum(j.flip.duration_s + (j.serve.duration_s if j.serve else 0.0) for j in jobs)
         horizon = _ms(max(j.t_drop for j in jobs) + FIRST_SIDE_S + SECOND_SIDE_S + work
                       + dwell_s * (1 + len(jobs)) + 120.0)
@@ -192,34 +210,78 @@ def edf_hint(jobs, dwell_s: float, earliest_s: float = -math.inf) -> dict:
 def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                    earliest_s: float = -math.inf, time_limit_s: float = 10.0,
                    workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
-    """Order and time the motions of ``jobs`` (:class:`BurgerJob`, any order); module docstring.
-
-    First with every event in its window (the stages B and C); when that is infeasible (or
-    not decided within the limit), with lateness beyond the windows allowed (A, B, C). No
-    event is ever earlier than its window allows. The first solution is hinted by
-    :func:`edf_hint`.
+    """Order and time the motions of ``jobs`` (:class:`BurgerJob`, any order) with CP-SAT in
+    a child process (module docstring); :func:`solve_here` says how.
 
     Args:
         windows: Event windows. dwell_s: Table dwell (s). earliest_s: No motion before (s).
         time_limit_s: Wall-time limit for all solves together (s).
         workers: CP-SAT search workers. seed: CP-SAT random seed.
+        relax: The first objective when the windows cannot be met: "max" or "count".
+
+    Returns:
+        The schedule; ``wall_s`` counts the child process's start too.
 
     Raises:
         ScheduleTimeoutError: No schedule found within ``time_limit_s``.
-        FlipkitError: No jobs.
+        CpSatProcessError: The child process failed or hung.
+        InvalidChoiceError: An unknown ``relax``. FlipkitError: No jobs.
     """
     jobs = list(jobs)
+    _check(jobs, relax)
+    problem = {"jobs": [asdict(j) for j in jobs], "windows": windows.to_dict(),
+               "dwell_s": dwell_s, "earliest_s": earliest_s if math.isfinite(earliest_s)
+               else None, "time_limit_s": time_limit_s, "workers": workers, "seed": seed,
+               "relax": relax}
+    t0 = time.perf_counter()
+    try:
+        run = subprocess.run([sys.executable, "-m", __name__], input=json.dumps(problem),
+                             capture_output=True, text=True,
+                             timeout=time_limit_s + CHILD_MARGIN_S)
+    except subprocess.TimeoutExpired:
+        raise CpSatProcessError(f"the CP-SAT process did not answer within "
+                                f"{time_limit_s + CHILD_MARGIN_S:g} s") from None
+    if run.returncode != 0:
+        last = (run.stderr.strip().splitlines() or ["no message"])[-1]
+        raise CpSatProcessError(f"the CP-SAT process failed (exit {run.returncode}): {last}")
+    answer = json.loads(run.stdout)
+    if "timeout" in answer:
+        raise ScheduleTimeoutError(answer["timeout"])
+    breach = answer["breach"]
+    return CpSatSchedule(
+        {(kind, k): start for kind, k, start in answer["starts"]}, answer["status"],
+        answer["max_excess_s"], answer["max_deviation_s"], answer["total_deviation_s"],
+        None if breach is None else WindowBreak(**{**breach, "window": tuple(breach["window"])}),
+        time.perf_counter() - t0, answer["proved_infeasible"], answer["solve_s"])
+
+
+def _check(jobs, relax: str) -> None:
     if relax not in RELAX:
         raise InvalidChoiceError("relaxed objective", relax, RELAX)
     if not jobs:
         raise FlipkitError("no burgers to schedule")
-    solver = cp_model.CpSolver()
+
+
+def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
+               earliest_s: float = -math.inf, time_limit_s: float = 10.0,
+               workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
+    """The solve, in this process, with ``cp`` OR-Tools' ``cp_model`` module (the child's
+    work; arguments as :func:`solve_schedule`).
+
+    First with every event in its window (the stages B and C); when that is infeasible (or
+    not decided within the limit), with lateness beyond the windows allowed (A, B, C). No
+    event is ever earlier than its window allows. The first solution is hinted by
+    :func:`edf_hint`.
+    """
+    jobs = list(jobs)
+    _check(jobs, relax)
+    solver = cp.CpSolver()
     solver.parameters.num_search_workers = int(workers)
     solver.parameters.random_seed = int(seed)
     t0, proved, last = time.perf_counter(), True, edf_hint(jobs, dwell_s, earliest_s)
     found = infeasible = False
     for hard in (True, False):
-        model = _Model(jobs, windows, dwell_s, earliest_s, hard)
+        model = _Model(cp, jobs, windows, dwell_s, earliest_s, hard)
         stages = ((model.max_d, model.total) if hard else
                   (model.max_x, model.n_late, model.max_d, model.total) if relax == "max" else
                   (model.n_late, model.max_x, model.max_d, model.total))
@@ -229,11 +291,11 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
             model.hint(last)
             model.m.Minimize(objective)
             code = solver.Solve(model.m)
-            infeasible = infeasible or (hard and code == cp_model.INFEASIBLE)
-            if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+            infeasible = infeasible or (hard and code == cp.INFEASIBLE)
+            if code not in (cp.OPTIMAL, cp.FEASIBLE):
                 proved = proved and found  # a later stage stopped: keep what was found
                 break
-            found, proved = True, proved and code == cp_model.OPTIMAL
+            found, proved = True, proved and code == cp.OPTIMAL
             last = {key: solver.Value(v[0]) for key, v in model.starts.items()}
             events = [(k, e, _excess(windows, e, solver.Value(d)), solver.Value(d))
                       for k, e, _, d in model.events]  # x is only bounded below: from d
@@ -264,5 +326,32 @@ def _excess(windows: Windows, event: str, dev_ms: int) -> int:
     return max(0, dev_ms - late, -early - dev_ms)
 
 
-__all__ = ["MS", "BurgerJob", "CpSatSchedule", "MotionTimes", "ScheduleTimeoutError",
+def answer(problem: dict, cp) -> dict:
+    """The child's answer (JSON-ready) to ``problem`` (the JSON :func:`solve_schedule` sends)."""
+    jobs = [BurgerJob(j["burger"], j["t_drop"], MotionTimes(**j["flip"]),
+                      None if j["serve"] is None else MotionTimes(**j["serve"]), j["previous"])
+            for j in problem["jobs"]]
+    earliest = problem["earliest_s"]
+    try:
+        r = solve_here(cp, jobs, Windows(**problem["windows"]), dwell_s=problem["dwell_s"],
+                       earliest_s=-math.inf if earliest is None else earliest,
+                       time_limit_s=problem["time_limit_s"], workers=problem["workers"],
+                       seed=problem["seed"], relax=problem["relax"])
+    except ScheduleTimeoutError as exc:
+        return {"timeout": str(exc)}
+    return {"starts": [[kind, k, v] for (kind, k), v in r.starts.items()],
+            "status": r.status, "max_excess_s": r.max_excess_s,
+            "max_deviation_s": r.max_deviation_s, "total_deviation_s": r.total_deviation_s,
+            "breach": None if r.breach is None else asdict(r.breach), "solve_s": r.wall_s,
+            "proved_infeasible": r.proved_infeasible}
+
+
+__all__ = ["CHILD_MARGIN_S", "MS", "RELAX", "BurgerJob", "CpSatProcessError", "CpSatSchedule",
+           "MotionTimes", "ScheduleTimeoutError", "answer", "edf_hint", "solve_here",
            "solve_schedule"]
+
+
+if __name__ == "__main__":  # the child process: a problem on stdin, the answer on stdout
+    from ortools.sat.python import cp_model
+
+    json.dump(answer(json.load(sys.stdin), cp_model), sys.stdout)

@@ -140,6 +140,7 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
     motions.sort(key=lambda m: (m.start, m.kind != "flip"))
     solver = None if result is None else {
         "name": "cp-sat", "status": result.status, "wall_s": round(result.wall_s, 6),
+        "solve_s": None if result.solve_s is None else round(result.solve_s, 6),
         "time_limit_s": time_limit_s, "workers": workers, "seed": seed, "relax": relax,
         "windows_met": result.breach is None, "proved_infeasible": result.proved_infeasible,
         "max_excess_s": result.max_excess_s, "max_deviation_s": result.max_deviation_s,
