@@ -11,6 +11,7 @@ import json
 from pathlib import Path
 
 from flipkit.behaviors.models import Models
+from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
@@ -23,7 +24,9 @@ START, GOAL = (0.64, -0.33, 0.15), (0.75, 0.0, 0.15)
 def reference_nlp():
     models = Models(CellConfig())
     q_start = solve_pose(models.loaded, START, (0.0, 0.0, 0.0))
-    return transcribe("translate", models, q_start, goal=flat_pose(GOAL))
+    # the NLP the committed log was written on: the cone at the nominal μ × 0.8
+    return transcribe("translate", models, q_start, goal=flat_pose(GOAL),
+                      options=SegmentOptions(mu_plan=0.4))
 
 
 def run():

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
-from flipkit.behaviors.options import R_LAND, SegmentOptions, SCOOP_PRESS, SCOOP_TIP_BAND
+from flipkit.behaviors.options import MU_SAFETY, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline import run_baseline
 from flipkit.baseline.ee_opt import EEState, orientation_profile
@@ -105,8 +105,8 @@ def test_task_constraints_hold_at_fine_samples(chain, cell):
         assert np.all(np.abs(tr.v) <= lim.v_max + 1e-6) and np.all(np.abs(tr.a) <= lim.a_max + 1e-6)
         assert np.all(tr.o[:, 1] >= lim.pitch_range[0] - 1e-6)
         assert np.all(tr.o[:, 1] <= lim.pitch_range[1] + 1e-6)
-        # friction cone from the fine samples' accelerations (physical form, the planned μ)
-        mu = SegmentOptions().cone_mu(cell.burger.mu, True)
+        # friction cone from the fine samples' accelerations (physical form, μ × safety)
+        mu = cell.burger.mu * MU_SAFETY
         for k in np.flatnonzero(tr.cone):
             f = specific_force(tr.R[k], tr.a[k], g)
             tol = 0.02  # m/s²: between the optimisation's samples

@@ -18,8 +18,10 @@ def translate(cell):
     """The first translate of bench (key point 1 to 2), without the arm's clearance rows."""
     models = Models(cell)
     q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
+    # the cone at the nominal μ × 0.8: with MU_PLAN's 0.16 FATROP ends "failed" at a
+    # violation of 3e-8 (the peers' set-up is issue 31's)
     return transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
-                         options=SegmentOptions(arm_clearance=False))
+                      options=SegmentOptions(arm_clearance=False, mu_plan=0.4))
 
 
 @pytest.fixture(scope="module")

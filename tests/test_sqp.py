@@ -275,7 +275,16 @@ def cold_flip():
     cell, pb = CellConfig(), TABLE1_LOCATIONS[6]
     pickup = next(s for s in plan_flip(pb, cell=cell, solver="sqp").segments
                   if s.name == "pickup")
-    return transcribe("flip", Models(cell), pickup.q[-1], pickup.qd[-1], location=pb)
+    # the flip NLP this test was written on: a 0.6 s bound, the cone at 0.8 μ, no release
+    # press (the restoration's behaviour is the subject, not the plan)
+    from dataclasses import replace
+
+    from flipkit.behaviors.flip import FLIP
+    from flipkit.behaviors.options import SegmentOptions
+
+    spec, options = replace(FLIP, duration=(0.2, 0.6)), SegmentOptions(mu_plan=0.4, release_press=0.0)
+    return transcribe(spec, Models(cell), pickup.q[-1], pickup.qd[-1], location=pb,
+                      options=options)
 
 
 def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_flip):

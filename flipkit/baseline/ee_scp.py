@@ -53,8 +53,7 @@ import cvxpy as cp
 import numpy as np
 
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
-from flipkit.behaviors.options import (RELEASE_FRACTION, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND,
-                                       SegmentOptions)
+from flipkit.behaviors.options import MU_SAFETY, RELEASE_FRACTION, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
 from flipkit.baseline.scp_problem import (ACC_WEIGHT, COST_SCALE, ORIENTATION_WEIGHT, REST,
@@ -117,7 +116,10 @@ class Task:
         self.tip = hg - SCOOP_PRESS
         self.cone_frac = {"pickup": 1.0, "flip": max(RELEASE_FRACTION, tg.FLIP_CONE_FRACTION)}
         self.release = int(np.ceil(RELEASE_FRACTION * (n - 1) - 1e-9))
-        self.mu = SegmentOptions().cone_mu(cell.burger.mu, True)  # the collocation's cone
+        # The nominal μ × MU_SAFETY, not collocation's MU_PLAN: with the 0.16 cone the SCP
+        # finds no feasible chain at the tests' location (scp_violation 0.6), so the baseline
+        # keeps the cone it was compared with.
+        self.mu = cell.burger.mu * MU_SAFETY
         self.g = np.asarray(cell.gravity, float)
 
     def cone_idx(self, n: int) -> np.ndarray:
