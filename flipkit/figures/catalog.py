@@ -13,5 +13,6 @@ FIGURES = {  # figure id -> notebook that makes it, in the report's order
     "solve_times": "solve_times.ipynb", "cone_forms": "cone_forms.ipynb",
     "landing": "landing.ipynb", "filmstrip": "landing.ipynb",
     "sensitivity": "sensitivity.ipynb", "schedule": "schedule.ipynb",
+    "throughput": "throughput.ipynb",
 }
 FIGURE_IDS = tuple(FIGURES)

@@ -1,16 +1,18 @@
 """The cook as a Gantt chart: the arm's motions, when each was planned, and every burger's
-cook states against its 90 s and 150 s marks (figure ``schedule``)."""
+cook states against its 90 s and 150 s marks; and each event's deviation from its mark
+under two schedules of the same cook, against its window (figure ``schedule``)."""
 
 from __future__ import annotations
 
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 
 from flipkit.figures.style import BURGER_COLOR, COLORS
 
 MOTION_COLORS = {"flip": COLORS[0], "serve": COLORS[2]}
 SIDE_COLORS = ("#E8C9A8", BURGER_COLOR)  # first side (raw), second side
 PLAN_COLOR = "0.55"
+WINDOW_COLOR = "0.82"  # an event's window, behind its deviations
 
 
 def plot_schedule(ax, timeline: dict, title: str = "") -> dict:
@@ -76,4 +78,50 @@ def plot_schedule(ax, timeline: dict, title: str = "") -> dict:
     return {"n_burgers": len(burgers), "n_motions": len(motions), "t_end_s": float(t_end)}
 
 
-__all__ = ["MOTION_COLORS", "plot_schedule"]
+def plot_deviations(ax, timelines: dict) -> dict:
+    """Each event's deviation from its mark (s) under several schedules of one cook.
+
+    Args:
+        timelines: Label → timeline JSON (``flipkit schedule --json``, as a dict), the same
+            burgers in each; the first's ``windows`` are drawn as grey bands.
+
+    Returns:
+        ``{"max_deviation_s": {label: s}, "n_outside": {label: events beyond their
+        windows}}`` (1 ms tolerance).
+    """
+    labels = list(timelines)
+    first = timelines[labels[0]]
+    windows = first["windows"]
+    events = [(b["burger"], e) for b in first["burgers"] for e in ("flip", "serve")
+              if b["deviation_s"][e] is not None]
+    x = list(range(len(events)))
+    width = 0.8 / len(labels)
+    for k, (burger, event) in enumerate(events):
+        early, late = windows[event]
+        ax.add_patch(Rectangle((k - 0.45, -early), 0.9, early + late, facecolor=WINDOW_COLOR,
+                               lw=0, zorder=0))
+    out = {"max_deviation_s": {}, "n_outside": {}}
+    for j, label in enumerate(labels):
+        dev = {b["burger"]: b["deviation_s"] for b in timelines[label]["burgers"]}
+        ys = [dev[burger][event] for burger, event in events]
+        ax.bar([k - 0.4 + width * (j + 0.5) for k in x], ys, width, label=label,
+               color=COLORS[j % len(COLORS)], zorder=2)
+        out["max_deviation_s"][label] = max(abs(v) for v in ys)
+        out["n_outside"][label] = sum(v > windows[e][1] + 1e-3 or v < -windows[e][0] - 1e-3
+                                      for v, (_, e) in zip(ys, events))
+    ax.axhline(0, color="black", lw=0.6)
+    ax.set_xticks(x, [f"{b}\n{e}" for b, e in events])
+    ax.set_xlim(-0.6, len(events) - 0.4)
+    low = min([0.0] + [-windows[e][0] for e in ("flip", "serve")]
+              + [min(0.0, *(d for b in t["burgers"] for d in b["deviation_s"].values()
+                            if d is not None)) for t in timelines.values()])
+    high = max([windows[e][1] for e in ("flip", "serve")] + list(out["max_deviation_s"].values()))
+    ax.set_ylim(low - 0.1 * (high - low), high + 0.45 * (high - low))  # room for the legend
+    ax.set_ylabel("deviation from mark (s)")
+    handles, names = ax.get_legend_handles_labels()
+    ax.legend(handles + [Patch(facecolor=WINDOW_COLOR, label="window")], names + ["window"],
+              loc="upper left", ncol=len(labels) + 1)
+    return out
+
+
+__all__ = ["MOTION_COLORS", "plot_deviations", "plot_schedule"]

@@ -25,7 +25,8 @@ previous solution as a hint (the first hint: :func:`edf_hint`, the greedy rule):
   windows allowed, and first (``relax="max"``, a cook) (A) the largest excess — how much
   the worst event must break its window at the least — then the number of burgers beyond
   their windows, B and C; or (``relax="count"``, a stream) the number of burgers beyond
-  their windows first, then A, B and C. Several events often share the least largest
+  their windows first, then A, B and C (the first pair in one solve, as a weighted sum
+  that keeps the order). Several events often share the least largest
   excess; the one named (:class:`~flipkit.planning.kitchen.windows.WindowBreak`) is a late
   one of the last burger among them.
 
@@ -141,7 +142,7 @@ class _Model:
             for kind, t in (("flip", j.flip), ("serve", j.serve)):
                 if t is not None:
                     s = m.NewIntVar(max(_ms(j.t_drop), floor), horizon, f"{kind}_{k}")
-                    dur = int(math.ceil(t.duration_s * MS - 1e-6))
+                    dur = _dur_ms(t)
                     intervals.append(m.NewFixedSizeIntervalVar(s, dur, f"{kind}_{k}_iv"))
                     self.starts[kind, k] = (s, dur, _ms(t.event_s))
             f, fdur, fev = self.starts["flip", k]
@@ -171,6 +172,11 @@ class _Model:
             for k, _, x, _ in self.events:
                 m.Add(x == 0).OnlyEnforceIf(late_b[k].Not())
             self.n_late = sum(late_b)
+        # the relaxed first stage, one lexicographic pair as one weighted sum (a solve stopped
+        # by the time limit still presses on the second): "max" the largest excess, then the
+        # burgers beyond; "count" the other way round
+        self.excess_first = self.max_x * (len(jobs) + 1) + self.n_late
+        self.count_first = self.n_late * (horizon + 1) + self.max_x
         abs_d = []
         for _, _, _, d in self.events:
             a = m.NewIntVar(0, horizon, "")
@@ -180,28 +186,57 @@ class _Model:
         self.total = sum(abs_d)
 
     def hint(self, values: dict) -> None:
+        """Hint the starts only (ms by ``(kind, k)``)."""
         self.m.ClearHints()
         for key, (s, _, _) in self.starts.items():
             self.m.AddHint(s, values[key])
 
+    def variables(self) -> list:
+        return [self.m.GetIntVarFromProtoIndex(i) for i in range(len(self.m.Proto().variables))]
+
+    def snapshot(self, solver) -> list:
+        """Every variable's value in ``solver``'s last solution."""
+        return [solver.Value(v) for v in self.variables()]
+
+    def hint_all(self, full: list) -> None:
+        """Hint every variable: a complete solution (of an earlier stage)."""
+        self.m.ClearHints()
+        for v, value in zip(self.variables(), full):
+            self.m.AddHint(v, value)
+
+    def read(self, full: list, windows: Windows) -> tuple[dict, list]:
+        """The starts (ms by ``(kind, k)``) and the events ``(k, event, excess, deviation)``
+        (ms) of the solution ``full``."""
+        starts = {key: full[s.Index()] for key, (s, _, _) in self.starts.items()}
+        events = [(k, e, _excess(windows, e, full[d.Index()]), full[d.Index()])
+                  for k, e, _, d in self.events]  # x is only bounded below: from d
+        return starts, events
+
+
+def _dur_ms(t: MotionTimes) -> int:
+    return int(math.ceil(t.duration_s * MS - 1e-6))  # rounded up: no overlap in seconds
+
 
 def edf_hint(jobs, dwell_s: float, earliest_s: float = -math.inf) -> dict:
     """Starts (ms) by earliest deadline first, none before its mark (the greedy rule of
-    :mod:`~flipkit.planning.kitchen.schedule` on given times): CP-SAT's first solution."""
+    :mod:`~flipkit.planning.kitchen.schedule` on given times), on the model's integer times
+    so that it is one of the model's solutions: CP-SAT's first."""
     out, ends, free = {}, {}, -math.inf
-    pending = [(j.t_drop + FIRST_SIDE_S, k, "flip") for k, j in enumerate(jobs)]
+    floor = _ms(earliest_s) if math.isfinite(earliest_s) else 0
+    pending = [(_ms(j.t_drop + FIRST_SIDE_S), k, "flip") for k, j in enumerate(jobs)]
     while pending:
         pending.sort()
         due, k, kind = pending.pop(0)
         j = jobs[k]
         t = j.flip if kind == "flip" else j.serve
-        start = max(free, due - t.event_s, j.t_drop, earliest_s)
+        ev = _ms(t.event_s)
+        start = max(free, due - ev, _ms(j.t_drop), floor)
         if kind == "serve" and j.previous in ends:
-            start = max(start, ends[j.previous] + dwell_s - t.event_s)
-        out[kind, k] = _ms(start)
-        free = start + t.duration_s
+            start = max(start, ends[j.previous] + _ms(dwell_s) - ev)
+        out[kind, k] = start
+        free = start + _dur_ms(t)
         if kind == "flip" and j.serve is not None:
-            pending.append((start + t.event_s + SECOND_SIDE_S, k, "serve"))
+            pending.append((start + ev + _ms(SECOND_SIDE_S), k, "serve"))
         elif kind == "serve":
             ends[k] = free
     return out
@@ -255,6 +290,19 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
         time.perf_counter() - t0, answer["proved_infeasible"], answer["solve_s"])
 
 
+def _fixed(solver, model: "_Model", limit_s: float, cp) -> list | None:
+    """``model``'s hint, completed to a whole solution (every variable) with the hinted ones
+    fixed, or ``None`` when it is no solution (or that took longer than ``limit_s``); the
+    solver then holds it."""
+    solver.parameters.fix_variables_to_their_hinted_value = True
+    solver.parameters.max_time_in_seconds = limit_s
+    try:
+        code = solver.Solve(model.m)
+    finally:
+        solver.parameters.fix_variables_to_their_hinted_value = False
+    return model.snapshot(solver) if code in (cp.OPTIMAL, cp.FEASIBLE) else None
+
+
 def _check(jobs, relax: str) -> None:
     if relax not in RELAX:
         raise InvalidChoiceError("relaxed objective", relax, RELAX)
@@ -280,25 +328,35 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
     solver.parameters.random_seed = int(seed)
     t0, proved, last = time.perf_counter(), True, edf_hint(jobs, dwell_s, earliest_s)
     found = infeasible = False
+
+    def remaining() -> float:
+        return max(0.05, time_limit_s - (time.perf_counter() - t0))
+
     for hard in (True, False):
         model = _Model(cp, jobs, windows, dwell_s, earliest_s, hard)
         stages = ((model.max_d, model.total) if hard else
-                  (model.max_x, model.n_late, model.max_d, model.total) if relax == "max" else
-                  (model.n_late, model.max_x, model.max_d, model.total))
+                  (model.excess_first if relax == "max" else model.count_first,
+                   model.max_d, model.total))
+        full = None  # a complete solution of this model, every variable's value
         for objective in stages:
-            solver.parameters.max_time_in_seconds = max(
-                0.05, time_limit_s - (time.perf_counter() - t0))
-            model.hint(last)
             model.m.Minimize(objective)
+            if full is None:  # complete the hinted starts (a partial hint can be lost)
+                model.hint(last)
+                full = _fixed(solver, model, min(remaining(), 2.0), cp)
+            if full is not None:
+                model.hint_all(full)
+            solver.parameters.max_time_in_seconds = remaining()
             code = solver.Solve(model.m)
             infeasible = infeasible or (hard and code == cp.INFEASIBLE)
-            if code not in (cp.OPTIMAL, cp.FEASIBLE):
+            if code in (cp.OPTIMAL, cp.FEASIBLE):
+                full = model.snapshot(solver)
+            elif full is None:
                 proved = proved and found  # a later stage stopped: keep what was found
                 break
+            else:  # stopped without a better one: the hint's solution, evaluated
+                _fixed(solver, model, 2.0, cp)
             found, proved = True, proved and code == cp.OPTIMAL
-            last = {key: solver.Value(v[0]) for key, v in model.starts.items()}
-            events = [(k, e, _excess(windows, e, solver.Value(d)), solver.Value(d))
-                      for k, e, _, d in model.events]  # x is only bounded below: from d
+            last, events = model.read(full, windows)
             model.m.Add(objective <= int(solver.Value(objective)))
         if found:
             break

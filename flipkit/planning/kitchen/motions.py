@@ -159,5 +159,24 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
     return out
 
 
+def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPlanner]:
+    """``planners`` that plan each distinct motion once: a request with the same kind, burger,
+    location, table spot and start configuration (to 1e-9) returns the first plan (the same
+    object, its planning time included), so two schedules of one cook — the greedy rule and
+    CP-SAT — compare on the same plans."""
+    done: dict[tuple, PlannedMotion] = {}
+
+    def maker(kind: str) -> MotionPlanner:
+        def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
+            key = (kind, job.burger, tuple(np.round(job.location, 9)),
+                   None if job.table_spot is None else tuple(np.round(job.table_spot, 9)),
+                   tuple(np.round(np.asarray(q_start, float), 9)))
+            if key not in done:
+                done[key] = planners[kind](job, q_start)
+            return done[key]
+        return plan
+    return {kind: maker(kind) for kind in planners}
+
+
 __all__ = ["KINDS", "MissingPlannerError", "MotionJob", "MotionPlanner", "PlannedMotion",
-           "default_planners", "flip_planner", "from_plan", "serve_planner"]
+           "cached_planners", "default_planners", "flip_planner", "from_plan", "serve_planner"]
