@@ -81,15 +81,19 @@ def plot_throughput(ax, rows, claims=PUBLISHED_CLAIMS) -> dict:
             full = min(refused)
             out["grill_full_per_h"] = (full if out["grill_full_per_h"] is None
                                        else min(full, out["grill_full_per_h"]))
-    for k, c in enumerate(claims, 1):
+    rank = {k: n for n, k in enumerate(sorted(range(len(claims)),
+                                              key=lambda k: claims[k]["per_hour"]))}
+    for k, c in enumerate(claims, 1):  # labels by value, alternately left and right
         ax.axhline(c["per_hour"], color="0.35", lw=0.7, ls=":")
-        ax.annotate(f"[{k}] {c['label']}", (0.01, c["per_hour"]), xycoords=("axes fraction",
-                    "data"), fontsize=6, va="bottom", color="0.25")
+        left = rank[k - 1] % 2 == 0
+        ax.annotate(f"[{k}] {c['label']}", (0.01 if left else 0.99, c["per_hour"]),
+                    xycoords=("axes fraction", "data"), fontsize=6, va="bottom",
+                    ha="left" if left else "right", color="0.25")
     ax.set_xlabel("drop rate (burgers per hour)")
     ax.set_ylabel("served within windows (per hour)")
     ax.set_xlim(0, max(rates) * 1.02)
     ax.set_ylim(0, max([max(rates)] + [c["per_hour"] for c in claims]) * 1.08)
-    ax.legend(loc="lower right")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
     return out
 
 
@@ -115,7 +119,7 @@ def plot_lateness(ax, rows, late_s: float | None = None) -> dict:
     ax.set_ylim(bottom=0)
     ax.set_xlabel("drop rate (burgers per hour)")
     ax.set_ylabel("largest lateness (s)")
-    ax.legend(loc="upper left")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
     return out
 
 
