@@ -14,7 +14,8 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.planning.kitchen import motions
 from flipkit.planning.kitchen.cook import EXAMPLE_ORDER, CookBurger, read_cook_csv
-from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes, edf_hint, solve_schedule
+from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes, edf_hint
+from flipkit.planning.kitchen.cpsat_process import solve_schedule
 from flipkit.planning.kitchen.motions import PlannedMotion
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.schedule import schedule_cook
@@ -251,7 +252,7 @@ def test_cli_refuses_a_cook_that_breaks_its_windows_in_one_line(policy, excess, 
                      "--no-progress", "--policy", policy])
     err = capsys.readouterr().err.strip()
     assert code == 1 and "\n" not in err and err.startswith(f"flipkit: error: {policy}: ")
-    assert f"burger b5: its serve" in err and f"{excess} s beyond its window" in err
+    assert "burger b5: its serve" in err and f"{excess} s beyond its window" in err
     assert not out.exists() and not (tmp_path / "t_plans").exists()  # nothing written
 
 
@@ -269,3 +270,20 @@ def test_cpsat_runs_in_its_own_process_beside_cvxpy():
     assert result.solve_s < result.wall_s  # the child's start-up counted in wall_s
     assert "ortools.sat.python.cp_model" not in sys.modules
     assert "HIGHS" in cvxpy.installed_solvers()
+
+
+@pytest.mark.slow
+def test_cli_cpsat_with_the_real_flip_planner(tmp_path, capsys):
+    """One real flip, planned in a worker, scheduled by CP-SAT in its child process: on its
+    mark to the model's rounding (never early, at most 2 ms late), its plan written."""
+    path = tmp_path / "order.csv"
+    path.write_text("burger,t_drop,x,y\nb1,0,0.69,-0.16\n")
+    out = tmp_path / "t.json"
+    code = cli.main(["schedule", str(path), "--json", str(out), "--flip-only", "--no-progress",
+                     "--workers", "2"])
+    assert code == 0, capsys.readouterr().err
+    doc = json.loads(out.read_text())
+    (m,), (b,) = doc["motions"], doc["burgers"]
+    assert doc["solver"]["status"] == "optimal" and m["status"] == "solved"
+    assert 0.0 <= b["deviation_s"]["flip"] <= 2e-3
+    assert (tmp_path / m["plan"]).is_file()

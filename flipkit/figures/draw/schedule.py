@@ -87,7 +87,7 @@ def plot_deviations(ax, timelines: dict) -> dict:
 
     Returns:
         ``{"max_deviation_s": {label: s}, "n_outside": {label: events beyond their
-        windows}}`` (1 ms tolerance).
+        windows}}`` (2 ms tolerance, the optimiser's rounding).
     """
     labels = list(timelines)
     first = timelines[labels[0]]
@@ -107,7 +107,7 @@ def plot_deviations(ax, timelines: dict) -> dict:
         ax.bar([k - 0.4 + width * (j + 0.5) for k in x], ys, width, label=label,
                color=COLORS[j % len(COLORS)], zorder=2)
         out["max_deviation_s"][label] = max(abs(v) for v in ys)
-        out["n_outside"][label] = sum(v > windows[e][1] + 1e-3 or v < -windows[e][0] - 1e-3
+        out["n_outside"][label] = sum(v > windows[e][1] + 2e-3 or v < -windows[e][0] - 2e-3
                                       for v, (_, e) in zip(ys, events))
     ax.axhline(0, color="black", lw=0.6)
     ax.set_xticks(x, [f"{b}\n{e}" for b, e in events])

@@ -4,7 +4,9 @@ that keep every event closest to its mark, solved with OR-Tools CP-SAT.
 Every motion starts and ends at rest at the same configuration (q_home), so its duration
 and the time from its start to its burger event do not depend on the motions before it;
 they are given (:class:`MotionTimes`, from the motions' plans or a model of them). Time is
-integer, in ms. Per burger k with drop ``t_k``:
+integer, in ms, rounded so that the schedule in seconds is never worse on the safe side:
+durations and marks up, event times down (no overlap, no event early; an event may come up
+to 2 ms later than the model has it). Per burger k with drop ``t_k``:
 
 * variables: the start of its flip ``f_k`` and of its serve ``s_k``, each an interval of
   the motion's duration; one ``NoOverlap`` over all intervals (one arm);
@@ -34,22 +36,16 @@ One worker and a fixed seed make the result deterministic when every stage is pr
 optimal within the time limit; a stage stopped by the limit keeps its best solution, and
 the status says ``feasible`` instead of ``optimal``.
 
-CP-SAT runs in a child process (``python -m flipkit.planning.kitchen.cpsat``, the problem
-and the answer as JSON on its standard streams; :func:`solve_schedule`), never in the
-caller's: the OR-Tools wheel ships its own ``libhighs.so.1``, older than the one of
-``highspy`` (which cvxpy imports), and one process cannot load both (whichever comes second
-fails to load: google/or-tools issue #5246). The planners load cvxpy; the child loads only
-OR-Tools. :func:`solve_here` is the solve itself, given the ``cp_model`` module.
+:func:`solve_here` solves in the calling process, given OR-Tools' ``cp_model`` module;
+:func:`~flipkit.planning.kitchen.cpsat_process.solve_schedule` runs it in a child process, as
+every caller in the package does.
 """
 
 from __future__ import annotations
 
-import json
 import math
-import subprocess
-import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 from flipkit.errors import FlipkitError, InvalidChoiceError
 from flipkit.planning.kitchen.cook import FIRST_SIDE_S, SECOND_SIDE_S
@@ -59,15 +55,8 @@ MS = 1000  # model time units per s
 RELAX = ("max", "count")  # the first objective when the windows cannot be met
 
 
-CHILD_MARGIN_S = 60.0  # s the child process may take beyond the time limit (start-up)
-
-
 class ScheduleTimeoutError(FlipkitError):
     """CP-SAT found no schedule at all within its time limit."""
-
-
-class CpSatProcessError(FlipkitError):
-    """The CP-SAT child process failed (its last error line) or did not answer in time."""
 
 
 @dataclass(frozen=True)
@@ -105,8 +94,7 @@ class CpSatSchedule:
         status: ``"optimal"`` (every stage proved) or ``"feasible"`` (a stage hit the limit).
         max_excess_s, max_deviation_s, total_deviation_s: The three objectives (s).
         breach: The event furthest beyond its window when ``max_excess_s`` > 0, else ``None``.
-        wall_s: Wall time (s), all stages (with :func:`solve_schedule`: and the child
-            process's start).
+        wall_s: Wall time (s), all stages (from a child process: its start too).
         proved_infeasible: CP-SAT proved that no schedule keeps every event in its window
             (``False`` when the windows are met, or when it ran out of time deciding).
     """
@@ -126,6 +114,14 @@ def _ms(seconds: float) -> int:
     return int(round(seconds * MS))
 
 
+def _up(seconds: float) -> int:
+    return int(math.ceil(seconds * MS - 1e-6))
+
+
+def _down(seconds: float) -> int:
+    return int(math.floor(seconds * MS + 1e-6))
+
+
 class _Model:
     """The CP-SAT model of ``jobs`` (``cp``: OR-Tools' ``cp_model`` module); ``hard``: every
     deviation within its window, else lateness beyond it is allowed (the excess variables)."""
@@ -137,20 +133,20 @@ class _Model:
         horizon = _ms(max(j.t_drop for j in jobs) + FIRST_SIDE_S + SECOND_SIDE_S + work
                       + dwell_s * (1 + len(jobs)) + 120.0)
         self.starts, self.events, intervals = {}, [], []
-        floor = _ms(earliest_s) if math.isfinite(earliest_s) else 0
+        floor = _up(earliest_s) if math.isfinite(earliest_s) else 0
         for k, j in enumerate(jobs):
             for kind, t in (("flip", j.flip), ("serve", j.serve)):
                 if t is not None:
-                    s = m.NewIntVar(max(_ms(j.t_drop), floor), horizon, f"{kind}_{k}")
-                    dur = _dur_ms(t)
+                    s = m.NewIntVar(max(_up(j.t_drop), floor), horizon, f"{kind}_{k}")
+                    dur = _up(t.duration_s)
                     intervals.append(m.NewFixedSizeIntervalVar(s, dur, f"{kind}_{k}_iv"))
-                    self.starts[kind, k] = (s, dur, _ms(t.event_s))
+                    self.starts[kind, k] = (s, dur, _down(t.event_s))
             f, fdur, fev = self.starts["flip", k]
-            devs = {"flip": f + fev - _ms(j.t_drop + FIRST_SIDE_S)}
+            devs = {"flip": f + fev - _up(j.t_drop + FIRST_SIDE_S)}
             if j.serve is not None:
                 s, _, sev = self.starts["serve", k]
                 m.Add(s >= f + fdur)
-                devs["serve"] = s + sev - f - fev - _ms(SECOND_SIDE_S)
+                devs["serve"] = s + sev - f - _up(j.flip.event_s) - _ms(SECOND_SIDE_S)
             for event, dev in devs.items():
                 early, late = (_ms(v) for v in windows.of(event))  # never early beyond it
                 d = m.NewIntVar(-early, late if hard else horizon, f"d_{event}_{k}")
@@ -161,7 +157,7 @@ class _Model:
             prev = j.previous
             if j.serve is not None and prev is not None and ("serve", prev) in self.starts:
                 p, pdur, _ = self.starts["serve", prev]
-                m.Add(s + sev >= p + pdur + _ms(dwell_s))
+                m.Add(s + sev >= p + pdur + _up(dwell_s))
         m.AddNoOverlap(intervals)
         self.max_x = m.NewIntVar(0, horizon, "max_x")
         self.max_d = m.NewIntVar(0, horizon, "max_d")
@@ -213,81 +209,29 @@ class _Model:
         return starts, events
 
 
-def _dur_ms(t: MotionTimes) -> int:
-    return int(math.ceil(t.duration_s * MS - 1e-6))  # rounded up: no overlap in seconds
-
-
 def edf_hint(jobs, dwell_s: float, earliest_s: float = -math.inf) -> dict:
     """Starts (ms) by earliest deadline first, none before its mark (the greedy rule of
     :mod:`~flipkit.planning.kitchen.schedule` on given times), on the model's integer times
     so that it is one of the model's solutions: CP-SAT's first."""
     out, ends, free = {}, {}, -math.inf
-    floor = _ms(earliest_s) if math.isfinite(earliest_s) else 0
-    pending = [(_ms(j.t_drop + FIRST_SIDE_S), k, "flip") for k, j in enumerate(jobs)]
+    floor = _up(earliest_s) if math.isfinite(earliest_s) else 0
+    pending = [(_up(j.t_drop + FIRST_SIDE_S), k, "flip") for k, j in enumerate(jobs)]
     while pending:
         pending.sort()
         due, k, kind = pending.pop(0)
         j = jobs[k]
         t = j.flip if kind == "flip" else j.serve
-        ev = _ms(t.event_s)
-        start = max(free, due - ev, _ms(j.t_drop), floor)
+        ev = _down(t.event_s)
+        start = max(free, due - ev, _up(j.t_drop), floor)
         if kind == "serve" and j.previous in ends:
-            start = max(start, ends[j.previous] + _ms(dwell_s) - ev)
+            start = max(start, ends[j.previous] + _up(dwell_s) - ev)
         out[kind, k] = start
-        free = start + _dur_ms(t)
+        free = start + _up(t.duration_s)
         if kind == "flip" and j.serve is not None:
-            pending.append((start + ev + _ms(SECOND_SIDE_S), k, "serve"))
+            pending.append((start + _up(t.event_s) + _ms(SECOND_SIDE_S), k, "serve"))
         elif kind == "serve":
             ends[k] = free
     return out
-
-
-def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
-                   earliest_s: float = -math.inf, time_limit_s: float = 10.0,
-                   workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
-    """Order and time the motions of ``jobs`` (:class:`BurgerJob`, any order) with CP-SAT in
-    a child process (module docstring); :func:`solve_here` says how.
-
-    Args:
-        windows: Event windows. dwell_s: Table dwell (s). earliest_s: No motion before (s).
-        time_limit_s: Wall-time limit for all solves together (s).
-        workers: CP-SAT search workers. seed: CP-SAT random seed.
-        relax: The first objective when the windows cannot be met: "max" or "count".
-
-    Returns:
-        The schedule; ``wall_s`` counts the child process's start too.
-
-    Raises:
-        ScheduleTimeoutError: No schedule found within ``time_limit_s``.
-        CpSatProcessError: The child process failed or hung.
-        InvalidChoiceError: An unknown ``relax``. FlipkitError: No jobs.
-    """
-    jobs = list(jobs)
-    _check(jobs, relax)
-    problem = {"jobs": [asdict(j) for j in jobs], "windows": windows.to_dict(),
-               "dwell_s": dwell_s, "earliest_s": earliest_s if math.isfinite(earliest_s)
-               else None, "time_limit_s": time_limit_s, "workers": workers, "seed": seed,
-               "relax": relax}
-    t0 = time.perf_counter()
-    try:
-        run = subprocess.run([sys.executable, "-m", __name__], input=json.dumps(problem),
-                             capture_output=True, text=True,
-                             timeout=time_limit_s + CHILD_MARGIN_S)
-    except subprocess.TimeoutExpired:
-        raise CpSatProcessError(f"the CP-SAT process did not answer within "
-                                f"{time_limit_s + CHILD_MARGIN_S:g} s") from None
-    if run.returncode != 0:
-        last = (run.stderr.strip().splitlines() or ["no message"])[-1]
-        raise CpSatProcessError(f"the CP-SAT process failed (exit {run.returncode}): {last}")
-    answer = json.loads(run.stdout)
-    if "timeout" in answer:
-        raise ScheduleTimeoutError(answer["timeout"])
-    breach = answer["breach"]
-    return CpSatSchedule(
-        {(kind, k): start for kind, k, start in answer["starts"]}, answer["status"],
-        answer["max_excess_s"], answer["max_deviation_s"], answer["total_deviation_s"],
-        None if breach is None else WindowBreak(**{**breach, "window": tuple(breach["window"])}),
-        time.perf_counter() - t0, answer["proved_infeasible"], answer["solve_s"])
 
 
 def _fixed(solver, model: "_Model", limit_s: float, cp) -> list | None:
@@ -303,7 +247,8 @@ def _fixed(solver, model: "_Model", limit_s: float, cp) -> list | None:
     return model.snapshot(solver) if code in (cp.OPTIMAL, cp.FEASIBLE) else None
 
 
-def _check(jobs, relax: str) -> None:
+def check_jobs(jobs, relax: str) -> None:
+    """Refuse an unknown ``relax`` (:class:`~flipkit.errors.InvalidChoiceError`) or no jobs."""
     if relax not in RELAX:
         raise InvalidChoiceError("relaxed objective", relax, RELAX)
     if not jobs:
@@ -314,7 +259,15 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                earliest_s: float = -math.inf, time_limit_s: float = 10.0,
                workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
     """The solve, in this process, with ``cp`` OR-Tools' ``cp_model`` module (the child's
-    work; arguments as :func:`solve_schedule`).
+    work in :mod:`~flipkit.planning.kitchen.cpsat_process`).
+
+    Args:
+        cp: ``ortools.sat.python.cp_model``.
+        jobs: :class:`BurgerJob` rows, any order. windows: Event windows.
+        dwell_s: Table dwell (s). earliest_s: No motion before (s).
+        time_limit_s: Wall-time limit for all solves together (s).
+        workers: CP-SAT search workers. seed: CP-SAT random seed.
+        relax: The first objective when the windows cannot be met: "max" or "count".
 
     First with every event in its window (the stages B and C); when that is infeasible (or
     not decided within the limit), with lateness beyond the windows allowed (A, B, C). No
@@ -322,7 +275,7 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
     :func:`edf_hint`.
     """
     jobs = list(jobs)
-    _check(jobs, relax)
+    check_jobs(jobs, relax)
     solver = cp.CpSolver()
     solver.parameters.num_search_workers = int(workers)
     solver.parameters.random_seed = int(seed)
@@ -384,32 +337,5 @@ def _excess(windows: Windows, event: str, dev_ms: int) -> int:
     return max(0, dev_ms - late, -early - dev_ms)
 
 
-def answer(problem: dict, cp) -> dict:
-    """The child's answer (JSON-ready) to ``problem`` (the JSON :func:`solve_schedule` sends)."""
-    jobs = [BurgerJob(j["burger"], j["t_drop"], MotionTimes(**j["flip"]),
-                      None if j["serve"] is None else MotionTimes(**j["serve"]), j["previous"])
-            for j in problem["jobs"]]
-    earliest = problem["earliest_s"]
-    try:
-        r = solve_here(cp, jobs, Windows(**problem["windows"]), dwell_s=problem["dwell_s"],
-                       earliest_s=-math.inf if earliest is None else earliest,
-                       time_limit_s=problem["time_limit_s"], workers=problem["workers"],
-                       seed=problem["seed"], relax=problem["relax"])
-    except ScheduleTimeoutError as exc:
-        return {"timeout": str(exc)}
-    return {"starts": [[kind, k, v] for (kind, k), v in r.starts.items()],
-            "status": r.status, "max_excess_s": r.max_excess_s,
-            "max_deviation_s": r.max_deviation_s, "total_deviation_s": r.total_deviation_s,
-            "breach": None if r.breach is None else asdict(r.breach), "solve_s": r.wall_s,
-            "proved_infeasible": r.proved_infeasible}
-
-
-__all__ = ["CHILD_MARGIN_S", "MS", "RELAX", "BurgerJob", "CpSatProcessError", "CpSatSchedule",
-           "MotionTimes", "ScheduleTimeoutError", "answer", "edf_hint", "solve_here",
-           "solve_schedule"]
-
-
-if __name__ == "__main__":  # the child process: a problem on stdin, the answer on stdout
-    from ortools.sat.python import cp_model
-
-    json.dump(answer(json.load(sys.stdin), cp_model), sys.stdout)
+__all__ = ["MS", "RELAX", "BurgerJob", "CpSatSchedule", "MotionTimes", "ScheduleTimeoutError",
+           "check_jobs", "edf_hint", "solve_here"]

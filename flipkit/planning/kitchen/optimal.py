@@ -26,7 +26,8 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.kitchen.cook import SECOND_SIDE_S, check_cook, table_spots
-from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes, solve_schedule
+from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes
+from flipkit.planning.kitchen.cpsat_process import solve_schedule
 from flipkit.planning.kitchen.motions import KINDS, MissingPlannerError, MotionJob, MotionPlanner
 from flipkit.planning.kitchen.schedule import BurgerRecord, MotionRecord, Timeline
 from flipkit.planning.kitchen.table import DWELL_S, assign_spots
@@ -48,7 +49,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
         burgers, planners, q_start, kinds, cell, spots, plan_start: As
             :func:`~flipkit.planning.kitchen.schedule.schedule_cook`.
         windows: The event windows. dwell_s: Table dwell (s).
-        time_limit_s, workers, seed, relax: As :func:`~flipkit.planning.kitchen.cpsat.solve_schedule`.
+        time_limit_s, workers, seed, relax: As
+            :func:`~flipkit.planning.kitchen.cpsat_process.solve_schedule`.
 
     Returns:
         The timeline (``policy`` :data:`CPSAT`; ``solver``: status, objectives, wall time).

@@ -2,7 +2,8 @@
 utilisation and the largest lateness; and a sweep of drop rates for the ``throughput`` figure.
 
 * **Burgers per hour within windows**: the drop rate times the share of burgers whose flip
-  and serve both lie within their windows (to 1 ms); the drop rate when all do.
+  and serve both lie within their windows (to 2 ms, the optimiser's rounding); the drop
+  rate when all do.
 * **Utilisation**: the arm's motion time over the span from its first motion's start to
   its last motion's end.
 * **Largest lateness**: the largest deviation of an event past its mark (s, ≥ 0): a flip's
@@ -66,7 +67,7 @@ def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: f
     for b in timeline.burgers:
         dev = event_deviations(b)
         done = all(dev[k] is not None for k in timeline.kinds)
-        within += done and all(w.excess(k, dev[k]) <= 1e-3 for k in timeline.kinds)
+        within += done and all(w.excess(k, dev[k]) <= 2e-3 for k in timeline.kinds)
         late = max([late] + [v for v in dev.values() if v is not None])
     ran = [m for m in timeline.motions if m.ok]
     span = max(m.end for m in ran) - min(m.start for m in ran) if ran else 0.0

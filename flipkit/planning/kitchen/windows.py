@@ -147,9 +147,9 @@ class WindowBreak:
                 f"+{self.window[1]:g}] s{also}")
 
 
-def worst_break(records, windows: Windows, tol: float = 1e-3) -> WindowBreak | None:
+def worst_break(records, windows: Windows, tol: float = 2e-3) -> WindowBreak | None:
     """The event of ``records`` (burger records, :func:`event_deviations`) furthest outside
-    its window, by more than ``tol`` s (default 1 ms, the optimiser's resolution); ``None``
+    its window, by more than ``tol`` s (default 2 ms, the optimiser's rounding); ``None``
     when every event done is in its window. Among events as far outside (within ``tol``),
     a late one of the last burger in ``records``, its serve before its flip."""
     found = []
