@@ -25,12 +25,13 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.planning.kitchen.cook import SECOND_SIDE_S, check_cook, table_spots
+from flipkit.planning.kitchen.cook import SECOND_SIDE_S
 from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes
 from flipkit.planning.kitchen.cpsat_process import solve_schedule
-from flipkit.planning.kitchen.motions import KINDS, MissingPlannerError, MotionJob, MotionPlanner
-from flipkit.planning.kitchen.schedule import BurgerRecord, MotionRecord, Timeline
-from flipkit.planning.kitchen.table import DWELL_S, assign_spots
+from flipkit.planning.kitchen.motions import KINDS, MotionJob, MotionPlanner
+from flipkit.planning.kitchen.schedule import (BurgerRecord, MotionRecord, Timeline,
+                                              check_cook_inputs)
+from flipkit.planning.kitchen.table import DWELL_S
 from flipkit.planning.kitchen.windows import Windows
 from flipkit.planning.planners.planner import REST_TOL
 
@@ -63,17 +64,9 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             that does not end at rest at ``q_start``.
         ScheduleTimeoutError: CP-SAT found no schedule within the time limit.
     """
-    cell = cell or CellConfig()
-    kinds = tuple(kinds)
-    if "flip" not in kinds or not set(kinds) <= set(KINDS):
-        raise ConfigError(f"kinds must be ('flip',) or ('flip', 'serve'), got {kinds}")
-    for kind in kinds:
-        if kind not in planners:
-            raise MissingPlannerError(f"no planner given for the {kind!r} motions")
-    order = check_cook(burgers, cell)
-    spots = list(table_spots(cell) if spots is None else spots)
+    cell, kinds, order, spots, assigned = check_cook_inputs(burgers, planners, kinds, cell,
+                                                            spots, dwell_s)
     serve = "serve" in kinds
-    assigned = {a.burger: a for a in assign_spots(order, spots, dwell_s)} if serve else {}
     q0 = np.asarray(q_start, float)
     t0 = min(b.t_drop for b in order) if plan_start is None else float(plan_start)
     if not np.isfinite(t0):

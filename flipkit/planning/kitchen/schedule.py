@@ -192,6 +192,30 @@ class Timeline:
         }
 
 
+def check_cook_inputs(burgers, planners, kinds, cell, spots, dwell_s):
+    """The checks both policies make before they plan: ``(cell, kinds, order, spots,
+    assigned)`` — the cell (default :class:`~flipkit.config.CellConfig`), the kinds as a
+    tuple, the checked cook order, the table spots and each burger's assigned spot (empty
+    without serves).
+
+    Raises:
+        ConfigError: Bad kinds. MissingPlannerError: A kind without a planner.
+        CookOrderError: A malformed order.
+    """
+    cell = cell or CellConfig()
+    kinds = tuple(kinds)
+    if "flip" not in kinds or not set(kinds) <= set(KINDS):
+        raise ConfigError(f"kinds must be ('flip',) or ('flip', 'serve'), got {kinds}")
+    for kind in kinds:
+        if kind not in planners:
+            raise MissingPlannerError(f"no planner given for the {kind!r} motions")
+    order = check_cook(burgers, cell)
+    spots = list(table_spots(cell) if spots is None else spots)
+    assigned = ({a.burger: a for a in assign_spots(order, spots, dwell_s)}
+                if "serve" in kinds else {})
+    return cell, kinds, order, spots, assigned
+
+
 def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
                   kinds=KINDS, cell: CellConfig | None = None, spots=None,
                   plan_start: float | None = None, progress: bool = False,
@@ -223,17 +247,8 @@ def schedule_cook(burgers, planners: Mapping[str, MotionPlanner], q_start, *,
         MissingPlannerError: A kind in ``kinds`` without a planner.
         CookOrderError: A malformed order. ConfigError: Bad kinds, spots or times.
     """
-    cell = cell or CellConfig()
-    kinds = tuple(kinds)
-    if "flip" not in kinds or not set(kinds) <= set(KINDS):
-        raise ConfigError(f"kinds must be ('flip',) or ('flip', 'serve'), got {kinds}")
-    for kind in kinds:
-        if kind not in planners:
-            raise MissingPlannerError(f"no planner given for the {kind!r} motions")
-    order = check_cook(burgers, cell)
-    spots = list(table_spots(cell) if spots is None else spots)
-    assigned = {a.burger: a for a in assign_spots(order, spots, dwell_s)} if (
-        "serve" in kinds) else {}
+    cell, kinds, order, spots, assigned = check_cook_inputs(burgers, planners, kinds, cell,
+                                                            spots, dwell_s)
     serve_end: dict[str, float] = {}
     records = [BurgerRecord(b) for b in order]
     clock = min(b.t_drop for b in order) if plan_start is None else float(plan_start)
