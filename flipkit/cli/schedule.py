@@ -80,8 +80,9 @@ def register(subparsers) -> None:
                    help=f"s a served plate stays on the table before its spot is free "
                         f"again, in [0, 3600] (default {DWELL_S:g})")
     p.add_argument("--time-limit", type=float, default=10.0, metavar="S",
-                   help="CP-SAT's wall-time limit, s in (0, 3600] (default 10); one search "
-                        "worker and a fixed seed")
+                   help="CP-SAT's limit in its deterministic time (about seconds on one "
+                        "worker), in (0, 3600] (default 10); one search worker and a fixed "
+                        "seed: the same schedule on every run")
     p.add_argument("--stream", type=float, metavar="RATE",
                    help="instead of BURGERS.csv, a stream of drops: RATE burgers per hour, "
                         "evenly spaced from t = 0, each at a random free place on the grill")

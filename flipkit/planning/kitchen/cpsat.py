@@ -32,9 +32,10 @@ previous solution as a hint (the first hint: :func:`edf_hint`, the greedy rule):
   excess; the one named (:class:`~flipkit.planning.kitchen.windows.WindowBreak`) is a late
   one of the last burger among them.
 
-One worker and a fixed seed make the result deterministic when every stage is proved
-optimal within the time limit; a stage stopped by the limit keeps its best solution, and
-the status says ``feasible`` instead of ``optimal``.
+One worker, a fixed seed and a limit in CP-SAT's deterministic time (its count of work, about
+seconds on one worker; ``max_deterministic_time``) make the result the same on every run and
+machine, also when a stage is stopped by the limit: it keeps its best solution, and the
+status says ``feasible`` instead of ``optimal``.
 
 :func:`solve_here` solves in the calling process, given OR-Tools' ``cp_model`` module;
 :func:`~flipkit.planning.kitchen.cpsat_process.solve_schedule` runs it in a child process, as
@@ -239,7 +240,7 @@ def _fixed(solver, model: "_Model", limit_s: float, cp) -> list | None:
     fixed, or ``None`` when it is no solution (or that took longer than ``limit_s``); the
     solver then holds it."""
     solver.parameters.fix_variables_to_their_hinted_value = True
-    solver.parameters.max_time_in_seconds = limit_s
+    solver.parameters.max_deterministic_time = limit_s
     try:
         code = solver.Solve(model.m)
     finally:
@@ -265,7 +266,8 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
         cp: ``ortools.sat.python.cp_model``.
         jobs: :class:`BurgerJob` rows, any order. windows: Event windows.
         dwell_s: Table dwell (s). earliest_s: No motion before (s).
-        time_limit_s: Wall-time limit for all solves together (s).
+        time_limit_s: Limit for all solves together, in CP-SAT's deterministic time (about
+            seconds on one worker; the same work on every run).
         workers: CP-SAT search workers. seed: CP-SAT random seed.
         relax: The first objective when the windows cannot be met: "max" or "count".
 
@@ -282,8 +284,15 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
     t0, proved, last = time.perf_counter(), True, edf_hint(jobs, dwell_s, earliest_s)
     found = infeasible = False
 
+    used = [0.0]  # deterministic time spent so far
+
     def remaining() -> float:
-        return max(0.05, time_limit_s - (time.perf_counter() - t0))
+        return max(0.05, time_limit_s - used[0])
+
+    def solve(model_):
+        code_ = solver.Solve(model_.m)
+        used[0] += solver.ResponseProto().deterministic_time
+        return code_
 
     for hard in (True, False):
         model = _Model(cp, jobs, windows, dwell_s, earliest_s, hard)
@@ -298,8 +307,8 @@ def solve_here(cp, jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                 full = _fixed(solver, model, min(remaining(), 2.0), cp)
             if full is not None:
                 model.hint_all(full)
-            solver.parameters.max_time_in_seconds = remaining()
-            code = solver.Solve(model.m)
+            solver.parameters.max_deterministic_time = remaining()
+            code = solve(model)
             infeasible = infeasible or (hard and code == cp.INFEASIBLE)
             if code in (cp.OPTIMAL, cp.FEASIBLE):
                 full = model.snapshot(solver)
