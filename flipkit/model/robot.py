@@ -81,6 +81,7 @@ class Robot:
         self.model, self.data = model, model.createData()
         self.frame_id = model.getFrameId(SPATULA_FRAME)
         self.spatula_in_joint = in_joint
+        self._placements = {}
         self.nq = model.nq
         self._minus_identity = -np.eye(self.nq)  # ∂r/∂u, shared read-only
         self._minus_identity.setflags(write=False)
@@ -148,24 +149,32 @@ class Robot:
         pin.updateFramePlacements(m, d)
         J = pin.getFrameJacobian(m, d, self.frame_id, LWA)
         M = d.oMf[self.frame_id]
-        placement = self.spatula_in_joint
-        if point is not None:
-            placement = placement * pin.SE3(np.eye(3), np.asarray(point, dtype=float))
+        R, Jv, Jw = M.rotation.copy(), J[:3].copy(), J[3:].copy()
         v_dq, a_dq, a_dqd, a_dqdd = pin.getPointClassicAccelerationDerivatives(
-            m, d, self.joint_id, placement, LWA)
+            m, d, self.joint_id, self._point_placement(point), LWA)
         acc = pin.getFrameClassicalAcceleration(m, d, self.frame_id, LWA).linear
-        Jv, p, v = J[:3].copy(), M.translation.copy(), J[:3] @ qd
+        p, v = M.translation.copy(), Jv @ qd
         if point is not None:  # rigid-body transport from the blade centre to the point
-            r, w = M.rotation @ np.asarray(point, dtype=float), J[3:] @ qd
+            r, w = R @ np.asarray(point, dtype=float), Jw @ qd
             alpha = pin.getFrameAcceleration(m, d, self.frame_id, LWA).angular
             # [w]× products: np.cross costs ~35 µs a call, and the SQP asks for thousands
-            W = skew(w)
-            acc = acc + skew(alpha) @ r + W @ (W @ r)
-            Jv, p, v = Jv - skew(r) @ J[3:], p + r, v + W @ r
-        return SpatulaState(p=p, R=M.rotation.copy(), v=v, a=np.array(acc), dp_dq=Jv,
-                            Jw=J[3:].copy(), dv_dq=np.array(v_dq), dv_dqd=Jv.copy(),
-                            da_dq=np.array(a_dq), da_dqd=np.array(a_dqd),
-                            da_dqdd=np.array(a_dqdd))
+            W, Rx = skew(w), skew(r)
+            wr = W @ r
+            acc = acc + skew(alpha) @ r + W @ wr
+            Jv, p, v = Jv - Rx @ Jw, p + r, v + wr
+        return SpatulaState(p=p, R=R, v=v, a=np.array(acc), dp_dq=Jv, Jw=Jw, dv_dq=v_dq,
+                            dv_dqd=Jv.copy(), da_dq=a_dq, da_dqd=a_dqd, da_dqdd=a_dqdd)
+
+    def _point_placement(self, point) -> pin.SE3:
+        """The joint-frame placement of a blade point (spatula frame, m; None: the centre),
+        kept per point: the SQP asks for the same few points at every node."""
+        key = None if point is None else tuple(float(c) for c in point)
+        placement = self._placements.get(key)
+        if placement is None:
+            placement = self.spatula_in_joint if key is None else (
+                self.spatula_in_joint * pin.SE3(np.eye(3), np.array(key)))
+            self._placements[key] = placement
+        return placement
 
     def angular_velocity_jacobian(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """Spatula angular velocity ω = J_ω q̇ (world, rad/s) and ∂ω/∂q (3×nq); ∂ω/∂q̇ = J_ω.

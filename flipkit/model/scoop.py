@@ -34,7 +34,10 @@ from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.errors import ConfigError
 
-STEP_S = 2e-4  # s: integration step of the friction model
+# s: integration step of the friction model. Stick-slip transitions are resolved within a step,
+# so the step only sets how finely the blade's speed is sampled: over the Table I scoops and
+# μ_b 0.4-0.6, ±1 cm placements, 1 ms moves the outcome by at most 0.18 mm from 0.2 ms.
+STEP_S = 1e-3
 GRAVITY = 9.81  # m/s²
 
 
