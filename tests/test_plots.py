@@ -268,6 +268,21 @@ def test_solve_time_table_groups_rows():
     assert table["solved"] == {"sqp": [1, 2], "ipopt": [1, 1]}
 
 
+def test_solve_time_sweep_hands_out_ipopt_first_and_returns_location_major(monkeypatch):
+    calls = []
+
+    def fake(item):
+        calls.append((item["location"][0], item["solver"]))
+        return {"location": item["location"], "solver": item["solver"]}
+
+    monkeypatch.setattr(runs, "flip_solve_times", fake)
+    rows = runs.solve_time_sweep([(1, 0, 0), (2, 0, 0)], ("sqp", "ipopt"), workers=0)
+    assert calls == [(1.0, "ipopt"), (2.0, "ipopt"), (1.0, "sqp"), (2.0, "sqp")]
+    assert [(r["location"][0], r["solver"]) for r in rows] == [
+        (1.0, "sqp"), (1.0, "ipopt"), (2.0, "sqp"), (2.0, "ipopt")]
+    assert runs.solve_workers(1) == 1 and runs.solve_workers(100) >= 1
+
+
 def test_tracked_segment_errors():
     series = data.PlanSeries(np.array([0.0, 1.0, 2.0]), *(np.zeros((3, 6)),) * 4,
                              np.array([0, 0, 1]), np.array([0.0, 1.0, 2.0]), ["a", "b"])

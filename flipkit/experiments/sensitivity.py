@@ -7,16 +7,18 @@ value); the Table I trials (:func:`flipkit.experiments.trials.run_trial`, by def
 sense-plan-act pipeline in feed-forward mode) run over the given plans at each setting, and
 the scoop, pickup and flip successes are counted (cumulative, as in Table I). The nominal
 cell runs on the same draws for reference. All trials are one sweep
-(:func:`flipkit.experiments.sweep.run_sweep`), so they spread over the executor and are cached.
+(:func:`flipkit.experiments.sweep.run_sweep`), so they spread over the executor and are cached;
+a setting equal to the plan's nominal cell (a range's end at the nominal value, e.g. the UR
+CB-series servo rate) runs the nominal jobs, so its trials are simulated once.
 """
 
 from __future__ import annotations
 
-from flipkit.config import PHYSICAL_RANGES
+from flipkit.config import PHYSICAL_RANGES, with_parameter
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
-from flipkit.experiments.trial_jobs import TRACK_RATE_HZ, trial_jobs, trial_key
+from flipkit.experiments.trial_jobs import TRACK_RATE_HZ, plan_from_text, trial_jobs, trial_key
 from flipkit.experiments.trials import STAGES, run_trial
 from flipkit.simulation.modes import FEEDFORWARD
 
@@ -80,14 +82,18 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
     if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     cases = ([(None, None, None)] if nominal else []) + settings(parameters)
+    cells = [plan_from_text(text).cell() for text in plan_texts]
     jobs, owner = [], []
     for k, (name, _, value) in enumerate(cases):
-        physics = None if name is None else {name: value}
-        for text in plan_texts:
-            new = trial_jobs(text, trials, seed, perturbations, rate_hz, mode, replan, physics)
+        for text, cell in zip(plan_texts, cells):
+            # a setting that leaves the plan's cell as it is (a range's end at the nominal
+            # value) simulates the nominal cell: the nominal job, computed (and cached) once
+            same = name is None or with_parameter(cell, name, value) == cell
+            new = trial_jobs(text, trials, seed, perturbations, rate_hz, mode, replan,
+                             None if same else {name: value})
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress,
-                        desc="sensitivity")
+                        desc="sensitivity", dedupe=True)
     out = {"plans": len(plan_texts), "trials": int(trials), "seed": int(seed), "mode": mode,
            "replan": bool(replan), "nominal": None, "parameters": {}}
     for k, (name, end, value) in enumerate(cases):

@@ -142,7 +142,8 @@ def _write_cache(path: Path, name: str, key, result) -> None:
 
 
 def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, key_fn=None,
-              progress: bool = True, *, name: str | None = None, desc: str = "sweep") -> list:
+              progress: bool = True, *, name: str | None = None, desc: str = "sweep",
+              dedupe: bool = False) -> list:
     """``[fn(item) for item in items]``, in input order, run on ``executor`` and cached.
 
     Each result is stored as JSON as soon as it arrives, so the function must return JSON
@@ -159,6 +160,8 @@ def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, ke
         progress: Show a tqdm progress bar on stderr.
         name: Cache namespace of ``fn``; default ``"<module>.<qualname>"``.
         desc: Progress-bar label.
+        dedupe: Compute items of equal keys once and give each the same result (the
+            function must be deterministic in its key, as the cache assumes).
 
     Returns:
         The results, one per item, in input order.
@@ -181,13 +184,28 @@ def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, ke
             if found:
                 continue
         pending.append(i)
+    cached = len(items) - len(pending)
+    copies = {}  # item computed -> the later items of equal key that take its result
+    if dedupe:
+        first, unique = {}, []
+        for i in pending:
+            digest = stable_hash(keys[i])
+            if digest in first:
+                copies.setdefault(first[digest], []).append(i)
+            else:
+                first[digest] = i
+                unique.append(i)
+        pending = unique
 
     def store(i, result):
         results[i] = json.loads(json.dumps(result))
         if paths[i] is not None:
             _write_cache(paths[i], name, keys[i], results[i])
+        for j in copies.get(i, ()):
+            results[j] = json.loads(json.dumps(results[i]))
+            bar.update()
 
-    with tqdm(total=len(items), initial=len(items) - len(pending), desc=desc, unit="item",
+    with tqdm(total=len(items), initial=cached, desc=desc, unit="item",
               disable=not progress, file=sys.stderr) as bar:
         if executor is None:
             for i in pending:

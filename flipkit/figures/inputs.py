@@ -7,8 +7,8 @@ A notebook's inputs are
 * the flipkit modules its code cells import, transitively: the closure of the package's
   import graph (:mod:`flipkit.import_graph`, read with ``ast``), parent packages included;
 * the package data, ``flipkit/data/*`` (read by path, never imported);
-* the parameters papermill passes (``quick``, ``scheduler``), but not ``out_dir``, which
-  says where the figure goes, not what it shows;
+* the parameters papermill passes (``quick``, ``scheduler``), but not ``out_dir`` and
+  ``cache_dir``, which say where the figure and the sweeps' results go, not what they show;
 * ``environment.lock``: every third-party version.
 
 Their SHA-256 is stored with each figure in ``manifest.json`` (``"inputs"``), and
@@ -31,7 +31,7 @@ from flipkit.figures.catalog import REPO_ROOT
 from flipkit.import_graph import PACKAGE, closure, import_graph, package_modules, source_imports
 
 LOCK = REPO_ROOT / "environment.lock"
-UNHASHED_PARAMETERS = ("out_dir",)  # where a figure goes, not what it shows
+UNHASHED_PARAMETERS = ("out_dir", "cache_dir")  # where results go, not what they show
 PARTS = ("notebook", "sources", "data", "parameters", "environment_lock")
 PART_NAMES = {"notebook": "the notebook", "sources": "flipkit sources",
               "data": "package data", "parameters": "parameters",
@@ -130,6 +130,21 @@ def hash_inputs(notebook: Path, parameters: dict, graph: dict[str, set[str]] | N
     }
     digest = "sha256:" + sha256(json.dumps(parts, sort_keys=True).encode())
     return Inputs(digest, parts, modules)
+
+
+def code_digest(root: Path = PACKAGE, lock: Path = LOCK) -> str:
+    """SHA-256 hex of every file of the package at ``root`` (sources and data, by relative
+    path) and of ``lock``: the code version a cached sweep result was computed with.
+
+    Wider than a notebook's :func:`hash_inputs` on purpose: a sweep worker may load code the
+    notebook does not import, so any change anywhere in the package makes a new version.
+    """
+    root = Path(root)
+    files = sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts
+                   and p.suffix not in (".pyc", ".pyo"))
+    listed = [(p.relative_to(root).as_posix(), sha256(p.read_bytes())) for p in files]
+    locked = sha256(Path(lock).read_bytes()) if Path(lock).is_file() else "absent"
+    return sha256(json.dumps([listed, locked]).encode())
 
 
 def module_file(module: str, root: Path = PACKAGE) -> Path:

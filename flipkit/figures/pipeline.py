@@ -5,11 +5,22 @@ papermill (:mod:`flipkit.figures.execute`) and merges the figures' sidecars
 (:func:`flipkit.figures.style.save`) into ``manifest.json``: every figure, its caption,
 notebook, parameters, numbers and the hash of its inputs (:mod:`flipkit.figures.inputs`).
 A notebook whose figures exist and carry the current hash is skipped, not re-executed.
+
+Notebooks that declare a ``cache_dir`` parameter get one sweep cache
+(:func:`flipkit.experiments.sweep.run_sweep`) shared by the run, :func:`sweep_cache`:
+``<build>/../figure-cache/<code version>``, so a plan or a trial that several figures need
+(the Table I plans, the Table I trials that the landing and sensitivity figures repeat) is
+computed once. The directory is named by :func:`flipkit.figures.inputs.code_digest` of the
+whole package, the package data and ``environment.lock``; directories of other versions are
+removed, so no result of other code is ever read, and ``force`` starts the version's
+directory empty, so that a forced run computes every result again (once).
 """
 
 from __future__ import annotations
 
 import json
+import re
+import shutil
 import sys
 import time
 from dataclasses import dataclass, field
@@ -22,7 +33,8 @@ from flipkit import __version__
 from flipkit.errors import InvalidChoiceError
 from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR
 from flipkit.figures.execute import NotebookError, execute_notebook, kernel_name
-from flipkit.figures.inputs import UNHASHED_PARAMETERS, Inputs, changed, hash_inputs
+from flipkit.figures.inputs import (UNHASHED_PARAMETERS, Inputs, changed, code_digest,
+                                    hash_inputs)
 from flipkit.import_graph import import_graph
 from flipkit.provenance import git_commit
 
@@ -70,10 +82,52 @@ def stale_reason(out: Path, ids, inputs: Inputs, parameters: dict) -> str | None
     return None
 
 
+CACHE_VERSION_NAME = re.compile(r"[0-9a-f]{16}")  # sweep_cache's directory names
+
+
+def sweep_cache(root, fresh: bool = False, digest: str | None = None) -> Path:
+    """The sweep cache directory of the current code, ``root/<digest[:16]>``, created.
+
+    Args:
+        root: Directory holding one cache directory per code version.
+        fresh: Empty this version's directory first (a forced run).
+        digest: The code version (default :func:`flipkit.figures.inputs.code_digest`).
+
+    The directories of other versions under ``root`` (names of 16 hex digits; nothing else
+    is touched) are removed: their results were computed by other code.
+    """
+    root = Path(root)
+    name = (digest or code_digest())[:16]
+    if root.is_dir():
+        for old in root.iterdir():
+            if old.is_dir() and CACHE_VERSION_NAME.fullmatch(old.name) and (
+                    fresh or old.name != name):
+                shutil.rmtree(old)
+    path = root / name
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def declared_parameters(notebook: Path) -> set[str]:
+    """The names assigned in a notebook's ``parameters``-tagged cell."""
+    try:
+        cells = json.loads(Path(notebook).read_text(encoding="utf-8"))["cells"]
+    except (OSError, ValueError, KeyError):
+        return set()
+    names = set()
+    for cell in cells:
+        if "parameters" in (cell.get("metadata") or {}).get("tags", []):
+            for line in "".join(cell.get("source", "")).splitlines():
+                match = re.match(r"([A-Za-z_]\w*)\s*(?::[^=]*)?=", line)
+                if match:
+                    names.add(match.group(1))
+    return names
+
+
 def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
                   out_dir="figures", build_dir="build/notebooks", force: bool = False,
                   log: Callable[[str], None] | None = None,
-                  notebooks_dir: Path = NOTEBOOKS_DIR) -> RunReport:
+                  notebooks_dir: Path = NOTEBOOKS_DIR, cache_root=None) -> RunReport:
     """Execute the figure notebooks whose inputs changed and write ``<out_dir>/manifest.json``.
 
     Args:
@@ -87,6 +141,8 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         log: Called with one line per notebook, before any runs: skipped and why, or to
             run and why.
         notebooks_dir: Where the notebooks of :data:`~flipkit.figures.catalog.FIGURES` are.
+        cache_root: Where the shared sweep cache lives (:func:`sweep_cache`; default
+            ``figure-cache`` beside ``build_dir``). ``force`` empties it for this version.
 
     Returns:
         A :class:`RunReport`; ids whose notebook does not exist yet are in ``missing``.
@@ -123,13 +179,18 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
     out.mkdir(parents=True, exist_ok=True)
     build.mkdir(parents=True, exist_ok=True)
     params = {"quick": bool(quick), "out_dir": str(out), "scheduler": scheduler}
+    cached = {nb for nb in jobs if "cache_dir" in declared_parameters(notebooks_dir / nb)}
+    cache = (sweep_cache(Path(cache_root or build.parent / "figure-cache").absolute(),
+                         fresh=force) if cached else None)
     kernel = kernel_name() if jobs else "python3"
     bar = tqdm(jobs.items(), desc="notebooks", unit="nb", disable=not jobs, file=sys.stderr)
     for notebook, (ids, inputs) in bar:
         bar.set_postfix_str(notebook)
         for fig_id in ids:
             (out / f"{fig_id}.json").unlink(missing_ok=True)
-        execute_notebook(notebooks_dir / notebook, build / notebook, params, kernel)
+        extra = {"cache_dir": str(cache)} if notebook in cached else {}
+        execute_notebook(notebooks_dir / notebook, build / notebook, {**params, **extra},
+                         kernel)
         for fig_id in ids:
             sidecar = out / f"{fig_id}.json"
             if not sidecar.is_file():

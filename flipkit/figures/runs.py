@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 import warnings
@@ -184,23 +185,42 @@ def flip_solve_times(item) -> dict:
                          for s in plan.segments]}
 
 
+def solve_workers(items: int | None = None) -> int:
+    """Local worker processes of :func:`solve_time_sweep`: one per CPU (at most one per item),
+    so that each solve has a core to itself when nothing else runs."""
+    n = os.cpu_count() or 1
+    return max(1, min(n, items)) if items is not None else n
+
+
 def solve_time_sweep(locations, solvers=("sqp", "ipopt"), scheduler: str | None = None,
-                     progress: bool = False) -> list[dict]:
+                     progress: bool = False, workers: int | None = None) -> list[dict]:
     """:func:`flip_solve_times` for every (location, solver), location-major.
 
-    Locally the runs go one after the other in this process, so that no two solves compete
-    for the CPU and the times are those of one core; with a Dask ``scheduler`` address they
-    are spread over its workers.
+    Locally the runs go to ``workers`` worker processes (default :func:`solve_workers`: one
+    per CPU), one solve per process at a time, so that on an otherwise idle machine no two
+    solves compete for a core and the times are those of one core (BLAS and OpenMP are
+    single-threaded in the workers); ``workers=0`` runs them one after the other in this
+    process. The slow solver's runs (IPOPT) are handed out first, so that the SQP's short
+    ones fill the end. With a Dask ``scheduler`` address they are spread over its workers.
     """
     items = [{"location": [float(v) for v in loc], "solver": s}
              for loc in locations for s in solvers]
-    executor = make_executor(scheduler) if scheduler else None
+    order = sorted(range(len(items)), key=lambda i: items[i]["solver"] != "ipopt")
+    workers = solve_workers(len(items)) if workers is None else int(workers)
+    if scheduler:
+        executor = make_executor(scheduler)
+    else:
+        executor = make_executor(None, workers=workers) if workers > 0 else None
     try:
-        return run_sweep(flip_solve_times, items, executor, progress=progress,
-                         desc="solve times")
+        rows = run_sweep(flip_solve_times, [items[i] for i in order], executor,
+                         progress=progress, desc="solve times")
     finally:
         if executor is not None:
             executor.shutdown()
+    out = [None] * len(items)
+    for i, row in zip(order, rows):
+        out[i] = row
+    return out
 
 
 def solve_time_table(rows, names) -> dict:
@@ -232,17 +252,38 @@ def solve_time_table(rows, names) -> dict:
 
 
 # ------------------------------------------------------------------ Table I plans and runs
-def plan_targets(locations, solver: str = "auto", executor=None, progress: bool = False):
-    """Plan pickup-and-flip at every location on the sweep (in a temporary directory) and
-    return the :func:`flipkit.experiments.trials.validate` targets ``[(location, plan_info, plan_text
-    or None)]``, so that one set of plans serves several validations."""
-    with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
-        jobs = [{"location": [float(v) for v in loc], "solver": solver, "plans_dir": tmp}
-                for loc in locations]
-        infos = run_sweep(plan_location, jobs, executor, None, progress=progress, desc="plans")
-        return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},
-                 Path(r["path"]).read_text() if r["status"] == "solved" else None)
-                for job, r in zip(jobs, infos)]
+def plan_location_text(job: dict) -> dict:
+    """Plan pickup-and-flip at one location as :func:`flipkit.experiments.trials.plan_location`
+    does (a sweep worker) and return the plan file's text instead of its path.
+
+    Args:
+        job: ``{"location": [3] (m), "solver": str}``.
+
+    Returns:
+        ``{"status", "reason", "time_s" (s, planning wall time), "text" (the plan file's text,
+        or None when planning failed)}``.
+    """
+    with tempfile.TemporaryDirectory(prefix="flipkit-plan-") as tmp:
+        r = plan_location({**job, "plans_dir": tmp})
+        text = Path(r["path"]).read_text() if r["path"] else None
+    return {"status": r["status"], "reason": r["reason"], "time_s": r["time_s"], "text": text}
+
+
+def plan_targets(locations, solver: str = "auto", executor=None, progress: bool = False,
+                 cache_dir=None):
+    """Plan pickup-and-flip at every location on the sweep and return the
+    :func:`flipkit.experiments.trials.validate` targets ``[(location, plan_info, plan_text or
+    None)]``, so that one set of plans serves several validations.
+
+    With ``cache_dir`` (:func:`flipkit.experiments.sweep.run_sweep`'s cache, keyed by the
+    location and the solver) a plan made earlier by the same code is read back, not planned
+    again: the caller must give each code version its own directory
+    (:func:`flipkit.figures.pipeline.sweep_cache`).
+    """
+    jobs = [{"location": [float(v) for v in loc], "solver": solver} for loc in locations]
+    infos = run_sweep(plan_location_text, jobs, executor, cache_dir, progress=progress, desc="plans")
+    return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},
+             r["text"] if r["status"] == "solved" else None) for job, r in zip(jobs, infos)]
 
 
 def flip_execution(plan_text: str, mode: str = "feedforward", replan: bool = True):
@@ -323,5 +364,5 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
 
 
 __all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
-           "solve_time_sweep", "solve_time_table", "plan_targets", "flip_execution",
+           "solve_workers", "solve_time_sweep", "solve_time_table", "plan_location_text", "plan_targets", "flip_execution",
            "example_location", "ik_example"]
