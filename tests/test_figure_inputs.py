@@ -144,6 +144,7 @@ def test_the_runner_skips_an_up_to_date_notebook(runner):
     run, calls, notebooks, out = runner
     report, lines = run()
     assert report.ran == {"cell.ipynb": "no figure 'cell' in " + str(out)} and len(calls) == 1
+    assert list(report.times_s) == ["cell.ipynb"] and lines[-1].startswith("made cell.ipynb in ")
     entry = json.loads((out / "manifest.json").read_text())["figures"]["cell"]
     assert entry["inputs"]["hash"].startswith("sha256:") and entry["numbers"] == {"n": 1}
 

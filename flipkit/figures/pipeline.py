@@ -48,6 +48,7 @@ class RunReport:
             remade and recorded too). missing: Requested ids whose notebook does not exist.
         ran: Notebook name → why it ran. skipped: Notebook name → why it was skipped.
         manifest: Path of the manifest written. wall_time_s: Wall time of the run (s).
+        times_s: Notebook name → wall time of its execution (s), for those that ran.
     """
 
     made: list[str] = field(default_factory=list)
@@ -56,6 +57,7 @@ class RunReport:
     skipped: dict[str, str] = field(default_factory=dict)
     manifest: Path | None = None
     wall_time_s: float = 0.0
+    times_s: dict[str, float] = field(default_factory=dict)
 
 
 def stale_reason(out: Path, ids, inputs: Inputs, parameters: dict) -> str | None:
@@ -139,7 +141,7 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         build_dir: Where the executed notebooks are written.
         force: Execute every selected notebook, up to date or not.
         log: Called with one line per notebook, before any runs: skipped and why, or to
-            run and why.
+            run and why; then one line as each notebook is made, with its wall time.
         notebooks_dir: Where the notebooks of :data:`~flipkit.figures.catalog.FIGURES` are.
         cache_root: Where the shared sweep cache lives (:func:`sweep_cache`; default
             ``figure-cache`` beside ``build_dir``). ``force`` empties it for this version.
@@ -189,8 +191,11 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         for fig_id in ids:
             (out / f"{fig_id}.json").unlink(missing_ok=True)
         extra = {"cache_dir": str(cache)} if notebook in cached else {}
+        began = time.perf_counter()
         execute_notebook(notebooks_dir / notebook, build / notebook, {**params, **extra},
                          kernel)
+        report.times_s[notebook] = time.perf_counter() - began
+        log(f"made {notebook} in {report.times_s[notebook]:.1f} s")
         for fig_id in ids:
             sidecar = out / f"{fig_id}.json"
             if not sidecar.is_file():
