@@ -29,15 +29,15 @@ from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
-import pinocchio as pin
-from scipy.interpolate import CubicHermiteSpline
 
-from flipkit.planning.plans.servo_command import COMMANDS, command_lead, position_command
+from flipkit.planning.plans.servo_command import COMMANDS
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
-from flipkit.simulation.modes import FEEDFORWARD, MODES, POSITION
+from flipkit.simulation.control import (ArmController, References, plan_references,
+                                        step_references)
+from flipkit.simulation.modes import FEEDFORWARD, MODES
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
 
 HOLD_S = 1.0  # s after the plan: the flipped burger lands
@@ -90,32 +90,6 @@ class Execution:
     sensed_on_blade: list | None = None
     replan_failure: str | None = None
     replan_time_s: float | None = None
-
-
-def _paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
-    """Plan times of run times ``t`` (s) when the plan stops at ``t_pause`` for ``pause`` s."""
-    return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
-
-
-def _desired(plan, t: np.ndarray):
-    """Plan's desired q, q̇ (per-segment cubic Hermite) and u (per-segment linear) at times t
-    (s, from 0); after the last segment the final q with q̇ = 0 and the final u."""
-    n, start = len(t), 0.0
-    q, qd, u = np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS))
-    bounds = {}
-    for seg in plan.segments:
-        ts = start + seg.t - seg.t[0]
-        sel = (t >= ts[0] - 1e-12) & (t <= ts[-1] + 1e-12)
-        spl = CubicHermiteSpline(ts, seg.q, seg.qd, axis=0)
-        tt = np.clip(t[sel], ts[0], ts[-1])
-        q[sel], qd[sel] = spl(tt), spl(tt, 1)
-        u[sel] = np.column_stack([np.interp(tt, ts, seg.u[:, j]) for j in range(ARM_JOINTS)])
-        bounds[seg.name] = (float(ts[0]), float(ts[-1]))
-        start = float(ts[-1])
-    after = t > start + 1e-12
-    last = plan.segments[-1]
-    q[after], qd[after], u[after] = last.q[-1], 0.0, last.u[-1]
-    return q, qd, u, bounds
 
 
 def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> dict:
@@ -187,39 +161,17 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     scene = build_scene(robot, cell, grill_offset=d_["grill_offset_m"],
                         mu=bg.mu * d_["mu_factor"], mass=bg.mass * d_["mass_factor"])
     m, d = scene.model, scene.data
-    sub = max(1, int(round(1.0 / (rate_hz * m.opt.timestep))))
-    dt = sub * m.opt.timestep
+    control = ArmController.of(robot, ph, mode, rate_hz, m.opt.timestep)
+    dt = control.substeps * m.opt.timestep
 
-    nominal = plan.cell().physics  # the cell's model of its servo, which commands use
-
-    def references(plan, t_pause=np.inf, pause=0.0):
-        T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments) + pause
-        t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
-        q_des, qd_des, u_ff, bounds = _desired(plan, _paused(t, t_pause, pause))
-        bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
-                      b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
-        if mode == POSITION:  # servo-rate samples, arriving latency_s late, zero-order hold
-            sent = np.floor(np.maximum(t - ph.latency_s, 0.0) * ph.servo_rate_hz + 1e-9) \
-                / ph.servo_rate_hz
-            lead = command_lead(nominal) if command == "compensated" else 0.0
-            sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
-            q_s, qd_s, u_s, _ = _desired(plan, _paused(sent + lead, t_pause, pause))
-            q_cmd, qd_cmd = (c[held] for c in position_command(q_s, qd_s, u_s, robot.model,
-                                                               nominal, command))
-        else:
-            q_cmd, qd_cmd = q_des, qd_des
-        return t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd
-
-    t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan)
-    t_sense = bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
-    kp, kd = (np.asarray(g) * ph.servo_gain_scale for g in (ph.kp, ph.kd))
-    umax = robot.u_max
+    refs = plan_references(plan, robot, ph, mode, command, dt, hold)
+    t_sense = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
 
     pb = np.asarray(plan.burger["location"], float)
-    place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=q_des[0])
-    d.qvel[:ARM_JOINTS] = qd_des[0]
+    place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=refs.q_des[0])
+    d.qvel[:ARM_JOINTS] = refs.qd_des[0]
     mujoco.mj_forward(m, d)
-    N = len(t) if replan is None else 3 * len(t)  # room for the pause and a longer tail
+    N = len(refs.t) if replan is None else 3 * len(refs.t)  # room for the pause and a longer tail
     rec = {k: np.zeros((N, 3)) for k in ("bp", "sp")}
     rec.update({k: np.zeros((N, 3, 3)) for k in ("br", "sr")})
     rec.update({k: np.zeros(N) for k in ("fs", "fg", "fbg")})
@@ -227,49 +179,54 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = m.geom_bodyid[scene.geoms["burger"]]
     f6 = np.zeros(6)
-    sensed, replan_failure, replan_time = None, None, None
+    sense = {"sensed": None, "failure": None, "time": None, "plan": plan}
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
     thick = cell.spatula.thickness
-    k = -1
-    while k + 1 < len(t):
-        k += 1
-        if t[k] >= t_sense - 1e-9 and sensed is None:  # at rest: sense and replan
-            mujoco.mj_kinematics(m, d)
-            p_b, R_b = scene.blade_pose()
-            rel = (d.xpos[burger_body] - p_b) @ R_b
-            sensed = rel[:2] + [d_["sense_dx_m"], d_["sense_dy_m"]]  # the camera's error
-            if np.any(np.abs(sensed) > half) or not 0.0 < rel[2] < bg.thickness + thick:
-                # not on the blade (the scoop missed or pushed it off): nothing to re-plan for;
-                # the verified plan runs on, and the judges see the miss
-                new, replan_failure = None, (
-                    f"burger not on the blade after the {SENSE_AFTER[plan.behavior]}: its centre "
-                    f"at ({rel[0]:+.3f}, {rel[1]:+.3f}, {rel[2]:+.3f}) m in the blade frame")
-            else:
-                started = time.perf_counter()
-                try:  # a failed replan keeps the verified plan under way (and this step runs)
-                    new = replan(plan, sensed)
-                except FlipkitError as exc:
-                    new, replan_failure = None, str(exc)
-                replan_time = time.perf_counter() - started
-            if new is not None and new.status != "solved":
-                new, replan_failure = None, new.failure or "replanned plan not solved"
-            if new is not None:
-                plan = new
-                # The arm held at rest while the replan ran: the rest of the run starts after
-                # that pause, a whole number of control steps long.
-                pause = dt * np.ceil(replan_time / dt - 1e-9)
-                t2, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd = references(plan, t[k], pause)
-                if len(t2) > N or np.any(np.abs(t2[:k + 1] - t[:k + 1]) > 1e-9):
-                    raise ConfigError("the replanned run does not extend the executed one")
-                t = t2
-        q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
-        ff = u_ff[k] if mode == FEEDFORWARD else pin.computeGeneralizedGravity(
-            robot.model, robot.data, q)
-        u = np.clip(ff + kp * (q_cmd[k] - q) + kd * (qd_cmd[k] - qd), -umax, umax)
+
+    def sense_and_replan(k: int, refs: References) -> References | None:
+        """At rest after the sensed segment: sense the burger on the blade and replan."""
+        t = refs.t
+        if not (t[k] >= t_sense - 1e-9 and sense["sensed"] is None):
+            return None
+        mujoco.mj_kinematics(m, d)
+        p_b, R_b = scene.blade_pose()
+        rel = (d.xpos[burger_body] - p_b) @ R_b
+        sensed = sense["sensed"] = rel[:2] + [d_["sense_dx_m"], d_["sense_dy_m"]]  # camera error
+        if np.any(np.abs(sensed) > half) or not 0.0 < rel[2] < bg.thickness + thick:
+            # not on the blade (the scoop missed or pushed it off): nothing to re-plan for;
+            # the verified plan runs on, and the judges see the miss
+            new, sense["failure"] = None, (
+                f"burger not on the blade after the {SENSE_AFTER[plan.behavior]}: its centre "
+                f"at ({rel[0]:+.3f}, {rel[1]:+.3f}, {rel[2]:+.3f}) m in the blade frame")
+        else:
+            started = time.perf_counter()
+            try:  # a failed replan keeps the verified plan under way (and this step runs)
+                new = replan(plan, sensed)
+            except FlipkitError as exc:
+                new, sense["failure"] = None, str(exc)
+            sense["time"] = time.perf_counter() - started
+        if new is not None and new.status != "solved":
+            new, sense["failure"] = None, new.failure or "replanned plan not solved"
+        if new is None:
+            return None
+        sense["plan"] = new
+        # The arm held at rest while the replan ran: the rest of the run starts after that
+        # pause, a whole number of control steps long.
+        pause = dt * np.ceil(sense["time"] / dt - 1e-9)
+        new_refs = plan_references(new, robot, ph, mode, command, dt, hold, t[k], pause)
+        if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):
+            raise ConfigError("the replanned run does not extend the executed one")
+        return new_refs
+
+    def record(k: int, q: np.ndarray, u: np.ndarray) -> None:
         qa[k], ua[k], qpos[k] = q, u, d.qpos
         _record(scene, rec, k, burger_body, f6)
-        d.qfrc_applied[:ARM_JOINTS] = u
-        mujoco.mj_step(m, d, nstep=sub)
+
+    refs, _ = step_references(scene, control, refs, record,
+                              sense_and_replan if replan is not None else None)
+    plan, sensed = sense["plan"], sense["sensed"]
+    replan_failure, replan_time = sense["failure"], sense["time"]
+    t, q_des, bounds = refs.t, refs.q_des, refs.bounds
     n = len(t)
     rec = {key: val[:n] for key, val in rec.items()}
     qa, ua, qpos = qa[:n], ua[:n], qpos[:n]

@@ -37,6 +37,17 @@ n = :data:`BLADE_EDGE_CONTACTS` contact points sharing the edge's load; the stat
 force is exactly k x whatever A is (tests/test_scene.py), and the instantaneous share of the
 push the constraint takes is A/(A + R) < 0.1 %. Friction on this pair stays Coulomb through
 the ``noslip`` iterations.
+
+Several burgers (``burgers=n`` > 1, a whole cook: :mod:`flipkit.simulation.cook`). Burger k is
+the body and geom ``burger_k``, with the same pairs as the single burger (blade, grill,
+table) and a pair with every other burger, so that burgers cannot pass through each other;
+burger–burger contacts have the patty's softness and the burger-grill friction
+(``mu_grill``): the cell has no patty-on-patty friction, and any such contact is reported by
+the cook simulation, not relied on. All n start *parked* (:func:`park_burger`): below the
+(visual) floor, :data:`PARK_SPACING` apart, out of every pair's reach and held against gravity
+(``gravcomp`` 1), so a parked burger stays exactly where it is; :func:`place_burger` with
+``burger=k`` puts one at rest on the grill (or table) and gives it back its weight. With one
+burger (the default) the scene is unchanged: body and geom ``burger``, on the grill.
 """
 
 from __future__ import annotations
@@ -61,6 +72,10 @@ BLADE_IMPEDANCE = 0.01
 # edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
 # spring-damper, so that the pressed edge meets k and b in all.
 BLADE_EDGE_CONTACTS = 2
+# Parked burgers (several-burger scenes): a row below the visual floor (z = -0.6 m), hidden from
+# the cameras above it, 0.2 m apart (more than a diameter: no burger-burger contact).
+PARK_ORIGIN = (-1.0, 0.0, -1.5)  # m
+PARK_SPACING = 0.2  # m, along x
 
 
 def _vec(v) -> str:
@@ -112,6 +127,8 @@ class Scene:
         burger_qpos, burger_qvel: Slices of the burger's free joint in qpos / qvel.
         blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
             (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
+        burger_bodies: Body id of each burger (one, or ``burgers`` of :func:`build_scene`);
+            with several, ``geoms`` holds ``burger_k`` for each instead of ``burger``.
     """
 
     model: mujoco.MjModel
@@ -122,6 +139,7 @@ class Scene:
     grill_height: float
     geoms: dict
     blade_contact: dict
+    burger_bodies: tuple = ()
 
     burger_qpos = slice(ARM_JOINTS, ARM_JOINTS + 7)  # class constants, not fields
     burger_qvel = slice(ARM_JOINTS, ARM_JOINTS + 6)
@@ -130,6 +148,14 @@ class Scene:
         """World position (m) and rotation of the spatula frame (after mj_kinematics)."""
         return (self.data.site_xpos[self.blade_site].copy(),
                 self.data.site_xmat[self.blade_site].reshape(3, 3).copy())
+
+    def qpos_of(self, k: int) -> slice:
+        """Slice of burger k's free joint (position, quaternion) in qpos."""
+        return slice(ARM_JOINTS + 7 * k, ARM_JOINTS + 7 * k + 7)
+
+    def qvel_of(self, k: int) -> slice:
+        """Slice of burger k's free joint (linear, angular velocity) in qvel."""
+        return slice(ARM_JOINTS + 6 * k, ARM_JOINTS + 6 * k + 6)
 
 
 def _joint_axis(joint) -> np.ndarray:
@@ -168,7 +194,7 @@ def _arm_bodies(robot: Robot, sp_xml: str) -> str:
 
 def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                 grill_offset: float = 0.0, burger_xy=None, mu: float | None = None,
-                mass: float | None = None) -> Scene:
+                mass: float | None = None, burgers: int = 1) -> Scene:
     """Compile the cell.
 
     Args:
@@ -180,7 +206,16 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
             :func:`place_burger`.
         mu: Burger-blade friction; default ``cell.burger.mu``.
         mass: Burger mass (kg); default ``cell.burger.mass``.
+        burgers: Number of burgers, ≥ 1. One: the burger lies at ``burger_xy``. Several:
+            all start parked (module docstring); ``burger_xy`` must be ``None``.
+
+    Raises:
+        ConfigError: ``burgers`` not a positive integer, or ``burger_xy`` with several.
     """
+    if isinstance(burgers, bool) or not isinstance(burgers, (int, np.integer)) or burgers < 1:
+        raise ConfigError(f"burgers must be a positive integer, got {burgers!r}")
+    if burgers > 1 and burger_xy is not None:
+        raise ConfigError("burger_xy places the single burger; several start parked")
     robot = robot or Robot(cell, with_burger=False)
     cell = cell or robot.cell
     ph, sp, bg, gr, tb = cell.physics, cell.spatula, cell.burger, cell.grill, cell.table
@@ -214,6 +249,30 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                 f'friction="{f} {f} 0.001 0.0001 0.0001" '
                 f'solref="{solref[0]:.6g} {solref[1]:.6g}"{solimp}/>')
 
+    names = ["burger"] if burgers == 1 else [f"burger_{k}" for k in range(burgers)]
+    soft = (tau_b, ph.burger_dampratio)
+
+    def body(name, pos, gravcomp):
+        return (f'<body name="{name}" pos="{pos}"{gravcomp}>\n'
+                f'      <freejoint name="{name}"/>\n'
+                f'      <inertial pos="0 0 0" mass="{mass:.9g}" '
+                f'diaginertia="{_vec(_disc_inertia(mass, r, 2 * h2))}"/>\n'
+                f'      <geom name="{name}" type="mesh" mesh="burger" contype="0" '
+                f'conaffinity="0"\n            rgba="0.45 0.25 0.15 1"/>\n'
+                f'      <geom type="cylinder" size="{r * 0.8:.4g} 0.0005" pos="0 0 {h2}" '
+                f'contype="0"\n            conaffinity="0" rgba="0.3 0.15 0.08 1" mass="0"/>\n'
+                f'    </body>')
+
+    if burgers == 1:
+        bodies = body("burger", f"{xy[0]:.9g} {xy[1]:.9g} {h_g + h2:.9g}", "")
+    else:
+        bodies = "\n    ".join(body(n, _vec(_park_position(k)), ' gravcomp="1"')
+                               for k, n in enumerate(names))
+    pairs = "\n    ".join(
+        [line for n in names for line in (pair(n, "blade", mu, soft),
+                                          pair(n, "grill", ph.mu_grill, soft),
+                                          pair(n, "table", ph.mu_grill, soft))]
+        + [pair(a, b, ph.mu_grill, soft) for i, a in enumerate(names) for b in names[i + 1:]])
     xml = f"""<mujoco model="flipkit_cell">
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
@@ -239,20 +298,11 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
           pos="{tx:.6g} {ty:.6g} {tb.height - 0.02:.6g}" contype="0" conaffinity="0"
           rgba="0.6 0.45 0.3 1"/>
     {_arm_bodies(robot, sp_xml)}
-    <body name="burger" pos="{xy[0]:.9g} {xy[1]:.9g} {h_g + h2:.9g}">
-      <freejoint name="burger"/>
-      <inertial pos="0 0 0" mass="{mass:.9g}" diaginertia="{_vec(_disc_inertia(mass, r, 2 * h2))}"/>
-      <geom name="burger" type="mesh" mesh="burger" contype="0" conaffinity="0"
-            rgba="0.45 0.25 0.15 1"/>
-      <geom type="cylinder" size="{r * 0.8:.4g} 0.0005" pos="0 0 {h2}" contype="0"
-            conaffinity="0" rgba="0.3 0.15 0.08 1" mass="0"/>
-    </body>
+    {bodies}
   </worldbody>
   <contact>
     {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
-    {pair("burger", "blade", mu, (tau_b, ph.burger_dampratio))}
-    {pair("burger", "grill", ph.mu_grill, (tau_b, ph.burger_dampratio))}
-    {pair("burger", "table", ph.mu_grill, (tau_b, ph.burger_dampratio))}
+    {pairs}
     {pair("blade", "table", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
   </contact>
 </mujoco>"""
@@ -266,7 +316,8 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     scene = Scene(model, data, xml, robot,
                   mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
-                  {n: gid(n) for n in ("blade", "grill", "burger", "table")}, contact)
+                  {n: gid(n) for n in ("blade", "grill", *names, "table")}, contact,
+                  tuple(int(model.geom_bodyid[gid(n)]) for n in names))
     mujoco.mj_forward(model, data)
     return scene
 
@@ -291,11 +342,43 @@ def _disc_inertia(m: float, r: float, h: float) -> np.ndarray:
     return np.array([ixx, ixx, m * r**2 / 2])
 
 
-def place_burger(scene: Scene, xy, q=None) -> None:
-    """Put the burger upright on the grill at ``xy`` (m), at rest; the arm at ``q`` (rad)."""
+def _park_position(k: int) -> np.ndarray:
+    """Where burger k is parked (m): :data:`PARK_ORIGIN` + k :data:`PARK_SPACING` along x."""
+    return np.asarray(PARK_ORIGIN, float) + [PARK_SPACING * k, 0.0, 0.0]
+
+
+def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | None = None
+                 ) -> None:
+    """Put a burger upright at ``xy`` (m) on the grill, at rest; the arm at ``q`` (rad).
+
+    Args:
+        scene: The cell. xy: Where the burger's centre lies (m).
+        q: Arm configuration (rad) to set too, or ``None``.
+        burger: Which burger (index into ``scene.burger_bodies``); it gets its weight back.
+        height: Surface it rests on (m); default the grill's.
+    """
     d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
     if q is not None:
         d.qpos[:ARM_JOINTS] = q
-    d.qpos[scene.burger_qpos] = [*np.asarray(xy, float)[:2], scene.grill_height + h2, 1, 0, 0, 0]
-    d.qvel[scene.burger_qvel] = 0.0
+    surface = scene.grill_height if height is None else float(height)
+    d.qpos[scene.qpos_of(burger)] = [*np.asarray(xy, float)[:2], surface + h2, 1, 0, 0, 0]
+    d.qvel[scene.qvel_of(burger)] = 0.0
+    if scene.model.body_gravcomp[scene.burger_bodies[burger]] != 0.0:
+        scene.model.body_gravcomp[scene.burger_bodies[burger]] = 0.0
+    mujoco.mj_forward(scene.model, d)
+
+
+def park_burger(scene: Scene, burger: int) -> None:
+    """Take a burger of a several-burger scene out of the cell: parked (module docstring), at
+    rest, held against gravity.
+
+    Raises:
+        ConfigError: A single-burger scene (compiled without gravity compensation).
+    """
+    if len(scene.burger_bodies) < 2:
+        raise ConfigError("only a scene of several burgers parks them (build_scene(burgers=n))")
+    d = scene.data
+    d.qpos[scene.qpos_of(burger)] = [*_park_position(burger), 1, 0, 0, 0]
+    d.qvel[scene.qvel_of(burger)] = 0.0
+    scene.model.body_gravcomp[scene.burger_bodies[burger]] = 1.0
     mujoco.mj_forward(scene.model, d)

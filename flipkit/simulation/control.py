@@ -1,0 +1,171 @@
+"""The arm's joint controller and the stepping of a plan on a compiled cell.
+
+A plan becomes :class:`References` on the controller's clock (:func:`plan_references`): the
+desired state (per-segment cubic Hermite q, q̇; linear u) and, in position mode, the delayed,
+servo-rate commands the robot's PD receives. :class:`ArmController` turns the measured state
+into joint torques (the two controllers of :mod:`flipkit.simulation.execute`), and
+:func:`step_references` runs one plan on a scene as it is, whatever else the scene holds:
+:func:`~flipkit.simulation.execute.execute_plan` on a one-burger cell, the cook simulation
+(:mod:`flipkit.simulation.cook`) on a cell with every burger of the cook.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+from scipy.interpolate import CubicHermiteSpline
+
+from flipkit.model.robot import Robot
+from flipkit.planning.plans.servo_command import command_lead, position_command
+from flipkit.simulation.modes import FEEDFORWARD, POSITION
+from flipkit.simulation.scene import ARM_JOINTS, Scene
+
+
+def paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
+    """Plan times of run times ``t`` (s) when the plan stops at ``t_pause`` for ``pause`` s."""
+    return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
+
+
+def desired(plan, t: np.ndarray):
+    """Plan's desired q, q̇ (per-segment cubic Hermite) and u (per-segment linear) at times t
+    (s, from 0); after the last segment the final q with q̇ = 0 and the final u."""
+    n, start = len(t), 0.0
+    q, qd, u = np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS))
+    bounds = {}
+    for seg in plan.segments:
+        ts = start + seg.t - seg.t[0]
+        sel = (t >= ts[0] - 1e-12) & (t <= ts[-1] + 1e-12)
+        spl = CubicHermiteSpline(ts, seg.q, seg.qd, axis=0)
+        tt = np.clip(t[sel], ts[0], ts[-1])
+        q[sel], qd[sel] = spl(tt), spl(tt, 1)
+        u[sel] = np.column_stack([np.interp(tt, ts, seg.u[:, j]) for j in range(ARM_JOINTS)])
+        bounds[seg.name] = (float(ts[0]), float(ts[-1]))
+        start = float(ts[-1])
+    after = t > start + 1e-12
+    last = plan.segments[-1]
+    q[after], qd[after], u[after] = last.q[-1], 0.0, last.u[-1]
+    return q, qd, u, bounds
+
+
+@dataclass(frozen=True)
+class References:
+    """A plan's references on the controller's clock, N samples from the plan's start.
+
+    Attributes:
+        t: Sample times (s). q_des, qd_des: Desired (undelayed) joint positions (rad) and
+            velocities (rad/s), N×6. u_ff: The plan's torques (N·m), N×6. bounds:
+            ``{segment: (t_start, t_end)}`` (s). q_cmd, qd_cmd: What the joint PD receives:
+            the desired state (feed-forward mode) or position mode's delayed, servo-rate
+            commands (N×6).
+    """
+
+    t: np.ndarray
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    u_ff: np.ndarray
+    bounds: dict
+    q_cmd: np.ndarray
+    qd_cmd: np.ndarray
+
+
+def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: float,
+                    hold: float, t_pause: float = np.inf, pause: float = 0.0) -> References:
+    """The references of ``plan`` every ``dt`` s until ``hold`` s after its end (module
+    docstring: the two controllers), the plan paused ``pause`` s at ``t_pause`` (a replan).
+
+    Args:
+        plan: A solved plan. robot: The arm (position mode's controller model).
+        physics: The plant's :class:`~flipkit.config.PhysicsConfig` (servo rate, latency);
+            commands use the plan's nominal servo model (``plan.cell().physics``).
+        mode, command: As :func:`execute_plan`. dt: Controller period (s).
+        hold: Time (s) the last desired state is held after the plan.
+    """
+    nominal = plan.cell().physics  # the cell's model of its servo, which commands use
+    T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments) + pause
+    t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
+    q_des, qd_des, u_ff, bounds = desired(plan, paused(t, t_pause, pause))
+    bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
+                  b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
+    if mode == POSITION:  # servo-rate samples, arriving latency_s late, zero-order hold
+        sent = np.floor(np.maximum(t - physics.latency_s, 0.0) * physics.servo_rate_hz + 1e-9) \
+            / physics.servo_rate_hz
+        lead = command_lead(nominal) if command == "compensated" else 0.0
+        sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
+        q_s, qd_s, u_s, _ = desired(plan, paused(sent + lead, t_pause, pause))
+        q_cmd, qd_cmd = (c[held] for c in position_command(q_s, qd_s, u_s, robot.model,
+                                                           nominal, command))
+    else:
+        q_cmd, qd_cmd = q_des, qd_des
+    return References(t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd)
+
+
+@dataclass(frozen=True)
+class ArmController:
+    """The joint controller of ``mode`` (module docstring) at ``substeps`` MuJoCo steps per
+    control step.
+
+    Attributes:
+        robot: The arm; position mode's gravity compensation uses its model.
+        mode: ``"feedforward"`` or ``"position"``. kp, kd: Joint gains (N·m/rad, N·m s/rad),
+            scaled by ``physics.servo_gain_scale``. u_max: Torque limits (N·m).
+        substeps: MuJoCo steps per control step.
+    """
+
+    robot: Robot
+    mode: str
+    kp: np.ndarray
+    kd: np.ndarray
+    u_max: np.ndarray
+    substeps: int
+
+    @classmethod
+    def of(cls, robot: Robot, physics, mode: str, rate_hz: float, timestep: float
+           ) -> "ArmController":
+        """The controller at ``rate_hz`` (Hz) over a MuJoCo ``timestep`` (s)."""
+        kp, kd = (np.asarray(g) * physics.servo_gain_scale for g in (physics.kp, physics.kd))
+        return cls(robot, mode, kp, kd, robot.u_max,
+                   max(1, int(round(1.0 / (rate_hz * timestep)))))
+
+    def torque(self, refs: References, k: int, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Joint torques (N·m) at sample k of ``refs`` from the measured q (rad), q̇ (rad/s)."""
+        ff = refs.u_ff[k] if self.mode == FEEDFORWARD else pin.computeGeneralizedGravity(
+            self.robot.model, self.robot.data, q)
+        return np.clip(ff + self.kp * (refs.q_cmd[k] - q) + self.kd * (refs.qd_cmd[k] - qd),
+                       -self.u_max, self.u_max)
+
+
+def step_references(scene: Scene, control: ArmController, refs: References,
+                    record: Callable, hook: Callable | None = None,
+                    stop: Callable | None = None) -> tuple[References, int]:
+    """Run the arm through ``refs`` on the scene as it is, one control step per sample.
+
+    Each step k: ``hook(k, refs)`` may return new references (a replan) or change the scene;
+    ``stop(k, refs)`` True ends the run before the step; then the torque from the current
+    state, ``record(k, q, u)`` (the state before the step: q a view of the arm's qpos), the
+    torque held over ``control.substeps`` MuJoCo steps.
+
+    Returns:
+        The references finally run and the number of control steps taken.
+    """
+    m, d = scene.model, scene.data
+    k = -1
+    while k + 1 < len(refs.t):
+        k += 1
+        if hook is not None:
+            refs = hook(k, refs) or refs
+        if stop is not None and stop(k, refs):
+            return refs, k
+        q, qd = d.qpos[:ARM_JOINTS], d.qvel[:ARM_JOINTS]
+        u = control.torque(refs, k, q, qd)
+        record(k, q, u)
+        d.qfrc_applied[:ARM_JOINTS] = u
+        mujoco.mj_step(m, d, nstep=control.substeps)
+    return refs, len(refs.t)
+
+
+__all__ = ["ArmController", "References", "desired", "paused", "plan_references",
+           "step_references"]
