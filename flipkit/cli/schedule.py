@@ -13,11 +13,19 @@ a malformed ``--window``, ``--dwell``, ``--time-limit``, ``--stream`` or ``--min
 stream whose grill fills up), an output that is not writable, of an unknown format or the
 cook order itself, or a motion kind without a planner (``flipkit.planning.planners.planner.plan_serve``
 missing) — one line on stderr, nothing planned, nothing written.
+
+With ``--simulate`` a cook that was planned, solved and kept its windows is then run in
+MuJoCo, every motion on one cell holding every burger (:mod:`flipkit.simulation.cook`), and
+``--film`` renders it: one line per burger and a summary; exit 0 when every burger was
+flipped and served, 1 otherwise (one line naming the first burger that was not and why). A
+refused or failed schedule is never simulated (exit 1 as above).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import os
 
 from flipkit.cli.common import MAX_WORKERS, SOLVER_CHOICES, check_float, check_int, deferred
 from flipkit.errors import ConfigError
@@ -27,6 +35,8 @@ from flipkit.planning.kitchen.table import DWELL_S, check_dwell
 from flipkit.planning.kitchen.windows import parse_windows
 
 FIGURE_FORMATS = (".pdf", ".png", ".svg")  # --figure, by suffix
+FILM_FORMATS = (".gif", ".mp4")  # --film, by suffix
+SIM_MODES = ("position", "feedforward")  # flipkit.simulation.modes.MODES, position first
 POLICIES = ("cpsat", "greedy")
 MAX_TIME_LIMIT_S = 3600.0
 DESCRIPTION = (
@@ -94,6 +104,16 @@ def register(subparsers) -> None:
     p.add_argument("--plan", action="store_true",
                    help="with --stream: plan every motion (minutes for hundreds) instead of "
                         "scheduling on the durations of six representative plans")
+    p.add_argument("--simulate", action="store_true",
+                   help="run the planned cook in MuJoCo: every motion in order on one cell "
+                        "with all the burgers; judge each burger's flip and serve (exit 1 "
+                        "unless all are flipped and served)")
+    p.add_argument("--mode", choices=SIM_MODES, default="position",
+                   help="with --simulate: the joint controller, position (default: the "
+                        "robot's servo on compensated commands) or feedforward")
+    p.add_argument("--film", metavar="FILE",
+                   help="with --simulate: a film of the motions (.gif, or .mp4 with "
+                        "imageio-ffmpeg), 320x240 at 15 fps, idle intervals cut")
     p.set_defaults(run=run)
 
 
@@ -115,8 +135,21 @@ def run(args: argparse.Namespace) -> int:
                               "streams: notebooks/throughput.ipynb)")
     elif args.minutes is not None or args.plan:
         raise ConfigError("--minutes and --plan go with --stream")
+    if args.simulate and args.stream is not None:
+        raise ConfigError("--simulate runs a cook order (BURGERS.csv), not a stream")
+    if (args.film or args.mode != "position") and not args.simulate:
+        raise ConfigError("--film and --mode go with --simulate")
     inputs = [args.burgers] if args.burgers else []
     check_output(args.json, "--json", (".json",), inputs=inputs)
+    if args.film:
+        check_output(args.film, "--film", FILM_FORMATS, inputs=inputs,
+                     outputs=[args.json] + ([args.figure] if args.figure else []))
+        if args.film.lower().endswith(".mp4") and importlib.util.find_spec(
+                "imageio_ffmpeg") is None:
+            raise ConfigError("--film .mp4 needs imageio-ffmpeg, which is not installed; "
+                              "write a .gif instead")
+    if args.simulate:
+        os.environ.setdefault("MUJOCO_GL", "osmesa")  # before anything imports mujoco
     if args.figure:
         check_output(args.figure, "--figure", FIGURE_FORMATS, inputs=inputs,
                      outputs=[args.json])

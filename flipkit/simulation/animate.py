@@ -13,6 +13,8 @@ package.
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import os
 
 os.environ.setdefault("MUJOCO_GL", "osmesa")
@@ -83,21 +85,19 @@ def _mark_spot(scene, spot) -> None:
     scene.ngeom += 1
 
 
-def render(execution, indices, width: int = 480, height: int = 360, progress: bool = False):
-    """Rendered RGB frames (height×width×3 uint8) of the samples ``indices`` of a run, with the
-    landing target marked by a translucent 5 cm disc."""
-    scene = execution.scene
-    m, d = scene.model, mujoco.MjData(scene.model)
-    cam, frames = _camera(), []
-    renderer = _renderer(m, width, height)
+def render_states(model, qpos, width: int = 480, height: int = 360, camera=None,
+                  spot=None, progress: bool = False) -> list:
+    """Rendered RGB frames (height×width×3 uint8) of the MuJoCo states ``qpos`` (rows) of
+    ``model``, seen from ``camera`` (a :class:`mujoco.MjvCamera`; default the package's view
+    of the grill), with a translucent 5 cm disc at ``spot`` (x, y, z) (m) if given."""
+    d = mujoco.MjData(model)
+    cam, frames = camera or _camera(), []
+    renderer = _renderer(model, width, height)
     try:
-        it = indices
-        if progress:
-            it = tqdm(indices, desc="frames", unit="frame")
-        spot = _landing_spot(execution)
-        for k in it:
-            d.qpos[:] = execution.qpos[k]
-            mujoco.mj_forward(m, d)
+        it = tqdm(qpos, desc="frames", unit="frame") if progress else qpos
+        for row in it:
+            d.qpos[:] = row
+            mujoco.mj_forward(model, d)
             renderer.update_scene(d, camera=cam)
             if spot is not None:
                 _mark_spot(renderer.scene, spot)
@@ -105,6 +105,13 @@ def render(execution, indices, width: int = 480, height: int = 360, progress: bo
     finally:
         renderer.close()
     return frames
+
+
+def render(execution, indices, width: int = 480, height: int = 360, progress: bool = False):
+    """Rendered RGB frames (height×width×3 uint8) of the samples ``indices`` of a run, with the
+    landing target marked by a translucent 5 cm disc."""
+    return render_states(execution.scene.model, [execution.qpos[k] for k in indices], width,
+                         height, spot=_landing_spot(execution), progress=progress)
 
 
 def write_animation(execution, out, fps: float = 30.0, width: int = 480, height: int = 360,
@@ -116,23 +123,44 @@ def write_animation(execution, out, fps: float = 30.0, width: int = 480, height:
             file cannot be written.
     """
     out = Path(out)
-    ext = out.suffix.lower()
-    if ext not in FORMATS:
-        raise InvalidChoiceError("animation format", ext or out.name, FORMATS)
-    if ext == ".mp4":
-        try:
-            import imageio_ffmpeg  # optional (not in environment.lock): only .mp4 needs it
-        except ImportError:
-            raise FlipkitError("MP4 needs imageio-ffmpeg, which is not installed (not in "
-                               "environment.lock); write a .gif instead") from None
+    check_writer(out)
     frames = render(execution, frame_indices(execution.run.t, fps), width, height, progress)
+    return write_frames(frames, out, fps)
+
+
+def check_writer(out) -> str:
+    """The extension of ``out`` (``.gif`` or ``.mp4``) once a writer for it is installed.
+
+    Raises:
+        InvalidChoiceError: Unknown extension. FlipkitError: ``.mp4`` without imageio-ffmpeg.
+    """
+    ext = Path(out).suffix.lower()
+    if ext not in FORMATS:
+        raise InvalidChoiceError("animation format", ext or Path(out).name, FORMATS)
+    if ext == ".mp4" and importlib.util.find_spec("imageio_ffmpeg") is None:
+        raise FlipkitError("MP4 needs imageio-ffmpeg, which is not installed (not in "
+                           "environment.lock); write a .gif instead")
+    return ext
+
+
+def write_frames(frames, out, fps: float) -> Path:
+    """Write RGB frames (height×width×3 uint8, all one size) to ``out`` (``.gif`` or ``.mp4``)
+    at ``fps``.
+
+    Raises:
+        InvalidChoiceError, FlipkitError: As :func:`check_writer`; the file cannot be written.
+    """
+    out = Path(out)
+    ext = check_writer(out)
     try:
         if ext == ".gif":
             imgs = [Image.fromarray(f) for f in frames]
             imgs[0].save(out, save_all=True, append_images=imgs[1:], loop=0,
                          duration=int(round(1000 / fps)))
         else:
-            w = imageio_ffmpeg.write_frames(str(out), (width, height), fps=fps)
+            writer = importlib.import_module("imageio_ffmpeg")  # optional: only .mp4 needs it
+            height, width = frames[0].shape[:2]
+            w = writer.write_frames(str(out), (width, height), fps=fps)
             w.send(None)
             for f in frames:
                 w.send(np.ascontiguousarray(f))
@@ -209,5 +237,6 @@ def write_filmstrip(execution, out, width: int = 320, height: int = 240) -> Path
     return Path(out)
 
 
-__all__ = ["FORMATS", "frame_indices", "render", "write_animation", "key_frames",
+__all__ = ["FORMATS", "check_writer", "frame_indices", "render", "render_states",
+           "write_animation", "write_frames", "key_frames",
            "filmstrip_figure", "write_filmstrip"]

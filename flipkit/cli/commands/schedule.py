@@ -1,5 +1,7 @@
-"""``flipkit schedule`` once its arguments passed :mod:`flipkit.cli.schedule`: read the cook
-order, plan its motions, write the timeline, the plans and the Gantt chart, report."""
+"""``flipkit schedule`` once its arguments passed :mod:`flipkit.cli.schedule` (which sets
+``MUJOCO_GL`` before this module imports MuJoCo): read the cook order, plan its motions,
+write the timeline, the plans and the Gantt chart, simulate the cook (``--simulate``, and
+its ``--film``), report."""
 
 from __future__ import annotations
 
@@ -30,6 +32,8 @@ from flipkit.planning.kitchen.table import assign_spots
 from flipkit.planning.kitchen.throughput import run_stream, stream_report
 from flipkit.planning.kitchen.windows import WindowsBrokenError, worst_break
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.simulation.cook import simulate_cook
+from flipkit.simulation.cook_film import FILM_FPS, write_cook_film
 
 
 def _safe(text: str) -> str:
@@ -58,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         timeline_path.stem + "_plans")
     if not stream or args.plan:
         check_output_dir(plans, "--plans", inputs=[p for p in (args.burgers,) if p]
-                         + [args.json, args.figure])
+                         + [args.json, args.figure, getattr(args, "film", None)])
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     executor = make_executor(workers=workers) if workers > 1 else None
     try:
@@ -101,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
     if stream:
         doc["stream"] = stream_report(timeline, args.policy, args.stream,
                                       args.minutes).to_dict()
+    sim = None
+    if getattr(args, "simulate", False) and timeline.ok:  # a failed schedule is not simulated
+        sim = simulate_cook(timeline, mode=args.mode, film_fps=FILM_FPS if args.film else 0.0)
+        doc["simulation"] = sim.to_dict()
     write_json(timeline_path, doc)
     if args.figure:
         _figure(doc, args.figure)
@@ -116,7 +124,39 @@ def run(args: argparse.Namespace) -> int:
     for b in timeline.burgers:
         if b.failure:
             print(f"flipkit: error: burger {b.burger.burger}: {b.failure}", file=sys.stderr)
+    if sim is not None:
+        return _report_simulation(sim, args)
     return 0 if timeline.ok else 1
+
+
+def _report_simulation(sim, args: argparse.Namespace) -> int:
+    """One line per simulated burger and a summary; the film; exit 0 all flipped and served."""
+    def s(v):
+        return "-" if v is None else f"{v:+.3f}"
+    for b in sim.burgers:
+        off = "-" if b.flip is None else "{:.1f}".format(100 * max(map(abs, b.flip.offset)))
+        dist = "-" if b.serve is None else f"{100 * b.serve.distance:.1f}"
+        print(f"simulated {b.burger}: flipped {'yes' if b.flipped else 'no'} (landing off "
+              f"{off} cm, {s(b.deviation_s['flip'])} s from its mark), served "
+              f"{'yes' if b.served else 'no'} ({dist} cm from its spot, "
+              f"{s(b.deviation_s['serve'])} s from its mark), knocked {1000 * b.knocked_m:.1f} "
+              f"mm{'' if b.ok else '; ' + b.failure}")
+    film = ""
+    if args.film:
+        replace_with(args.film, lambda tmp: write_cook_film(sim, tmp,
+                                                            progress=not args.no_progress))
+        film = f"; wrote {args.film}"
+    ok = sum(b.ok for b in sim.burgers)
+    near = ("-" if sim.min_distance_m == float("inf") else f"{100 * sim.min_distance_m:.1f} cm")
+    print(f"flipkit schedule: simulated ({sim.mode}) {ok} of {len(sim.burgers)} burgers "
+          f"flipped and served; closest lying burgers {near}; stepped {sim.stepped_s:.1f} s, "
+          f"skipped {sim.skipped_s:.1f} s idle, wall {sim.wall_s:.1f} s{film}")
+    bad = [b for b in sim.burgers if not b.ok]
+    if bad:
+        print(f"flipkit: error: simulated cook: {len(bad)} of {len(sim.burgers)} burgers not "
+              f"flipped and served; burger {bad[0].burger}: {bad[0].failure}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _modelled_stream(args, cell, atlas, executor, timeline_path: Path) -> int:

@@ -1,0 +1,242 @@
+"""A whole cook in one MuJoCo simulation: every motion of a schedule, in order, on one cell
+holding every burger.
+
+The scene is :func:`~flipkit.simulation.scene.build_scene` with one body per burger (and
+burger–burger contact). On the cook's clock (s, the timeline's):
+
+* a burger appears at its drop time, placed at rest on the grill at its drop position;
+  before that it is parked out of the cell (below the floor, held against gravity);
+* the arm runs the timeline's motions at their start times, each plan stepped by
+  :func:`~flipkit.simulation.control.step_references` with the controller of
+  :func:`~flipkit.simulation.execute.execute_plan` (default: position mode, compensated
+  commands — the robot's own servo; feed-forward as an option), from whatever state the
+  previous motion left (no reset: a burger lies where it landed, the arm where it stopped);
+* after a motion the arm holds its plan's last command for at least
+  :data:`~flipkit.simulation.execute.HOLD_S` (less when the next motion starts sooner), then
+  on while any burger or the arm still moves faster than :data:`REST_SPEED` (at most
+  :data:`MAX_SETTLE_S`);
+* a served burger is taken away (parked again) the table's dwell (``timeline.dwell_s``,
+  :data:`~flipkit.planning.kitchen.table.DWELL_S` by default) after its serve ends, and
+  not before its serve is judged (``HOLD_S`` after the serve).
+
+Idle intervals are skipped, not stepped: from the end of a motion's settling to the next
+motion's start the state is carried over unchanged (only the clock moves, and drops and
+take-aways happen at their times). This stands for stepping them because every body is at
+rest then — the arm holds home under its PD, each burger rests on a plate under static
+friction (``noslip``) — so stepping would leave the state where it is; the speeds at each
+skip are reported (:attr:`CookSimulation.skip_speed`), and ``step_idle=True`` steps them
+instead (the arm holding its last command), for comparison. A motion that starts less
+than one control step after the previous one's settling ends skips that fraction too.
+
+The burgers are judged one by one on their own trajectories
+(:mod:`flipkit.simulation.cook_judges`); a burger moved while it lay untouched by its own
+motions is reported as knocked (:mod:`flipkit.simulation.cook_record`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.model.robot import Robot
+from flipkit.planning.plans.servo_command import COMMANDS
+from flipkit.simulation.control import ArmController, plan_references, step_references
+from flipkit.simulation.cook_judges import BurgerResult, judge_burger
+from flipkit.simulation.cook_record import CookRecorder, Watch
+from flipkit.simulation.execute import HOLD_S
+from flipkit.simulation.modes import MODES, POSITION
+from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger, place_burger
+
+REST_SPEED = 1e-3  # m/s (burger centres) and rad/s (arm joints): "at rest" before a skip
+MAX_SETTLE_S = 5.0  # s after a motion's end: the longest the cell is stepped to come to rest
+
+
+class CookNotSimulatedError(ConfigError):
+    """A timeline that is not a solved cook (a failed plan, no motions): not simulated."""
+
+
+@dataclass
+class CookSimulation:
+    """A simulated cook.
+
+    Attributes:
+        burgers: One :class:`~flipkit.simulation.cook_judges.BurgerResult` per burger, in
+            drop order.
+        mode, command: The controller and position mode's command stream.
+        min_distance_m: Smallest centre distance (m, in the plane) between two burgers
+            lying on the grill or table (``inf``: never two at once).
+        stepped_s, skipped_s: Cook time stepped and skipped (s).
+        skip_speed: Largest burger speed (m/s) and arm joint speed (rad/s) when an idle
+            interval was skipped: ``{"burger_m_s", "arm_rad_s"}``.
+        wall_s: Wall time of the simulation (s).
+        frames: ``(cook time s, label, qpos)`` for the film (empty without ``film_fps``).
+        scene: The cell, in its final state.
+        runs: ``{(burger id, kind): BurgerRun}``: each burger's own trajectory over its flip
+            and serve windows, on times from the motion's start (what the judges read).
+    """
+
+    burgers: list[BurgerResult]
+    mode: str
+    command: str
+    min_distance_m: float
+    stepped_s: float
+    skipped_s: float
+    skip_speed: dict
+    wall_s: float
+    frames: list
+    scene: Scene
+    runs: dict
+
+    @property
+    def ok(self) -> bool:
+        """Every burger flipped and served."""
+        return all(b.ok for b in self.burgers)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (the timeline's ``simulation``)."""
+        return {"mode": self.mode, "command": self.command, "ok": self.ok,
+                "burgers": [b.to_dict() for b in self.burgers],
+                "min_distance_m": (None if not np.isfinite(self.min_distance_m)
+                                   else round(self.min_distance_m, 6)),
+                "stepped_s": round(self.stepped_s, 3), "skipped_s": round(self.skipped_s, 3),
+                "skip_speed": {k: float(f"{v:.3g}") for k, v in self.skip_speed.items()},
+                "wall_s": round(self.wall_s, 2)}
+
+
+def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) -> list:
+    if mode not in MODES:
+        raise InvalidChoiceError("execution mode", mode, MODES)
+    if command not in COMMANDS:
+        raise InvalidChoiceError("position command", command, COMMANDS)
+    if not timeline.motions or not timeline.ok:
+        bad = next((m for m in timeline.motions if not m.ok), None)
+        raise CookNotSimulatedError(
+            "a failed schedule is not simulated" + (f": {bad.key}: {bad.failure}" if bad else
+                                                    ": it has no motions"))
+    if any(m.plan is None for m in timeline.motions):
+        raise CookNotSimulatedError("the timeline holds no plans (read from JSON?): "
+                                    "nothing to simulate")
+    return list(timeline.motions)
+
+
+def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated",
+                  cell: CellConfig | None = None, rate_hz: float = 1000.0,
+                  film_fps: float = 0.0, step_idle: bool = False) -> CookSimulation:
+    """Simulate the whole cook of ``timeline`` (module docstring).
+
+    Args:
+        timeline: A solved :class:`~flipkit.planning.kitchen.schedule.Timeline` with its
+            plans (``MotionRecord.plan``).
+        mode, command: The controller (:data:`~flipkit.simulation.modes.MODES`) and
+            position mode's commands, as :func:`~flipkit.simulation.execute.execute_plan`.
+        cell: The simulated cell; default the first plan's (``plan.cell()``).
+        rate_hz: Joint controller rate (Hz).
+        film_fps: Keep a frame every 1/film_fps s of stepped cook time (0: none).
+        step_idle: Step the idle intervals instead of skipping them.
+
+    Raises:
+        CookNotSimulatedError: A failed schedule or one without plans.
+        InvalidChoiceError: Unknown mode or command.
+    """
+    started = time.perf_counter()
+    motions = _check(timeline, mode, command)
+    cell = cell or motions[0].plan.cell()
+    robot = Robot(cell, with_burger=False)
+    records = timeline.burgers
+    index = {b.burger.burger: k for k, b in enumerate(records)}
+    n = len(records)
+    scene = build_scene(robot, cell, burgers=n)
+    m, d = scene.model, scene.data
+    control = ArmController.of(robot, cell.physics, mode, rate_hz, m.opt.timestep)
+    dt = control.substeps * m.opt.timestep
+    watches = [Watch(index[mo.burger], mo.kind, mo.start, mo.end + HOLD_S) for mo in motions]
+    rec = CookRecorder(scene, watches, dt, film_fps)
+    events = sorted([(b.burger.t_drop, 0, k) for k, b in enumerate(records)]
+                    + [(max(mo.end + timeline.dwell_s, mo.end + HOLD_S), 1, index[mo.burger])
+                       for mo in motions if mo.kind == "serve"])
+
+    def apply_events(t: float) -> None:
+        while events and events[0][0] <= t + 1e-9:
+            _, away, k = events.pop(0)
+            if away and n > 1:
+                park_burger(scene, k)
+                rec.removed(k)
+            elif not away:
+                b = records[k].burger
+                place_burger(scene, (b.x, b.y), burger=k)
+                rec.placed(k)
+
+    d.qpos[:ARM_JOINTS] = motions[0].plan.segments[0].q[0]
+    d.qvel[:] = 0.0
+    mujoco.mj_forward(m, d)
+    now = min(b.burger.t_drop for b in records)
+    stepped = skipped = 0.0
+    speed = {"burger_m_s": 0.0, "arm_rad_s": 0.0}
+    refs_of = {}
+    for i, mo in enumerate(motions):
+        if mo.start > now + 1e-9:  # idle: skipped (module docstring)
+            _note_speed(scene, rec, speed)
+            skipped += mo.start - now
+        apply_events(mo.start)
+        rec.skipped_to(mo.start)
+        nxt = motions[i + 1].start if i + 1 < len(motions) else np.inf
+        T = float(sum(s.T for s in mo.plan.segments))
+        gap = nxt - mo.end
+        hold = gap if step_idle and np.isfinite(gap) else min(max(gap, 0.0), MAX_SETTLE_S)
+        refs = plan_references(mo.plan, robot, cell.physics, mode, command, dt, hold)
+        refs_of[i] = refs
+        d.time = mo.start
+
+        def hook(k, refs, mo=mo):
+            apply_events(mo.start + refs.t[k])
+
+        def stop(k, refs, mo=mo, nxt=nxt, T=T):
+            if mo.start + (k + 1) * dt > nxt + 1e-9:  # the next motion starts
+                return True
+            return (not step_idle and refs.t[k] >= T + HOLD_S - 1e-9
+                    and _at_rest(scene, rec.active))
+
+        def record(k, q, u, mo=mo, refs=refs):
+            rec.sample(mo.start + refs.t[k], mo.key)
+
+        _, steps = step_references(scene, control, refs, record, hook, stop)
+        stepped += steps * dt
+        now = mo.start + steps * dt
+    results, all_runs = [], {}
+    for k, b in enumerate(records):
+        runs = {}
+        for i, (mo, w) in enumerate(zip(motions, watches)):
+            if w.burger == k:
+                runs[mo.kind] = (mo.plan, w.run(scene, mo.start), refs_of[i].bounds, mo.start)
+                all_runs[(mo.burger, mo.kind)] = runs[mo.kind][1]
+        results.append(judge_burger(b, runs.get("flip"), runs.get("serve"), cell.table,
+                                    rec.knocked_m[k], rec.contact_s[k]))
+    return CookSimulation(results, mode, command, rec.min_distance_m, stepped, skipped, speed,
+                          time.perf_counter() - started, rec.frames, scene, all_runs)
+
+
+def _at_rest(scene: Scene, active: np.ndarray) -> bool:
+    """Every placed burger slower than :data:`REST_SPEED` (m/s), every arm joint too (rad/s)."""
+    d = scene.data
+    if np.abs(d.qvel[:ARM_JOINTS]).max() >= REST_SPEED:
+        return False
+    return all(np.linalg.norm(d.qvel[scene.qvel_of(k)][:3]) < REST_SPEED
+               for k in np.flatnonzero(active))
+
+
+def _note_speed(scene: Scene, rec: CookRecorder, speed: dict) -> None:
+    """Keep the largest burger (m/s) and arm joint (rad/s) speeds seen at a skip."""
+    d = scene.data
+    speed["arm_rad_s"] = max(speed["arm_rad_s"], float(np.abs(d.qvel[:ARM_JOINTS]).max()))
+    for k in np.flatnonzero(rec.active):
+        speed["burger_m_s"] = max(speed["burger_m_s"],
+                                  float(np.linalg.norm(d.qvel[scene.qvel_of(k)][:3])))
+
+
+__all__ = ["MAX_SETTLE_S", "REST_SPEED", "CookNotSimulatedError", "CookSimulation",
+           "simulate_cook"]

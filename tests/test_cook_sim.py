@@ -1,0 +1,200 @@
+"""The whole cook in one MuJoCo simulation (flipkit.simulation.cook): the several-burger scene,
+a two-burger cook with real plans run end to end (API and ``flipkit schedule --simulate
+--film``), each burger judged on its own trajectory, drops and take-aways at their times,
+and the refusals (a failed or refused schedule is never simulated)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import mujoco
+import numpy as np
+import pytest
+
+from flipkit import cli
+from flipkit.config import CellConfig
+from flipkit.planning.kitchen import motions
+from flipkit.planning.kitchen.cook import CookBurger
+from flipkit.planning.kitchen.motions import PlannedMotion, cached_planners, default_planners
+from flipkit.planning.kitchen.schedule import schedule_cook
+from flipkit.planning.kitchen.windows import Windows
+from flipkit.simulation.cook import CookNotSimulatedError, simulate_cook
+from flipkit.simulation.scene import PARK_ORIGIN, build_scene, park_burger, place_burger
+
+CELL = CellConfig()
+# Two burgers whose approach lines from the arm do not cross (issue: a scoop runs over a
+# burger lying between the arm and its target), drops 20 s apart, wide windows.
+ORDER = [CookBurger("b1", 0.0, 0.69, -0.16), CookBurger("b2", 20.0, 0.75, -0.45)]
+WIDE = Windows(flip=(0.0, 5.0), serve=(0.0, 5.0))
+CSV = "burger,t_drop,x,y\n" + "".join(f"{b.burger},{b.t_drop:g},{b.x},{b.y}\n" for b in ORDER)
+
+
+# ---------------------------------------------------------------- the scene
+def test_several_burgers_have_their_own_pairs_and_stay_parked_until_placed():
+    scene = build_scene(burgers=3)
+    m, d = scene.model, scene.data
+    names = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PAIR, i) for i in range(m.npair)}
+    for k in range(3):
+        assert {f"burger_{k}_blade", f"burger_{k}_grill", f"burger_{k}_table"} <= names
+    assert {"burger_0_burger_1", "burger_0_burger_2", "burger_1_burger_2"} <= names
+    place_burger(scene, (0.7, -0.2), burger=1)
+    mujoco.mj_step(m, d, nstep=400)  # 0.2 s
+    parked = d.qpos[scene.qpos_of(0)][:3]
+    assert np.allclose(parked, PARK_ORIGIN, atol=1e-9)  # held against gravity, untouched
+    on = d.qpos[scene.qpos_of(1)][:3]
+    assert np.allclose(on[:2], (0.7, -0.2), atol=1e-6)
+    assert on[2] == pytest.approx(scene.grill_height + CELL.burger.thickness / 2, abs=1e-3)
+    park_burger(scene, 1)
+    assert np.allclose(d.qpos[scene.qpos_of(1)][:3], np.add(PARK_ORIGIN, (0.2, 0, 0)))
+
+
+def test_one_burger_scene_is_unchanged():
+    scene = build_scene()
+    assert "burger" in scene.geoms and len(scene.burger_bodies) == 1
+    with pytest.raises(Exception, match="several"):
+        park_burger(scene, 0)
+
+
+# ---------------------------------------------------------------- a two-burger cook
+@pytest.fixture(scope="module")
+def planners():
+    return cached_planners(default_planners(cell=CELL))
+
+
+@pytest.fixture(scope="module")
+def timeline(planners):
+    tl = schedule_cook(ORDER, planners, CELL.robot.q_home, cell=CELL, windows=WIDE)
+    assert tl.ok
+    return tl
+
+
+@pytest.fixture(scope="module")
+def simulated(timeline):
+    return simulate_cook(timeline, film_fps=15.0)
+
+
+@pytest.mark.slow
+def test_two_burgers_are_flipped_and_served_in_one_simulation(simulated, timeline):
+    assert [b.burger for b in simulated.burgers] == ["b1", "b2"]
+    for b in simulated.burgers:
+        assert b.flipped, b.failure
+        assert b.flip.upside_down and max(map(abs, b.flip.offset)) <= 0.05
+        # the simulated landing lies within a control step or two of the planned one
+        assert abs(b.deviation_s["flip"] - b.planned_deviation_s["flip"]) < 0.05
+        assert b.knocked_m < 0.01  # (b2 placed beside b1 on the table touches it: reported)
+    # the idle intervals (the 90 s and 60 s waits) are skipped, at rest
+    assert simulated.skipped_s > 100 and simulated.stepped_s < 40
+    assert simulated.skip_speed["burger_m_s"] < 1e-3 and simulated.skip_speed["arm_rad_s"] < 1e-3
+    assert simulated.min_distance_m > CELL.burger.diameter
+
+
+@pytest.mark.slow
+def test_each_burger_is_judged_on_its_own_trajectory(simulated, timeline):
+    for rec in timeline.burgers:
+        b = rec.burger
+        flip, serve = simulated.runs[(b.burger, "flip")], simulated.runs[(b.burger, "serve")]
+        assert np.allclose(flip.burger_pos[0, :2], (b.x, b.y), atol=1e-3)  # its drop position
+        assert flip.up_z[0] > 0.99 and flip.up_z[-1] < -0.99
+        assert np.allclose(serve.burger_pos[0], flip.burger_pos[-1], atol=2e-3)  # lay still
+        res = next(r for r in simulated.burgers if r.burger == b.burger)
+        assert np.allclose(np.add(res.flip.offset, rec.landing), flip.burger_pos[-1, :2],
+                           atol=0.02)
+        assert res.serve.distance == pytest.approx(
+            np.linalg.norm(serve.burger_pos[-1, :2] - np.asarray(rec.table_spot)), abs=1e-9)
+        assert res.served == (res.serve.distance <= 0.03 and res.serve.upright
+                              and res.serve.on_table and res.serve.at_rest)
+
+
+@pytest.mark.slow
+def test_a_burger_dropped_later_is_parked_before_its_drop(timeline):
+    flips = [m for m in timeline.motions if m.kind == "flip"]
+    t_drop = flips[0].start + 1.0  # b2 dropped during b1's flip
+    late = replace(timeline, motions=flips, burgers=[
+        timeline.burgers[0], replace(timeline.burgers[1], burger=replace(
+            timeline.burgers[1].burger, t_drop=t_drop))])
+    sim = simulate_cook(late, film_fps=50.0)
+    scene = sim.scene
+    before = [q for t, _, q in sim.frames if t < t_drop - 0.02]
+    after = [q for t, _, q in sim.frames if t_drop + 0.02 < t < flips[1].start]
+    assert before and after
+    assert all(q[scene.qpos_of(1)][2] < -1.0 for q in before)  # parked below the floor
+    b2 = timeline.burgers[1].burger
+    assert all(np.allclose(q[scene.qpos_of(1)][:2], (b2.x, b2.y), atol=1e-3) for q in after)
+
+
+@pytest.mark.slow
+def test_cli_simulates_the_cook_and_films_it(planners, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None: {
+        k: v for k, v in planners.items() if k in kinds})  # the fixture's plans, not again
+    path, out, film = tmp_path / "order.csv", tmp_path / "t.json", tmp_path / "cook.gif"
+    path.write_text(CSV)
+    code = cli.main(["schedule", str(path), "--json", str(out), "--no-progress", "--workers",
+                     "1", "--window", "flip=0,5", "--window", "serve=0,5", "--simulate",
+                     "--film", str(film)])
+    captured = capsys.readouterr()
+    lines = [ln for ln in captured.out.splitlines() if ln.startswith("simulated ")]
+    doc = json.loads(out.read_text())
+    sim = doc["simulation"]
+    assert [ln.split()[1].rstrip(":") for ln in lines] == ["b1", "b2"]
+    assert code == (0 if sim["ok"] else 1)
+    assert [b["burger"] for b in sim["burgers"]] == ["b1", "b2"]
+    assert all(b["flipped"] for b in sim["burgers"])
+    err = captured.err.strip().splitlines()
+    assert err == [] if sim["ok"] else (len(err) == 1 and "simulated cook" in err[0])
+    assert film.read_bytes()[:6] in (b"GIF89a", b"GIF87a") and film.stat().st_size > 10000
+
+
+# ---------------------------------------------------------------- refusals
+def _stub(monkeypatch, fail=()):
+    def planner(kind, duration, event):
+        def plan(job, q_start):
+            ok = (kind, job.burger) not in fail
+            return PlannedMotion(ok=ok, duration_s=duration, event_s=event,
+                                 q_end=np.asarray(q_start, float), planning_time_s=0.1,
+                                 landing=(job.location[0], job.location[1])
+                                 if kind == "flip" else None,
+                                 failure=None if ok else "scoop: test failure")
+        return plan
+    stubs = {"flip": planner("flip", 3.4, 2.2), "serve": planner("serve", 5.0, 1.5)}
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None: {
+        k: stubs[k] for k in kinds})
+
+
+@pytest.mark.parametrize("drops, fail, expect", [
+    ((0, 1), (), "beyond its window"),  # the second flip cannot land within 2 s of its mark
+    ((0, 30), (("flip", "b2"),), "burger b2: flip: scoop: test failure"),
+])
+def test_a_refused_or_failed_schedule_is_not_simulated(drops, fail, expect, tmp_path, capsys,
+                                                      monkeypatch):
+    _stub(monkeypatch, fail)
+    path = tmp_path / "order.csv"
+    path.write_text("burger,t_drop,x,y\n" + "".join(
+        f"b{k + 1},{t},{0.65 + 0.15 * k},-0.3\n" for k, t in enumerate(drops)))
+    code = cli.main(["schedule", str(path), "--json", str(tmp_path / "t.json"), "--workers",
+                     "1", "--policy", "greedy", "--no-progress", "--simulate"])
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert code == 1 and len(err) == 1 and expect in err[0]
+    assert "simulated" not in captured.out
+
+
+def test_simulate_cook_refuses_a_failed_timeline(monkeypatch):
+    _stub(monkeypatch, (("flip", "b1"),))
+    tl = schedule_cook(ORDER[:1], motions.default_planners(("flip", "serve"), CELL, "auto"),
+                       CELL.robot.q_home, cell=CELL)
+    with pytest.raises(CookNotSimulatedError, match="not simulated"):
+        simulate_cook(tl)
+
+
+@pytest.mark.parametrize("argv, expect", [
+    (["--film", "x.gif"], "--film and --mode go with --simulate"),
+    (["--simulate", "--film", "x.avi"], "unknown output format"),
+])
+def test_bad_simulation_options_are_one_line_and_exit_2(argv, expect, tmp_path, capsys):
+    path = tmp_path / "order.csv"
+    path.write_text(CSV)
+    argv = [a if a not in ("x.gif", "x.avi") else str(tmp_path / a) for a in argv]
+    code = cli.main(["schedule", str(path), "--json", str(tmp_path / "t.json")] + argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and expect in err[0]
