@@ -14,7 +14,8 @@ from flipkit import figures
 
 # The figures of the report (paper/main.tex), in its order.
 REPORT_FIGURE_IDS = ("cell", "forces", "subbehaviors", "defects", "translate", "flip", "table1",
-                     "ik_failure", "solve_times", "cone_forms", "landing", "filmstrip",
+                     "ik_failure", "solve_times", "solve_scaling", "cone_forms", "landing",
+                     "filmstrip",
                      "sensitivity", "schedule", "throughput")
 PAPER_DIR = figures.REPO_ROOT / "paper"
 MAIN_TEX = PAPER_DIR / "main.tex"

@@ -129,7 +129,9 @@ def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
     return solvers, build
 
 
-def _translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
+def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
+    """The six translate segments between :data:`TRANSLATE_KEY_POINTS`, each to the next,
+    as NLPs built with ``options`` (each start pose by IK from q_home)."""
     models = models_for(cell)
     robot = models.for_segment("translate")
     pts, nlps = TRANSLATE_KEY_POINTS, []
@@ -152,7 +154,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         jit: Compile FATROP's and exact IPOPT's functions to C (CasADi JIT).
     """
     names = NLP_SOLVERS if full else tuple(TRANSLATE_SOLVERS)
-    nlps = _translate_nlps(cell, SegmentOptions(arm_clearance=full))
+    nlps = translate_nlps(cell, SegmentOptions(arm_clearance=full))
     print(machine())
     print(f"problem: translate NLP {'with' if full else 'without'} the arm's clearance rows"
           f"{'' if full else ' (no symbolic form: left out for every solver)'}; "
