@@ -281,7 +281,8 @@ def plan_targets(locations, solver: str = "auto", executor=None, progress: bool 
     (:func:`flipkit.figures.pipeline.sweep_cache`).
     """
     jobs = [{"location": [float(v) for v in loc], "solver": solver} for loc in locations]
-    infos = run_sweep(plan_location_text, jobs, executor, cache_dir, progress=progress, desc="plans")
+    infos = run_sweep(plan_location_text, jobs, executor, cache_dir, progress=progress,
+                      desc="plans")
     return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},
              r["text"] if r["status"] == "solved" else None) for job, r in zip(jobs, infos)]
 
@@ -364,5 +365,5 @@ def ik_example(location, plans_dir=None, solver: str = "auto") -> dict:
 
 
 __all__ = ["chain_translates", "Tracked", "track_plan", "nominal_trial", "flip_solve_times",
-           "solve_workers", "solve_time_sweep", "solve_time_table", "plan_location_text", "plan_targets", "flip_execution",
-           "example_location", "ik_example"]
+           "solve_workers", "solve_time_sweep", "solve_time_table", "plan_location_text",
+           "plan_targets", "flip_execution", "example_location", "ik_example"]
