@@ -22,6 +22,10 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.bench import TRANSLATE_SOLVERS, translate_nlps, warm_up
 from flipkit.experiments.sweep import run_sweep
+from flipkit.planning.planners.chain import solve_segment
+from flipkit.solvers.exact import ExactSolver
+from flipkit.solvers.names import EXACT_RESULT_NAMES
+from flipkit.transcription.ocp_graph import OcpGraph
 
 SCALING_N = (10, 20, 40, 80)  # intervals per segment (the paper: 20)
 
@@ -37,11 +41,6 @@ def scaling_item(item: dict) -> dict:
         ``[{"segment", "status", "time_s" (the solver call alone), "iterations",
         "objective" (Σu²)}]``.
     """
-    from flipkit.planning.planners.chain import solve_segment
-    from flipkit.solvers.exact import ExactSolver
-    from flipkit.solvers.names import EXACT_RESULT_NAMES
-    from flipkit.transcription.ocp_graph import OcpGraph
-
     n, solver = int(item["N"]), str(item["solver"])
     nlps = translate_nlps(CellConfig(), SegmentOptions(N=n, arm_clearance=False))
     nlps = nlps[:int(item["segments"])]
