@@ -287,3 +287,22 @@ def test_cli_cpsat_with_the_real_flip_planner(tmp_path, capsys):
     assert doc["solver"]["status"] == "optimal" and m["status"] == "solved"
     assert 0.0 <= b["deviation_s"]["flip"] <= 2e-3
     assert (tmp_path / m["plan"]).is_file()
+
+
+def test_a_hung_child_is_reported_after_the_scaled_wall_bound(monkeypatch):
+    import subprocess
+
+    from flipkit.planning.kitchen import cpsat_process
+
+    asked = {}
+
+    def hang(*args, timeout, **kwargs):
+        asked["timeout"] = timeout
+        raise subprocess.TimeoutExpired(args[0], timeout)
+
+    monkeypatch.setattr(cpsat_process.subprocess, "run", hang)
+    job = BurgerJob("b1", 0.0, MotionTimes(3.0, 1.0), MotionTimes(5.0, 2.0), 0.0)
+    with pytest.raises(cpsat_process.CpSatProcessError, match="did not answer within 360 s"):
+        solve_schedule([job], time_limit_s=10.0)
+    # deterministic seconds are not wall seconds: a loaded machine needs many times more
+    assert asked["timeout"] == cpsat_process.wall_bound(10.0) > 10 * 10.0

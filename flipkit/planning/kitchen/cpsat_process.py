@@ -24,7 +24,16 @@ from flipkit.planning.kitchen.cpsat import (BurgerJob, CpSatSchedule, MotionTime
                                             ScheduleTimeoutError, check_jobs, solve_here)
 from flipkit.planning.kitchen.windows import WindowBreak, Windows
 
-CHILD_MARGIN_S = 60.0  # s the child process may take beyond the time limit (start-up)
+# The child's wall-time bound only detects a hung child. Its work is bounded in CP-SAT's
+# deterministic time (about seconds on one idle core), and the same work takes several times
+# longer on a loaded machine: at load 4-5 on two cores a 10 s limit overran 70 s of wall time.
+CHILD_WALL_FACTOR = 30.0  # wall s allowed per deterministic s of the limit
+CHILD_MARGIN_S = 60.0  # s beyond that (start-up, building the model)
+
+
+def wall_bound(time_limit_s: float) -> float:
+    """Wall time (s) after which the child counts as hung, for a deterministic-time limit."""
+    return CHILD_WALL_FACTOR * time_limit_s + CHILD_MARGIN_S
 
 
 class CpSatProcessError(FlipkitError):
@@ -40,7 +49,8 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
 
     Args:
         windows: Event windows. dwell_s: Table dwell (s). earliest_s: No motion before (s).
-        time_limit_s: Wall-time limit for all solves together (s).
+        time_limit_s: Limit for all solves together, in CP-SAT's deterministic time (about
+            seconds on one idle core); the child is given :func:`wall_bound` of wall time.
         workers: CP-SAT search workers. seed: CP-SAT random seed.
         relax: The first objective when the windows cannot be met: "max" or "count".
 
@@ -62,10 +72,10 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
     try:
         run = subprocess.run([sys.executable, "-m", __name__], input=json.dumps(problem),
                              capture_output=True, text=True,
-                             timeout=time_limit_s + CHILD_MARGIN_S)
+                             timeout=wall_bound(time_limit_s))
     except subprocess.TimeoutExpired:
         raise CpSatProcessError(f"the CP-SAT process did not answer within "
-                                f"{time_limit_s + CHILD_MARGIN_S:g} s") from None
+                                f"{wall_bound(time_limit_s):g} s") from None
     if run.returncode != 0:
         last = (run.stderr.strip().splitlines() or ["no message"])[-1]
         raise CpSatProcessError(f"the CP-SAT process failed (exit {run.returncode}): {last}")
