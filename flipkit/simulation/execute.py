@@ -24,6 +24,8 @@ draw; the plan's feed-forward ignores it. After the plan the last desired state 
 
 from __future__ import annotations
 
+import hashlib
+
 import time
 from dataclasses import dataclass, replace
 
@@ -240,32 +242,64 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
 
 
 def _record(scene: Scene, rec: dict, k: int, burger_body: int, f6: np.ndarray) -> None:
-    """Poses and contacts at the current state (contacts of the last mj_step)."""
+    """Poses and contacts at the current state (contacts of the last mj_step).
+
+    A contact's normal force is its first ``efc_force`` row: with elliptic cones (the scene's)
+    that is what ``mj_contactForce`` returns, read here without a call per contact; a contact
+    without constraint rows (``efc_address`` −1) has none. Forces are summed in contact order.
+    """
     m, d, g = scene.model, scene.data, scene.geoms
     rec["sp"][k], rec["sr"][k] = scene.blade_pose()
     rec["bp"][k], rec["br"][k] = d.xpos[burger_body], d.xmat[burger_body].reshape(3, 3)
-    for i in range(d.ncon):
-        c = d.contact[i]
-        pair = {int(c.geom[0]), int(c.geom[1])}
-        mujoco.mj_contactForce(m, d, i, f6)
-        if pair == {g["burger"], g["blade"]}:
-            rec["ts"][k], rec["fs"][k] = True, rec["fs"][k] + f6[0]
-        elif pair == {g["burger"], g["grill"]}:
-            rec["tg"][k], rec["fg"][k] = True, rec["fg"][k] + f6[0]
-        elif pair == {g["blade"], g["grill"]}:
-            rec["fbg"][k] += f6[0]
+    if d.ncon == 0:
+        return
+    slots = {tuple(sorted((g["burger"], g["blade"]))): ("ts", "fs"),
+             tuple(sorted((g["burger"], g["grill"]))): ("tg", "fg"),
+             tuple(sorted((g["blade"], g["grill"]))): (None, "fbg")}
+    efc = d.efc_force
+    for (a, b), adr in zip(d.contact.geom.tolist(), d.contact.efc_address.tolist()):
+        slot = slots.get((a, b) if a < b else (b, a))
+        if slot is None:
+            continue
+        touch, key = slot
+        if touch is not None:
+            rec[touch][k] = True
+        rec[key][k] = rec[key][k] + (efc[adr] if adr >= 0 else 0.0)
 
 
 def _errors(robot, t, q, q_des, bounds) -> dict:
     """Per-segment spatula position error against the plan (m)."""
-    e = np.array([np.linalg.norm(robot.placement(a).translation
-                                 - robot.placement(b).translation) for a, b in zip(q, q_des)])
+    e = np.array([np.linalg.norm(a - b)
+                  for a, b in zip(_positions(robot, q), _desired_positions(robot, q_des))])
     out = {}
     for name, (t0, t1) in bounds.items():
         sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
         out[name] = {"max_m": float(e[sel].max()), "sum_sq_m2": float(np.sum(e[sel] ** 2)),
                      "n": int(sel.sum())}
     return out
+
+
+def _positions(robot, q) -> np.ndarray:
+    """Blade-centre positions (m) at each row of q."""
+    return np.array([robot.placement(a).translation for a in q])
+
+
+_DESIRED: dict = {}  # digest of a desired path -> its positions: every trial of a plan has it
+
+
+def _desired_positions(robot, q_des) -> np.ndarray:
+    """:func:`_positions` of a desired path, kept for the trials of the same plan (keyed by
+    the path's bytes and the arm's kinematics: joint placements and the spatula's)."""
+    q_des = np.ascontiguousarray(q_des, dtype=float)
+    kinematics = np.concatenate([robot.spatula_in_joint.homogeneous.ravel()] + [
+        placement.homogeneous.ravel() for placement in robot.model.jointPlacements])
+    key = (hashlib.sha1(q_des.tobytes()).hexdigest(), q_des.shape,
+           hashlib.sha1(kinematics.tobytes()).hexdigest())
+    if key not in _DESIRED:
+        if len(_DESIRED) >= 16:
+            _DESIRED.pop(next(iter(_DESIRED)))
+        _DESIRED[key] = _positions(robot, q_des)
+    return _DESIRED[key]
 
 
 __all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "NO_DRAW", "Execution", "execute_plan"]
