@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import mujoco
 import numpy as np
 
 from flipkit.simulation.run import BurgerRun
@@ -69,7 +68,6 @@ class CookRecorder:
         self.frames: list = []
         self.next_frame = -np.inf
         self._open = np.zeros(n, bool)
-        self._f6 = np.zeros(6)
 
     def placed(self, k: int) -> None:
         """Burger k was put into the cell (at rest): it lies there from now on."""
@@ -124,12 +122,10 @@ class CookRecorder:
     def _contacts(self) -> list:
         """Per burger ``[touch blade, touch grill, blade force N, grill force N]`` of the last
         step's contacts; burger–burger contact time accumulated."""
-        sc, d, g = self.scene, self.scene.data, self.scene.geoms
+        sc, g = self.scene, self.scene.geoms
         out = [[False, False, 0.0, 0.0] for _ in sc.burger_bodies]
         touching = set()
-        for i in range(d.ncon):
-            c = d.contact[i]
-            a, b = int(c.geom[0]), int(c.geom[1])
+        for a, b, force in sc.contacts():
             ka, kb = self.owner[a], self.owner[b]
             if ka >= 0 and kb >= 0:
                 touching.update((int(ka), int(kb)))
@@ -137,10 +133,9 @@ class CookRecorder:
             k, other = (ka, b) if ka >= 0 else (kb, a)
             if k < 0 or other not in (g["blade"], g["grill"]):
                 continue
-            mujoco.mj_contactForce(sc.model, d, i, self._f6)
             j = 0 if other == g["blade"] else 1
             out[k][j] = True
-            out[k][j + 2] += self._f6[0]
+            out[k][j + 2] += force
         for k in touching:
             self.contact_s[k] += self.dt
         return out

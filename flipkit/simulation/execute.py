@@ -180,7 +180,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     rec.update({k: np.zeros(N, bool) for k in ("ts", "tg")})
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = m.geom_bodyid[scene.geoms["burger"]]
-    f6 = np.zeros(6)
+    slots = _slots(scene.geoms)
     sense = {"sensed": None, "failure": None, "time": None, "plan": plan}
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
     thick = cell.spatula.thickness
@@ -222,7 +222,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
 
     def record(k: int, q: np.ndarray, u: np.ndarray) -> None:
         qa[k], ua[k], qpos[k] = q, u, d.qpos
-        _record(scene, rec, k, burger_body, f6)
+        _record(scene, rec, k, burger_body, slots)
 
     refs, _ = step_references(scene, control, refs, record,
                               sense_and_replan if replan is not None else None)
@@ -241,30 +241,28 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                      replan_time)
 
 
-def _record(scene: Scene, rec: dict, k: int, burger_body: int, f6: np.ndarray) -> None:
-    """Poses and contacts at the current state (contacts of the last mj_step).
-
-    A contact's normal force is its first ``efc_force`` row: with elliptic cones (the scene's)
-    that is what ``mj_contactForce`` returns, read here without a call per contact; a contact
-    without constraint rows (``efc_address`` −1) has none. Forces are summed in contact order.
-    """
-    m, d, g = scene.model, scene.data, scene.geoms
+def _record(scene: Scene, rec: dict, k: int, burger_body: int, slots: dict) -> None:
+    """Poses and contacts at the current state (contacts of the last mj_step); ``slots``
+    maps a recorded geom pair (sorted) to its (touch flag, force) record keys
+    (:func:`_slots`). Forces are summed in contact order."""
+    d = scene.data
     rec["sp"][k], rec["sr"][k] = scene.blade_pose()
     rec["bp"][k], rec["br"][k] = d.xpos[burger_body], d.xmat[burger_body].reshape(3, 3)
-    if d.ncon == 0:
-        return
-    slots = {tuple(sorted((g["burger"], g["blade"]))): ("ts", "fs"),
-             tuple(sorted((g["burger"], g["grill"]))): ("tg", "fg"),
-             tuple(sorted((g["blade"], g["grill"]))): (None, "fbg")}
-    efc = d.efc_force
-    for (a, b), adr in zip(d.contact.geom.tolist(), d.contact.efc_address.tolist()):
+    for a, b, force in scene.contacts():
         slot = slots.get((a, b) if a < b else (b, a))
         if slot is None:
             continue
         touch, key = slot
         if touch is not None:
             rec[touch][k] = True
-        rec[key][k] = rec[key][k] + (efc[adr] if adr >= 0 else 0.0)
+        rec[key][k] = rec[key][k] + force
+
+
+def _slots(geoms: dict) -> dict:
+    """The recorded pairs of :func:`_record`: burger–blade, burger–grill, blade–grill."""
+    return {tuple(sorted((geoms["burger"], geoms["blade"]))): ("ts", "fs"),
+            tuple(sorted((geoms["burger"], geoms["grill"]))): ("tg", "fg"),
+            tuple(sorted((geoms["blade"], geoms["grill"]))): (None, "fbg")}
 
 
 def _errors(robot, t, q, q_des, bounds) -> dict:

@@ -144,6 +144,20 @@ class Scene:
     burger_qpos = slice(ARM_JOINTS, ARM_JOINTS + 7)  # class constants, not fields
     burger_qvel = slice(ARM_JOINTS, ARM_JOINTS + 6)
 
+    def contacts(self) -> list[tuple[int, int, float]]:
+        """(geom, geom, normal force N) of each contact of the last step, in contact order.
+
+        The normal force is the contact's first ``efc_force`` row: with the scene's elliptic
+        cones that is what ``mj_contactForce`` returns, read without a call per contact; a
+        contact without constraint rows (``efc_address`` −1) has none.
+        """
+        d = self.data
+        if d.ncon == 0:
+            return []
+        efc = d.efc_force
+        return [(a, b, efc[adr] if adr >= 0 else 0.0)
+                for (a, b), adr in zip(d.contact.geom.tolist(), d.contact.efc_address.tolist())]
+
     def blade_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """World position (m) and rotation of the spatula frame (after mj_kinematics)."""
         return (self.data.site_xpos[self.blade_site].copy(),
