@@ -134,8 +134,8 @@ class ArmController:
         """Joint torques (N·m) at sample k of ``refs`` from the measured q (rad), q̇ (rad/s)."""
         ff = refs.u_ff[k] if self.mode == FEEDFORWARD else pin.computeGeneralizedGravity(
             self.robot.model, self.robot.data, q)
-        return np.clip(ff + self.kp * (refs.q_cmd[k] - q) + self.kd * (refs.qd_cmd[k] - qd),
-                       -self.u_max, self.u_max)
+        u = ff + self.kp * (refs.q_cmd[k] - q) + self.kd * (refs.qd_cmd[k] - qd)
+        return np.minimum(np.maximum(u, -self.u_max, out=u), self.u_max, out=u)  # np.clip
 
 
 def step_references(scene: Scene, control: ArmController, refs: References,

@@ -41,6 +41,7 @@ from flipkit.simulation.control import (ArmController, References, plan_referenc
                                         step_references)
 from flipkit.simulation.modes import FEEDFORWARD, MODES
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
+from flipkit.simulation.trace import BurgerTrace
 
 HOLD_S = 1.0  # s after the plan: the flipped burger lands
 # The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
@@ -174,13 +175,9 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     d.qvel[:ARM_JOINTS] = refs.qd_des[0]
     mujoco.mj_forward(m, d)
     N = len(refs.t) if replan is None else 3 * len(refs.t)  # room for the pause and a longer tail
-    rec = {k: np.zeros((N, 3)) for k in ("bp", "sp")}
-    rec.update({k: np.zeros((N, 3, 3)) for k in ("br", "sr")})
-    rec.update({k: np.zeros(N) for k in ("fs", "fg", "fbg")})
-    rec.update({k: np.zeros(N, bool) for k in ("ts", "tg")})
+    trace = BurgerTrace(scene, N)
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
-    burger_body = m.geom_bodyid[scene.geoms["burger"]]
-    slots = _slots(scene.geoms)
+    burger_body = trace.burger_body
     sense = {"sensed": None, "failure": None, "time": None, "plan": plan}
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
     thick = cell.spatula.thickness
@@ -222,7 +219,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
 
     def record(k: int, q: np.ndarray, u: np.ndarray) -> None:
         qa[k], ua[k], qpos[k] = q, u, d.qpos
-        _record(scene, rec, k, burger_body, slots)
+        trace(k)
 
     refs, _ = step_references(scene, control, refs, record,
                               sense_and_replan if replan is not None else None)
@@ -230,45 +227,20 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     replan_failure, replan_time = sense["failure"], sense["time"]
     t, q_des, bounds = refs.t, refs.q_des, refs.bounds
     n = len(t)
-    rec = {key: val[:n] for key, val in rec.items()}
+    tr = trace.trimmed(n)
     qa, ua, qpos = qa[:n], ua[:n], qpos[:n]
-    run = BurgerRun(t, rec["bp"], rec["br"], rec["sp"], rec["sr"], rec["ts"], rec["tg"],
-                    rec["fs"], rec["fg"], bg.diameter, bg.thickness, cell.spatula.length,
-                    cell.spatula.width, scene.grill_height)
+    run = BurgerRun(t, tr.bp, tr.br, tr.sp, tr.sr, tr.ts, tr.tg, tr.fs, tr.fg, bg.diameter,
+                    bg.thickness, cell.spatula.length, cell.spatula.width, scene.grill_height)
     errors = _errors(robot, t, qa, q_des, bounds)
-    return Execution(run, bounds, errors, qa, q_des, ua, qpos, rec["fbg"], mode, scene, plan,
+    return Execution(run, bounds, errors, qa, q_des, ua, qpos, tr.fbg, mode, scene, plan,
                      None if sensed is None else [float(v) for v in sensed], replan_failure,
                      replan_time)
 
 
-def _record(scene: Scene, rec: dict, k: int, burger_body: int, slots: dict) -> None:
-    """Poses and contacts at the current state (contacts of the last mj_step); ``slots``
-    maps a recorded geom pair (sorted) to its (touch flag, force) record keys
-    (:func:`_slots`). Forces are summed in contact order."""
-    d = scene.data
-    rec["sp"][k], rec["sr"][k] = scene.blade_pose()
-    rec["bp"][k], rec["br"][k] = d.xpos[burger_body], d.xmat[burger_body].reshape(3, 3)
-    for a, b, force in scene.contacts():
-        slot = slots.get((a, b) if a < b else (b, a))
-        if slot is None:
-            continue
-        touch, key = slot
-        if touch is not None:
-            rec[touch][k] = True
-        rec[key][k] = rec[key][k] + force
-
-
-def _slots(geoms: dict) -> dict:
-    """The recorded pairs of :func:`_record`: burger–blade, burger–grill, blade–grill."""
-    return {tuple(sorted((geoms["burger"], geoms["blade"]))): ("ts", "fs"),
-            tuple(sorted((geoms["burger"], geoms["grill"]))): ("tg", "fg"),
-            tuple(sorted((geoms["blade"], geoms["grill"]))): (None, "fbg")}
-
-
 def _errors(robot, t, q, q_des, bounds) -> dict:
     """Per-segment spatula position error against the plan (m)."""
-    e = np.array([np.linalg.norm(a - b)
-                  for a, b in zip(_positions(robot, q), _desired_positions(robot, q_des))])
+    diff = _positions(robot, q) - _desired_positions(robot, q_des)
+    e = np.linalg.norm(diff, axis=1)
     out = {}
     for name, (t0, t1) in bounds.items():
         sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)

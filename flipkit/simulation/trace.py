@@ -1,0 +1,71 @@
+"""The per-step record of one burger's execution: poses, contact flags and contact forces.
+
+:func:`flipkit.simulation.execute.execute_plan` calls :class:`BurgerTrace` once per control
+step, thousands of times a trial, so it writes into arrays allocated once and reads MuJoCo's
+buffers without intermediate copies. What it records at step k is the state the last
+``mj_step`` computed its forces at (MuJoCo's kinematics and contacts of the step's start),
+as :class:`~flipkit.simulation.run.BurgerRun` expects.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flipkit.simulation.scene import Scene
+
+__all__ = ["BurgerTrace"]
+
+
+class BurgerTrace:
+    """Arrays of N samples, filled by calling the trace with the sample index.
+
+    Attributes:
+        bp, br: The burger's position (m) and rotation matrix, (N, 3) and (N, 3, 3).
+        sp, sr: The spatula frame's, the same shapes.
+        ts, tg: Burger–blade and burger–grill contact flags (N,).
+        fs, fg, fbg: Summed normal forces (N) of the burger–blade, burger–grill and
+            blade–grill contacts (N,).
+
+    Args:
+        scene: The scene whose ``data`` is read. n: Samples to hold.
+    """
+
+    def __init__(self, scene: Scene, n: int):
+        self.scene, self.data = scene, scene.data
+        self.burger_body = int(scene.model.geom_bodyid[scene.geoms["burger"]])
+        self.site = int(scene.blade_site)
+        self.bp, self.sp = np.zeros((n, 3)), np.zeros((n, 3))
+        self._br, self._sr = np.zeros((n, 9)), np.zeros((n, 9))
+        self.ts, self.tg = np.zeros(n, bool), np.zeros(n, bool)
+        self.fs, self.fg, self.fbg = np.zeros(n), np.zeros(n), np.zeros(n)
+        g = scene.geoms  # recorded geom pair (sorted) -> (touch flags or None, forces)
+        self._slots = {tuple(sorted((g["burger"], g["blade"]))): (self.ts, self.fs),
+                       tuple(sorted((g["burger"], g["grill"]))): (self.tg, self.fg),
+                       tuple(sorted((g["blade"], g["grill"]))): (None, self.fbg)}
+
+    @property
+    def br(self) -> np.ndarray:
+        return self._br.reshape(-1, 3, 3)
+
+    @property
+    def sr(self) -> np.ndarray:
+        return self._sr.reshape(-1, 3, 3)
+
+    def __call__(self, k: int) -> None:
+        """Record sample k from the scene's current data; forces summed in contact order."""
+        d, b, s = self.data, self.burger_body, self.site
+        self.sp[k], self._sr[k] = d.site_xpos[s], d.site_xmat[s]
+        self.bp[k], self._br[k] = d.xpos[b], d.xmat[b]
+        for a, c, force in self.scene.contacts():
+            slot = self._slots.get((a, c) if a < c else (c, a))
+            if slot is not None:
+                touch, forces = slot
+                if touch is not None:
+                    touch[k] = True
+                forces[k] += force
+
+    def trimmed(self, n: int) -> "BurgerTrace":
+        """This trace cut to its first n samples (views, not copies)."""
+        for name in ("bp", "sp", "_br", "_sr", "ts", "tg", "fs", "fg", "fbg"):
+            setattr(self, name, getattr(self, name)[:n])
+        return self
