@@ -8,7 +8,7 @@ with h = 1e-6 have truncation error O(h²) ≈ 1e-12 and round-off ≈ 1e-10/h �
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import central_fd, random_states
+from conftest import central_fd, check_block_jacobian, random_states
 
 from flipkit.model.contact import make_cone
 from flipkit.model.orientation import axis_jacobian, rpy_jacobian
@@ -105,3 +105,73 @@ def test_blade_point_state_jacobians(robot, seed):
         fv = central_fd(lambda z: robot.state(z[:6], z[6:12], qdd, point).v, x[:12])
         np.testing.assert_allclose(np.hstack([st.dv_dq, st.dv_dqd]), fv, **TOL)
         np.testing.assert_allclose(st.a, fv[:, :6] @ qd + fv[:, 6:] @ qdd, atol=1e-6)
+
+
+def test_states_of_a_batch_are_the_single_node_states(robot):
+    """Robot.states (one pass per node for the centre and every blade point) gives, bit for
+    bit, Robot.state at each node and point."""
+    states = list(random_states(robot, 11, n=4))
+    q, qd, qdd = (np.array([s[k] for s in states]) for k in range(3))
+    points = [np.array([0.05, -0.012, 0.0]), np.array([-0.02, 0.03, 0.0])]
+    centre, at_points = robot.states(q, qd, qdd, points)
+    for k in range(len(q)):
+        for st, point in [(centre, None), *zip(at_points, points)]:
+            one = robot.state(q[k], qd[k], qdd[k], point)
+            for name in ("p", "R", "v", "a", "dp_dq", "Jw", "dv_dq", "dv_dqd", "da_dq",
+                         "da_dqd", "da_dqdd"):
+                np.testing.assert_array_equal(getattr(st.take(k), name), getattr(one, name))
+
+
+@pytest.fixture(scope="module")
+def flip_nlp():
+    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.targets import pickup_end
+    from flipkit.behaviors.transcribe import transcribe
+    from flipkit.config import CellConfig
+    from flipkit.model.ik import solve_pose
+
+    cell = CellConfig()
+    models = models_for(cell)
+    pb = np.array([0.69, -0.16, 0.072])
+    pose = pickup_end(cell, pb)
+    q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
+    return transcribe("flip", models, q0, np.zeros(6), location=pb, on_blade=(0.03, 0.0),
+                      scenarios=[(0.02, 0.0), (0.045, 0.0), (0.03, -0.01)])
+
+
+@pytest.mark.parametrize("quantity", ["position", "height", "rpy", "pitch", "normal", "xaxis",
+                                      "tip_height", "blade_heights", "velocity",
+                                      "acceleration", "cone_centre", "cone_point",
+                                      "paper_cone_point"])
+def test_kinematic_block_over_nodes_jacobian(flip_nlp, cell, quantity):
+    """Every quantity evaluated over a batch of nodes (not contiguous) against central
+    differences, through the NLP's Evaluation that computes the blade points with the
+    centre."""
+    from flipkit.transcription.constraints.kinematic import Cone, KinematicBlock
+
+    if quantity.startswith(("cone", "paper")):
+        form = "paper" if quantity.startswith("paper") else "physical"
+        point = (0.04, -0.01, 0.0) if quantity.endswith("point") else None
+        quantity = Cone(make_cone(form, cell.burger.mu, cell.gravity), point)
+    ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
+    block = KinematicBlock("q", flip_nlp.layout, quantity, [0, 3, 4, 9, 20], -np.inf, np.inf,
+                           ctx=ctx)
+    check_block_jacobian(flip_nlp, block, seed=3)
+
+
+def test_node_by_node_quantity_matches_its_batch(flip_nlp, cell):
+    """A quantity without broadcasting is applied node by node: the same rows as the built-in
+    one it wraps."""
+    from flipkit.transcription.constraints.kinematic import BladeEdgeHeights, KinematicBlock
+    from flipkit.transcription.layout import Evaluation
+
+    class PerNode(BladeEdgeHeights):
+        broadcasts = False
+
+    ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
+    L, x = flip_nlp.layout, flip_nlp.x0
+    ev = Evaluation(L, flip_nlp.robot, x)
+    a = KinematicBlock("a", L, BladeEdgeHeights(), [1, 2, 7], 0, np.inf, ctx=ctx).evaluate(ev)
+    b = KinematicBlock("b", L, PerNode(), [1, 2, 7], 0, np.inf, ctx=ctx).evaluate(ev)
+    for u, v in zip(a, b):
+        np.testing.assert_array_equal(u, v)

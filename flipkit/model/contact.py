@@ -30,10 +30,11 @@ def specific_force(R: np.ndarray, a: np.ndarray, gravity) -> np.ndarray:
 
 
 def specific_force_jacobians(st: SpatulaState, gravity):
-    """f and ∂f/∂(q, q̇, q̈) (3x6 each) from a :class:`SpatulaState`."""
+    """f and ∂f/∂(q, q̇, q̈) (3x6 each) from a :class:`SpatulaState` (of one node, or of a
+    batch: every output then with the leading node axis)."""
     w = st.a - np.asarray(gravity)
-    Rt = st.R.T
-    f = Rt @ w
+    Rt = np.swapaxes(st.R, -1, -2)
+    f = (Rt @ w[..., None])[..., 0]
     return f, Rt @ (st.da_dq + skew(w) @ st.Jw), Rt @ st.da_dqd, Rt @ st.da_dqdd
 
 
@@ -58,7 +59,8 @@ class ConeForm:
         return self.jacobians(st)[0]
 
     def jacobians(self, st: SpatulaState):
-        """h and ∂h/∂q, ∂h/∂q̇, ∂h/∂q̈ at one node."""
+        """h (rows,) and ∂h/∂q, ∂h/∂q̇, ∂h/∂q̈ (rows x nq) at one node; at a batch of nodes
+        (:meth:`~flipkit.model.robot.SpatulaState.take`), each with a leading node axis."""
         raise NotImplementedError
 
     def margin(self, st: SpatulaState) -> float:
@@ -77,7 +79,7 @@ class PhysicalCone(ConeForm):
         f, df_dq, df_dqd, df_dqdd = specific_force_jacobians(st, self.gravity)
         mu = self.mu
         S = np.array([[0, 0, 1], [-1, 0, mu], [1, 0, mu], [0, -1, mu], [0, 1, mu]], dtype=float)
-        return S @ f, S @ df_dq, S @ df_dqd, S @ df_dqdd
+        return f @ S.T, S @ df_dq, S @ df_dqd, S @ df_dqdd
 
 
 class PaperCone(ConeForm):
@@ -89,15 +91,14 @@ class PaperCone(ConeForm):
 
     def jacobians(self, st):
         w = st.a - self.gravity
-        nw = np.linalg.norm(w)
+        nw = np.sqrt(w[..., None, :] @ w[..., :, None])[..., 0]  # |w|, shape (..., 1)
         what = w / nw
-        n = st.R[:, 2]
+        n = st.R[..., :, 2]
         dn_dq = -skew(n) @ st.Jw
-        P = (np.eye(3) - np.outer(what, what)) / nw  # ∂ŵ/∂w
-        g = n @ P
-        h = np.array([n @ what - np.cos(self.mu)])
-        return (h, (what @ dn_dq + g @ st.da_dq)[None], (g @ st.da_dqd)[None],
-                (g @ st.da_dqdd)[None])
+        P = (np.eye(3) - what[..., :, None] * what[..., None, :]) / nw[..., None]  # ∂ŵ/∂w
+        g = n[..., None, :] @ P  # (..., 1, 3)
+        h = (n[..., None, :] @ what[..., :, None])[..., 0] - np.cos(self.mu)
+        return h, what[..., None, :] @ dn_dq + g @ st.da_dq, g @ st.da_dqd, g @ st.da_dqdd
 
 
 def make_cone(form: str, mu: float, gravity=(0.0, 0.0, -9.81)) -> ConeForm:

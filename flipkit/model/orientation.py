@@ -44,13 +44,18 @@ def rpy_rate_matrix(o) -> np.ndarray:
 
 
 def rpy_jacobian(R: np.ndarray, Jw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """o(R) and ∂o/∂q = E(o)⁻¹ Jw, E mapping rpy rates to world angular velocity."""
+    """o(R) and ∂o/∂q = E(o)⁻¹ Jw, E mapping rpy rates to world angular velocity; for R
+    (n, 3, 3) and Jw (n, 3, nq), o (n, 3) and ∂o/∂q (n, 3, nq)."""
+    if np.ndim(R) == 3:
+        outs = [rpy_jacobian(Ri, Ji) for Ri, Ji in zip(R, Jw)]
+        return np.array([o for o, _ in outs]), np.array([J for _, J in outs])
     o = rpy(R)
     Einv = np.array(pin.rpy.computeRpyJacobianInverse(o, pin.ReferenceFrame.WORLD))
     return o, Einv @ Jw
 
 
 def axis_jacobian(R: np.ndarray, Jw: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Axis a = R e_k of the spatula (k = 0: x toward the tip, 2: blade normal F_n) and ∂a/∂q."""
-    a = R[:, k].copy()
+    """Axis a = R e_k of the spatula (k = 0: x toward the tip, 2: blade normal F_n) and ∂a/∂q
+    (over leading node axes of R and Jw)."""
+    a = R[..., :, k].copy()
     return a, -skew(a) @ Jw

@@ -20,13 +20,25 @@ LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 def skew(w: np.ndarray) -> np.ndarray:
-    """3x3 matrix [w]× with [w]× v = w × v."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    """3x3 matrix [w]× with [w]× v = w × v; over leading axes for w of shape (..., 3)."""
+    w = np.asarray(w)
+    if w.ndim == 1:
+        return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    S = np.zeros(w.shape + (3,))
+    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    return S
+
+
+def _matvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """M x over a leading node axis: (n, i, j), (n, j) -> (n, i)."""
+    return (M @ x[..., None])[..., 0]
 
 
 @dataclass
 class SpatulaState:
-    """Spatula kinematics at one (q, q̇, q̈), world frame, with Jacobians.
+    """Spatula kinematics at one (q, q̇, q̈), world frame, with Jacobians; or at several, every
+    field then with a leading node axis (see :meth:`Robot.states`).
 
     Attributes:
         p: Blade-centre position (m). R: Rotation spatula→world.
@@ -46,6 +58,18 @@ class SpatulaState:
     da_dq: np.ndarray
     da_dqd: np.ndarray
     da_dqdd: np.ndarray
+
+    def __len__(self) -> int:
+        """Number of nodes of a batch."""
+        return len(self.p)
+
+    def take(self, index) -> SpatulaState:
+        """The states at ``index`` of the node axis (an int: one node's state; a slice or an
+        index array: a batch)."""
+        return SpatulaState(self.p[index], self.R[index], self.v[index], self.a[index],
+                            self.dp_dq[index], self.Jw[index], self.dv_dq[index],
+                            self.dv_dqd[index], self.da_dq[index], self.da_dqd[index],
+                            self.da_dqdd[index])
 
 
 class Robot:
@@ -141,29 +165,63 @@ class Robot:
                 and acceleration to give instead of the blade centre's (e.g. where the burger
                 lies); the rotation is the spatula's either way.
         """
-        m, d = self.model, self.data
+        q, qd, qdd = (np.asarray(x, dtype=float)[None] for x in (q, qd, qdd))
+        if point is None:
+            return self.states(q, qd, qdd)[0].take(0)
+        return self.states(q, qd, qdd, [point])[1][0].take(0)
+
+    def states(self, q, qd, qdd, points=()) -> tuple[SpatulaState, list[SpatulaState]]:
+        """:meth:`state` at n joint states at once: the blade centre's and each blade point's.
+
+        One forward-kinematics pass per joint state serves the centre and every point: a
+        point r (spatula frame) moves with the blade, p_r = p + R r, v_r = v + ω × R r,
+        a_r = a + α × R r + ω × (ω × R r), its velocity and acceleration derivatives from
+        pinocchio's point classical-acceleration derivatives.
+
+        Args:
+            q, qd, qdd: Joint states (n, nq) (rad, rad/s, rad/s²).
+            points: Blade points (spatula frame, m).
+
+        Returns:
+            The centre's states and one batch per point, each field with a leading axis of n.
+        """
+        m, d, fid, jid = self.model, self.data, self.frame_id, self.joint_id
         q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
-        # also fills the joint Jacobians data.J that getFrameJacobian reads (a separate
-        # computeJointJacobians gave bit-identical states at 200 seeded ones, and cost twice)
-        pin.computeForwardKinematicsDerivatives(m, d, q, qd, qdd)
-        pin.updateFramePlacements(m, d)
-        J = pin.getFrameJacobian(m, d, self.frame_id, LWA)
-        M = d.oMf[self.frame_id]
-        R, Jv, Jw = M.rotation.copy(), J[:3].copy(), J[3:].copy()
-        v_dq, a_dq, a_dqd, a_dqdd = pin.getPointClassicAccelerationDerivatives(
-            m, d, self.joint_id, self._point_placement(point), LWA)
-        acc = pin.getFrameClassicalAcceleration(m, d, self.frame_id, LWA).linear
-        p, v = M.translation.copy(), Jv @ qd
-        if point is not None:  # rigid-body transport from the blade centre to the point
-            r, w = R @ np.asarray(point, dtype=float), Jw @ qd
-            alpha = pin.getFrameAcceleration(m, d, self.frame_id, LWA).angular
-            # [w]× products: np.cross costs ~35 µs a call, and the SQP asks for thousands
-            W, Rx = skew(w), skew(r)
-            wr = W @ r
-            acc = acc + skew(alpha) @ r + W @ wr
-            Jv, p, v = Jv - Rx @ Jw, p + r, v + wr
-        return SpatulaState(p=p, R=R, v=v, a=np.array(acc), dp_dq=Jv, Jw=Jw, dv_dq=v_dq,
-                            dv_dqd=Jv.copy(), da_dq=a_dq, da_dqd=a_dqd, da_dqdd=a_dqdd)
+        n, nq = q.shape
+        points = [np.asarray(r, dtype=float) for r in points]
+        placements = [self._point_placement(None)] + [self._point_placement(r) for r in points]
+        p, acc, alpha = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+        R, J = np.empty((n, 3, 3)), np.empty((n, 6, nq))
+        # per placement: ∂v/∂q, ∂a/∂q, ∂a/∂q̇, ∂a/∂q̈
+        D = np.empty((len(placements), 4, n, 3, nq))
+        for k in range(n):
+            # also fills the joint Jacobians data.J that getFrameJacobian reads
+            pin.computeForwardKinematicsDerivatives(m, d, q[k], qd[k], qdd[k])
+            pin.updateFramePlacements(m, d)
+            M = d.oMf[fid]
+            p[k], R[k] = M.translation, M.rotation
+            J[k] = pin.getFrameJacobian(m, d, fid, LWA)
+            acc[k] = pin.getFrameClassicalAcceleration(m, d, fid, LWA).linear
+            if points:
+                alpha[k] = pin.getFrameAcceleration(m, d, fid, LWA).angular
+            for j, placement in enumerate(placements):
+                D[j, :, k] = pin.getPointClassicAccelerationDerivatives(m, d, jid, placement, LWA)
+        Jv, Jw = J[:, :3], J[:, 3:]
+        v = _matvec(Jv, qd)
+        centre = SpatulaState(p=p, R=R, v=v, a=acc, dp_dq=Jv, Jw=Jw, dv_dq=D[0, 0], dv_dqd=Jv,
+                              da_dq=D[0, 1], da_dqd=D[0, 2], da_dqdd=D[0, 3])
+        out = []
+        if points:
+            W, A = skew(_matvec(Jw, qd)), skew(alpha)  # [ω]×, [α]×
+        for j, r_local in enumerate(points, 1):
+            r = R @ r_local
+            wr = _matvec(W, r)
+            Jv_r = Jv - skew(r) @ Jw
+            out.append(SpatulaState(p=p + r, R=R, v=v + wr,
+                                    a=acc + _matvec(A, r) + _matvec(W, wr),
+                                    dp_dq=Jv_r, Jw=Jw, dv_dq=D[j, 0], dv_dqd=Jv_r,
+                                    da_dq=D[j, 1], da_dqd=D[j, 2], da_dqdd=D[j, 3]))
+        return centre, out
 
     def _point_placement(self, point) -> pin.SE3:
         """The joint-frame placement of a blade point (spatula frame, m; None: the centre),

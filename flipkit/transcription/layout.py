@@ -86,13 +86,20 @@ class Layout:
 class Evaluation:
     """One point Z with per-node kinematics and dynamics computed once, on demand.
 
-    Blocks of constraints share it so that each node's pinocchio work is done once.
+    Blocks of constraints share it so that each node's pinocchio work is done once: the first
+    request for kinematics computes the blade centre's and every point of ``points`` at every
+    node in one pass (:meth:`~flipkit.model.robot.Robot.states`).
+
+    Attributes:
+        points: Blade points (spatula frame, m) the blocks will ask for, as tuples.
     """
 
     layout: Layout
     robot: Robot
     x: np.ndarray
+    points: tuple = ()
     _states: dict = field(default_factory=dict)
+    _batches: dict = field(default_factory=dict)
     _rnea: dict = field(default_factory=dict)
 
     @property
@@ -103,20 +110,27 @@ class Evaluation:
         """(q_i, q̇_i, q̈_i, u_i)."""
         return self.layout.nodes(self.x)[i]
 
+    def states(self, nodes=slice(None), point=None) -> SpatulaState:
+        """Spatula kinematics with Jacobians at ``nodes`` (an index array or a slice of the
+        node axis; an int: that node's state alone), of the blade centre or of a blade
+        ``point`` (spatula frame, m)."""
+        key = None if point is None else tuple(float(c) for c in point)
+        if key not in self._batches:  # the first request: the centre and every expected point
+            wanted = [key] if self._batches else [*self.points, key]
+            pts = list(dict.fromkeys(k for k in wanted if k is not None))
+            X = self.layout.nodes(self.x)
+            centre, at_points = self.robot.states(X[:, 0], X[:, 1], X[:, 2], pts)
+            self._batches.setdefault(None, centre)
+            self._batches.update(zip(pts, at_points))
+        return self._batches[key].take(nodes)
+
     def state(self, i: int) -> SpatulaState:
         """Spatula kinematics with Jacobians at node i."""
-        if i not in self._states:
-            q, qd, qdd, _ = self.node(i)
-            self._states[i] = self.robot.state(q, qd, qdd)
-        return self._states[i]
+        return self.states(i)
 
     def point_state(self, i: int, point) -> SpatulaState:
         """Kinematics at node i of a blade point (spatula frame, m), e.g. under the burger."""
-        key = (i, *(float(v) for v in point))
-        if key not in self._states:
-            q, qd, qdd, _ = self.node(i)
-            self._states[key] = self.robot.state(q, qd, qdd, point)
-        return self._states[key]
+        return self.states(i, point)
 
     def rnea(self, i: int):
         """RNEA torque and its Jacobians at node i."""

@@ -40,6 +40,9 @@ class NLP:
         self.x_scale = np.asarray(x_scale, float)
         self.x0 = np.clip(np.asarray(x0, float), self.x_lb, self.x_ub)
         self.cone_nodes = [int(i) for i in cone_nodes]
+        # blade points whose kinematics the blocks read: computed with the centre's, per node
+        self.points = tuple(dict.fromkeys(
+            pt for b in self.blocks for pt in getattr(b, "points", ())))
         for arr, what in ((self.x_lb, "x_lb"), (self.x_ub, "x_ub"), (self.x_scale, "x_scale"),
                           (self.x0, "x0")):
             if arr.shape != (self.n,):
@@ -74,7 +77,7 @@ class NLP:
     # ------------------------------------------------------------- functions
     def evaluate(self, x) -> tuple[np.ndarray, np.ndarray]:
         """Constraint values c(x) (m,) and Jacobian entries (nnz,), pattern order."""
-        ev = Evaluation(self.layout, self.robot, np.asarray(x, float))
+        ev = Evaluation(self.layout, self.robot, np.asarray(x, float), self.points)
         parts = [b.evaluate(ev) for b in self.blocks]
         return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 

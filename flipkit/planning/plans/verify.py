@@ -181,7 +181,11 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
         rows += [xi - (xa + xb) / 2 - dt * (da - db) / 8, xb - xa - dt * (da + 4 * di + db) / 6]
     report.add_nodes("defects", k, np.abs(np.concatenate(rows, axis=1)), tol, mid)
 
-    states = [robot.state(seg.q[i], seg.qd[i], seg.qdd[i]) for i in range(N + 1)]
+    on_blade = (seg.landing or seg.placing or {}).get(
+        "burger_on_blade" if seg.landing else "on_blade", (0.0, 0.0))
+    under_burger = [(*on_blade, 0.0)] if np.any(on_blade) else []
+    centre, at_burger = robot.states(seg.q, seg.qd, seg.qdd, under_burger)
+    states = [centre.take(i) for i in range(N + 1)]
     l, w = cell.spatula.length / 2, cell.spatula.width / 2
     floor = blade_floor(seg.name, cell, N)
     for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
@@ -194,12 +198,9 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
                 "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)],
                 "carry": range(N + 1),
                 "place": [i for i in range(N + 1) if i <= sv.PLACE_CONE_FRACTION * N + 1e-9]}
-    on_blade = (seg.landing or seg.placing or {}).get(
-        "burger_on_blade" if seg.landing else "on_blade", (0.0, 0.0))
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
-        st = states[i]  # the flip's cone holds where the burger lies on the blade
-        if np.any(on_blade):
-            st = robot.state(seg.q[i], seg.qd[i], seg.qdd[i], (*on_blade, 0.0))
+        # the flip's cone holds where the burger lies on the blade
+        st = at_burger[0].take(i) if at_burger else states[i]
         add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
 

@@ -174,6 +174,7 @@ class FlightClearance(Block):
         super().__init__("flight_clearance", layout)
         self.release = int(release)
         self.nodes = list(range(self.release + 1, layout.N + 1))
+        self._index = slice(self.release + 1, layout.N + 1)
         self.par = [thickness, diameter / 2, gravity_magnitude(gravity),
                     *np.asarray(on_blade, float)[:2]]
         r = self.release
@@ -188,17 +189,16 @@ class FlightClearance(Block):
         if not n:
             return np.zeros(0), np.zeros(0)
         x_r, R_r, dq_r, dqd_r = _release_inputs(ev, r)
-        states = [ev.state(i) for i in self.nodes]
+        st = ev.states(self._index)
         ds = L.s[self.nodes] - L.s[r]
         X = np.zeros((19, n))  # one column per node: (x_r, τ, p_i, δ_i = 0)
         X[:12] = x_r[:, None]
         X[12] = ds * ev.T
-        X[13:16] = np.array([st.p for st in states]).T
-        Ri = np.hstack([st.R for st in states])
+        X[13:16] = st.p.T
+        Ri = st.R.transpose(1, 0, 2).reshape(3, 3 * n)  # the nodes' rotations side by side
         d, J = _mapped_clearance(n)(X, R_r, Ri, self.par)  # every node in one call
         J = np.asarray(J).reshape(n, 19)
-        dp = np.array([st.dp_dq for st in states])  # (n, 3, nq)
-        Jw = np.array([st.Jw for st in states])
+        dp, Jw = st.dp_dq, st.Jw  # (n, 3, nq)
         jac = np.concatenate([J[:, :12] @ dq_r, J[:, :12] @ dqd_r,
                               np.einsum("nk,nkj->nj", J[:, 13:16], dp)
                               + np.einsum("nk,nkj->nj", J[:, 16:19], Jw),

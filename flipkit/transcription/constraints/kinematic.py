@@ -16,35 +16,54 @@ from flipkit.transcription.constraints.base import Block
 
 
 def _point_height(st: SpatulaState, r_local) -> tuple[np.ndarray, np.ndarray]:
-    """Height of the blade point p + R r and its ∂/∂q (1 row)."""
+    """Height of the blade point p + R r (m) and its ∂/∂q (1 row), over leading node axes."""
     r = st.R @ np.asarray(r_local, float)
-    return np.array([st.p[2] + r[2]]), (st.dp_dq[2] - (skew(r) @ st.Jw)[2])[None]
+    return ((st.p[..., 2] + r[..., 2])[..., None],
+            (st.dp_dq[..., 2, :] - (skew(r) @ st.Jw)[..., 2, :])[..., None, :])
 
 
 class Quantity:
-    """A spatula quantity of derivative order 0 (q), 1 (q, q̇) or 2 (q, q̇, q̈)."""
+    """A spatula quantity of derivative order 0 (q), 1 (q, q̇) or 2 (q, q̇, q̈).
+
+    ``__call__`` maps one node's :class:`SpatulaState` to the value (size,) and its
+    Jacobians (size x nq). A quantity whose ``__call__`` also maps a batch of nodes (every
+    array with a leading node axis) sets ``broadcasts``; the others are applied node by node.
+    """
 
     order = 0
     size = 3
+    broadcasts = False
 
     def __call__(self, st: SpatulaState, ctx) -> tuple:
         """(value, ∂/∂q[, ∂/∂q̇[, ∂/∂q̈]])."""
         raise NotImplementedError
 
+    def batch(self, st: SpatulaState, ctx) -> tuple:
+        """Values (n, size) and Jacobians (n, size, nq) at a batch of n nodes."""
+        if self.broadcasts:
+            return self(st, ctx)
+        outs = [self(st.take(k), ctx) for k in range(len(st))]
+        return tuple(np.stack(parts) for parts in zip(*outs))
+
 
 class Position(Quantity):
+    broadcasts = True
+
     def __call__(self, st, ctx):
         return st.p, st.dp_dq
 
 
 class Height(Quantity):
     size = 1
+    broadcasts = True
 
     def __call__(self, st, ctx):
-        return st.p[2:], st.dp_dq[2:]
+        return st.p[..., 2:], st.dp_dq[..., 2:, :]
 
 
 class Rpy(Quantity):
+    broadcasts = True
+
     def __call__(self, st, ctx):
         return rpy_jacobian(st.R, st.Jw)
 
@@ -54,18 +73,23 @@ class Pitch(Quantity):
     continuous while the roll o_x wraps at ±π (the flip rolls the blade over)."""
 
     size = 1
+    broadcasts = True
 
     def __call__(self, st, ctx):
         o, J = rpy_jacobian(st.R, st.Jw)
-        return o[1:2], J[1:2]
+        return o[..., 1:2], J[..., 1:2, :]
 
 
 class Normal(Quantity):
+    broadcasts = True
+
     def __call__(self, st, ctx):
         return axis_jacobian(st.R, st.Jw, 2)
 
 
 class XAxis(Quantity):
+    broadcasts = True
+
     def __call__(self, st, ctx):
         return axis_jacobian(st.R, st.Jw, 0)
 
@@ -74,6 +98,7 @@ class TipHeight(Quantity):
     """Height of the blade tip, p_z − (l_l/2) sin o_y for a level blade (eq. 24)."""
 
     size = 1
+    broadcasts = True
 
     def __call__(self, st, ctx):
         return _point_height(st, (ctx["length"] / 2, 0.0, 0.0))
@@ -83,16 +108,21 @@ class BladeEdgeHeights(Quantity):
     """Heights of the blade's tip, heel and two side edges (the spatula stays above the grill)."""
 
     size = 4
+    broadcasts = True
 
     def __call__(self, st, ctx):
         l, w = ctx["length"] / 2, ctx["width"] / 2
         r = st.R @ np.array([[l, -l, 0.0, 0.0], [0.0, 0.0, w, -w], [0.0, 0.0, 0.0, 0.0]])
         # height p_z + r_z; ∂/∂q: ∂p_z/∂q − (r × J_ω)_z = ∂p_z/∂q + r_y J_ωx − r_x J_ωy
-        return st.p[2] + r[2], st.dp_dq[2] + np.outer(r[1], st.Jw[0]) - np.outer(r[0], st.Jw[1])
+        Jw = st.Jw
+        return (st.p[..., 2, None] + r[..., 2, :],
+                st.dp_dq[..., 2, None, :] + r[..., 1, :, None] * Jw[..., 0, None, :]
+                - r[..., 0, :, None] * Jw[..., 1, None, :])
 
 
 class Velocity(Quantity):
     order = 1
+    broadcasts = True
 
     def __call__(self, st, ctx):
         return st.v, st.dv_dq, st.dv_dqd
@@ -100,6 +130,7 @@ class Velocity(Quantity):
 
 class Acceleration(Quantity):
     order = 2
+    broadcasts = True
 
     def __call__(self, st, ctx):
         return st.a, st.da_dq, st.da_dqd, st.da_dqdd
@@ -110,6 +141,7 @@ class Cone(Quantity):
     resting over the blade point ``point`` (spatula frame, m; default the blade centre)."""
 
     order = 2
+    broadcasts = True
 
     def __init__(self, cone: ConeForm, point=None):
         self.cone, self.size = cone, cone.rows
@@ -141,6 +173,12 @@ class KinematicBlock(Block):
                 raise InvalidChoiceError("spatula quantity", quantity, QUANTITIES)
             quantity = QUANTITIES[quantity]()
         self.quantity, self.nodes, self.ctx = quantity, [int(i) for i in nodes], ctx or {}
+        point = getattr(quantity, "point", None)
+        self.points = () if point is None else (tuple(float(c) for c in point),)
+        self._point = self.points[0] if self.points else None
+        n = len(self.nodes)
+        contiguous = n and self.nodes == list(range(self.nodes[0], self.nodes[0] + n))
+        self._index = slice(self.nodes[0], self.nodes[0] + n) if contiguous else np.array(self.nodes)
         k = quantity.size
         fields = (layout.iq, layout.iqd, layout.iqdd)[: quantity.order + 1]
 
@@ -155,14 +193,9 @@ class KinematicBlock(Block):
                      np.broadcast_to(scale, shape).ravel())
 
     def evaluate(self, ev):
-        k, nq = self.quantity.size, self.layout.nq
-        vals = np.empty((len(self.nodes), k))
-        jac = np.empty((len(self.nodes), k, (self.quantity.order + 1) * nq))
-        point = getattr(self.quantity, "point", None)
-        for r, i in enumerate(self.nodes):
-            st = ev.state(i) if point is None else ev.point_state(i, point)
-            out = self.quantity(st, self.ctx)
-            vals[r] = out[0]
-            for f, block in enumerate(out[1:]):  # ∂/∂q, ∂/∂q̇, ∂/∂q̈ side by side per row
-                jac[r, :, f * nq:(f + 1) * nq] = block
-        return vals.ravel(), jac.ravel()
+        if not self.nodes:
+            return np.zeros(0), np.zeros(0)
+        out = self.quantity.batch(ev.states(self._index, self._point), self.ctx)
+        # ∂/∂q, ∂/∂q̇, ∂/∂q̈ side by side per row
+        jac = np.concatenate(out[1:], axis=-1) if len(out) > 2 else out[1]
+        return np.ravel(out[0]), np.ravel(jac)
