@@ -113,7 +113,7 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
 
 
 def test_every_figure_id_has_a_notebook_name():
-    assert len(figures.FIGURE_IDS) == 16 and figures.FIGURE_IDS[0] == "cell"
+    assert len(figures.FIGURE_IDS) == 17 and figures.FIGURE_IDS[0] == "cell"
     assert {path.name for path in NOTEBOOKS} <= set(figures.FIGURES.values())
 
 

@@ -16,7 +16,7 @@ from flipkit import figures
 REPORT_FIGURE_IDS = ("cell", "forces", "subbehaviors", "defects", "translate", "flip", "table1",
                      "ik_failure", "solve_times", "solve_scaling", "cone_forms", "landing",
                      "filmstrip",
-                     "sensitivity", "schedule", "throughput")
+                     "sensitivity", "schedule", "throughput", "kitchen")
 PAPER_DIR = figures.REPO_ROOT / "paper"
 MAIN_TEX = PAPER_DIR / "main.tex"
 MACRO_USE = re.compile(r"\\fk(num|mm|pct)\{([^}]*)\}\{([^}]*)\}")

@@ -93,7 +93,7 @@ def predict_on_blade(segment, task: Task, models, options) -> Task:
 
 GO_TO_BURGER = Subbehavior(
     "go_to_burger", duration=(0.3, 0.75), carries_burger=False, end="rest",
-    needs=("location",), floor=arrival_floor, pressed=True, exempt=tool_at_grill,
+    needs=("location",), floor=arrival_floor, approach=True, pressed=True, exempt=tool_at_grill,
     end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location), guess=task_path_guess,
     doc="eq. (22): to the scoop's start, tip pressed into the grill before the burger")
 SCOOP = Subbehavior(

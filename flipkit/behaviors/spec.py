@@ -38,6 +38,10 @@ class Task:
         spot: Serve: the table spot (x, y) (m).
         scenarios: Flip: other places (x, y) (m, blade frame) the burger may lie on the blade,
             each to land within ``r_scenario`` of the spot.
+        approach_height: Height (m) above the grill that the blade's edges keep on a
+            segment that comes down to the grill (``Subbehavior.approach``) until its last
+            two nodes, e.g. above other burgers lying on the grill; ``None``: the segment's
+            own floor.
     """
 
     location: object = None
@@ -46,6 +50,7 @@ class Task:
     on_blade: object = None
     spot: object = None
     scenarios: tuple = ()
+    approach_height: object = None
 
     def blade_point(self) -> np.ndarray:
         """(x, y) (m) of the burger on the blade that the constraints use."""
@@ -107,6 +112,8 @@ class Subbehavior:
             ``moving`` (the next segment must have room to brake).
         needs: :class:`Task` fields it cannot do without (:data:`TASK_FIELDS`).
         floor: ``floor(cell, N) -> (N+1,)``: lowest height (m) of the blade's edges per node.
+        approach: It comes down to the grill only at its end: ``task.approach_height``
+            raises its floor on all nodes but the last two.
         pressed: The blade centre may go below the grill by the scoop's press.
         exempt: ``exempt(node, N) -> frozenset`` of (shape, box) pairs not held to the
             space margin at ``node`` (the tool end where it works on the grill or table).
@@ -131,6 +138,7 @@ class Subbehavior:
     guess: Callable
     needs: tuple[str, ...] = ()
     floor: Callable | None = None
+    approach: bool = False
     pressed: bool = False
     exempt: Callable = _no_exemption
     path: Callable = _no_blocks

@@ -89,11 +89,17 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
     return NLP(spec.name, L, robot, blocks, lb, ub, scale, x0, cone_nodes)
 
 
-def blade_floor(spec: Subbehavior | str, cell, N: int) -> np.ndarray:
+def blade_floor(spec: Subbehavior | str, cell, N: int, task=None) -> np.ndarray:
     """Lowest height (m) of the blade's tip, heel and side edges at nodes 0..N: the spec's
-    floor, the grill's surface by default."""
+    floor, the grill's surface by default; on an approach (``spec.approach``) at least
+    ``task.approach_height`` above the grill on nodes 0..N−2 when the task sets one."""
     spec = subbehavior(spec) if isinstance(spec, str) else spec
-    return np.full(N + 1, cell.grill.height) if spec.floor is None else spec.floor(cell, N)
+    floor = (np.full(N + 1, cell.grill.height) if spec.floor is None
+             else np.array(spec.floor(cell, N), float))
+    height = None if task is None else task.approach_height
+    if spec.approach and height is not None:
+        floor[:N - 1] = np.maximum(floor[:N - 1], cell.grill.height + float(height))
+    return floor
 
 
 def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
@@ -116,7 +122,7 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
         KinematicBlock("task_acceleration", L, "acceleration", range(L.n_nodes), -lim.a_max,
                        lim.a_max, scale=0.1),
         KinematicBlock("grill_clearance", L, "blade_heights", moving,
-                       blade_floor(spec, cell, L.N)[1:, None], np.inf, ctx=blade),
+                       blade_floor(spec, cell, L.N, ctx.task)[1:, None], np.inf, ctx=blade),
     ]
     if o.arm_clearance:
         margins = np.full(L.N, cell.space.margin)  # nodes 1..N

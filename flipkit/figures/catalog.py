@@ -14,6 +14,6 @@ FIGURES = {  # figure id -> notebook that makes it, in the report's order
     "cone_forms": "cone_forms.ipynb",
     "landing": "landing.ipynb", "filmstrip": "landing.ipynb",
     "sensitivity": "sensitivity.ipynb", "schedule": "schedule.ipynb",
-    "throughput": "throughput.ipynb",
+    "throughput": "throughput.ipynb", "kitchen": "kitchen.ipynb",
 }
 FIGURE_IDS = tuple(FIGURES)

@@ -22,6 +22,7 @@ from flipkit.experiments.sweep import make_executor
 from flipkit.figures.draw import plot_schedule
 from flipkit.fileio import check_output_dir, replace_with
 from flipkit.planning.kitchen import motions
+from flipkit.planning.kitchen.clearance import CookConflictError, clear_cook, cook_meetings
 from flipkit.planning.kitchen.cook import check_cook, read_cook_csv, table_spots
 from flipkit.planning.kitchen.durations import plan_model, representative_order
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
@@ -71,13 +72,26 @@ def run(args: argparse.Namespace) -> int:
         order = check_cook(burgers, cell)
         spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
         planners = _planners(order, kinds, cell, args, atlas, spots, executor)
+        if executor is None:
+            planners = motions.cached_planners(planners)
         common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
-        if args.policy == "cpsat":
-            timeline = schedule_cook_cpsat(burgers, planners, cell.robot.q_home, **common,
-                                           time_limit_s=args.time_limit, seed=args.seed)
-        else:
-            timeline = schedule_cook(burgers, planners, cell.robot.q_home, **common,
-                                     progress=not args.no_progress)
+        lands = {}
+        try:
+            if args.policy == "cpsat":
+                timeline, lands = clear_cook(lambda lands: schedule_cook_cpsat(
+                    burgers, planners, cell.robot.q_home, **common, lands=lands,
+                    time_limit_s=args.time_limit, seed=args.seed), cell)
+            else:
+                timeline = schedule_cook(burgers, planners, cell.robot.q_home, **common,
+                                         progress=not args.no_progress)
+                met = cook_meetings(timeline, cell) if timeline.ok else []
+                if met:
+                    raise CookConflictError(f"{met[0][0].describe()}; the greedy schedule "
+                                            f"lands every burger where it was picked up; "
+                                            f"--policy cpsat moves landings out of the way")
+        except CookConflictError as exc:  # refused before any motion runs: nothing written
+            print(f"flipkit: error: {args.policy}: {exc}", file=sys.stderr)
+            return 1
     finally:
         if executor is not None:
             executor.shutdown(cancel_futures=True)
@@ -102,6 +116,8 @@ def run(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise FlipkitError(f"{plans}: cannot write plans ({exc.strerror or exc})") from None
     doc = timeline.to_dict()
+    doc["clearance"] = {"landings_moved": {b: [round(v, 4) for v in xy]
+                                           for b, xy in sorted(lands.items())}}
     if stream:
         doc["stream"] = stream_report(timeline, args.policy, args.stream,
                                       args.minutes).to_dict()
@@ -120,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
           f"{_solver_note(timeline.solver)}; planning {doc['planning_time_s']:.1f}"
           f" s, min slack {doc['slack_s']['min']:.1f} s, max lateness flip "
           f"{_s(late['flip'])}, serve {_s(late['serve'])}; windows "
-          f"{args.windows.describe()} met; wrote {timeline_path}")
+          f"{args.windows.describe()} met; {_moved(lands)}; wrote {timeline_path}")
     for b in timeline.burgers:
         if b.failure:
             print(f"flipkit: error: burger {b.burger.burger}: {b.failure}", file=sys.stderr)
@@ -179,6 +195,13 @@ def _modelled_stream(args, cell, atlas, executor, timeline_path: Path) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def _moved(lands: dict) -> str:
+    if not lands:
+        return "no motion meets another burger"
+    return ("no motion meets another burger with " + ", ".join(
+        f"{b} landed at ({x:.3f}, {y:.3f})" for b, (x, y) in sorted(lands.items())))
 
 
 def _cpsat_why(solver: dict | None) -> str:

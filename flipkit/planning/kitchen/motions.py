@@ -19,6 +19,7 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError
 from flipkit.planning.planners.planner import plan_flip
+from flipkit.planning.kitchen.sweep import approach_height
 from flipkit.planning.planners.serve import plan_serve
 
 KINDS = ("flip", "serve")
@@ -38,12 +39,15 @@ class MotionJob:
         location: Where the burger lies (x, y, z) (m): its drop position for a flip, its
             predicted landing point (on the grill surface) for a serve.
         table_spot: Serve only: the spot (x, y) (m) on the table; ``None`` for a flip.
+        land: Flip only: where the flipped burger lands (x, y) (m); ``None``: where it was
+            picked up (:mod:`flipkit.planning.kitchen.clearance` moves it out of the way).
     """
 
     kind: str
     burger: str
     location: tuple
     table_spot: tuple | None = None
+    land: tuple | None = None
 
 
 @dataclass
@@ -119,10 +123,13 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
 def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                  ) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planners.planner.plan_flip` from ``q_start``, landing
-    where the burger was picked up (its default), warm-started from ``atlas`` if given."""
+    at the job's ``land`` (default where the burger was picked up), coming in above the other
+    burgers on the grill (:func:`~flipkit.planning.kitchen.sweep.approach_height`),
+    warm-started from ``atlas`` if given."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_flip(job.location, q_start, cell=cell, solver=solver, atlas=atlas)
+        p = plan_flip(job.location, q_start, cell=cell, solver=solver, land=job.land,
+                      atlas=atlas, approach_height=approach_height(cell or CellConfig()))
         return from_plan(p, "flip", time.perf_counter() - t0)
 
     return plan
@@ -131,12 +138,14 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                   ) -> MotionPlanner:
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
-    job's table spot; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to burger, scoop
-    and pickup."""
+    job's table spot, carrying and placing the burger where the scoop model says its scoop
+    leaves it on the blade, coming in above the other burgers as the flip does; ``atlas`` (a
+    pickup-and-flip atlas) warm-starts its go to burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell, solver=solver,
-                       atlas=atlas)
+                       on_blade=None, atlas=atlas,
+                       approach_height=approach_height(cell or CellConfig()))
         return from_plan(p, "serve", time.perf_counter() - t0)
 
     return plan
@@ -161,7 +170,7 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
 
 def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPlanner]:
     """``planners`` that plan each distinct motion once: a request with the same kind, burger,
-    location, table spot and start configuration (to 1e-9) returns the first plan (the same
+    location, table spot, landing spot and start configuration (to 1e-9) returns the first plan (the same
     object, its planning time included), so two schedules of one cook — the greedy rule and
     CP-SAT — compare on the same plans."""
     done: dict[tuple, PlannedMotion] = {}
@@ -170,6 +179,7 @@ def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPl
         def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
             key = (kind, job.burger, tuple(np.round(job.location, 9)),
                    None if job.table_spot is None else tuple(np.round(job.table_spot, 9)),
+                   None if job.land is None else tuple(np.round(job.land, 9)),
                    tuple(np.round(np.asarray(q_start, float), 9)))
             if key not in done:
                 done[key] = planners[kind](job, q_start)

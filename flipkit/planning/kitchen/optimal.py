@@ -43,7 +43,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
                         kinds=KINDS, cell: CellConfig | None = None, spots=None,
                         windows: Windows = Windows(), dwell_s: float = DWELL_S,
                         plan_start: float | None = None, time_limit_s: float = 10.0,
-                        workers: int = 1, seed: int = 0, relax: str = "max") -> Timeline:
+                        workers: int = 1, seed: int = 0, relax: str = "max",
+                        lands: Mapping | None = None) -> Timeline:
     """Plan every motion of a cook order from rest, then schedule them with CP-SAT.
 
     Args:
@@ -52,6 +53,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
         windows: The event windows. dwell_s: Table dwell (s).
         time_limit_s, workers, seed, relax: As
             :func:`~flipkit.planning.kitchen.cpsat_process.solve_schedule`.
+        lands: Burger id -> where its flip lands it (x, y) (m); a burger not in it lands
+            where it was picked up.
 
     Returns:
         The timeline (``policy`` :data:`CPSAT`; ``solver``: status, objectives, wall time).
@@ -87,8 +90,13 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             records[job.burger].failure = f"{kind}: {pm.failure}"
         return pm
 
-    for b in order:
-        pm = plan("flip", MotionJob("flip", b.burger, b.location(cell)))
+    flips = [MotionJob("flip", b.burger, b.location(cell),
+                       land=None if (lands or {}).get(b.burger) is None
+                       else tuple(lands[b.burger])) for b in order]
+    for job in flips:  # planners that plan ahead start every flip now
+        getattr(planners, "prefetch", lambda job: None)(job)
+    for b, job in zip(order, flips):
+        pm = plan("flip", job)
         if pm.ok:
             records[b.burger].landing = pm.landing if pm.landing is not None else (b.x, b.y)
     if serve:

@@ -61,7 +61,8 @@ class PrefetchPlanners(Mapping):
 
     def _key(self, job: MotionJob) -> tuple:
         return (job.kind, job.burger, tuple(np.round(job.location, 9)),
-                None if job.table_spot is None else tuple(np.round(job.table_spot, 9)))
+                None if job.table_spot is None else tuple(np.round(job.table_spot, 9)),
+                None if job.land is None else tuple(np.round(job.land, 9)))
 
     def _submit(self, job: MotionJob) -> None:
         fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
@@ -71,9 +72,17 @@ class PrefetchPlanners(Mapping):
             key, time.perf_counter() - self._t0))
         self._futures[key] = fut
 
+    def prefetch(self, job: MotionJob) -> None:
+        """Start planning ``job`` from the rest configuration now, unless it is already."""
+        if self._key(job) not in self._futures:
+            self._submit(job)
+
     def _result(self, job: MotionJob, q_start) -> PlannedMotion:
+        at_rest = np.abs(np.asarray(q_start, float) - self.q_rest).max() <= REST_TOL
+        if at_rest:  # a job made later (another landing spot) is planned by a worker too
+            self.prefetch(job)
         fut = self._futures.get(self._key(job))
-        if fut is None or np.abs(np.asarray(q_start, float) - self.q_rest).max() > REST_TOL:
+        if fut is None or not at_rest:
             self.on_demand += 1
             t = time.perf_counter()
             pm = plan_motion(job.kind, job, q_start, self.cell, self.solver, self.atlas)

@@ -82,6 +82,20 @@ def check_on_blade(on_blade, cell: CellConfig) -> np.ndarray:
     return xy
 
 
+def check_approach_height(height) -> float | None:
+    """``None``, or a finite height (m) >= 0 that the go to burger keeps above the grill
+    (:attr:`~flipkit.behaviors.spec.Task.approach_height`); ConfigError otherwise."""
+    if height is None:
+        return None
+    try:
+        h = float(height)
+    except (TypeError, ValueError):
+        h = math.nan
+    if not (math.isfinite(h) and h >= 0):
+        raise ConfigError(f"approach_height must be a finite height >= 0 m, got {height!r}")
+    return h
+
+
 def check_replan(plan, behavior: str, on_blade) -> tuple:
     """The cell of a solved ``behavior`` plan to re-plan, and the sensed ``on_blade`` (x, y)
     (m) checked on its blade; one-line ConfigError otherwise."""

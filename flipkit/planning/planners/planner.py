@@ -35,7 +35,8 @@ from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import (check_joint_vector, check_on_blade, check_position,
+from flipkit.planning.planners.inputs import (check_approach_height, check_joint_vector,
+                                              check_on_blade, check_position,
                                               check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_flight import LANDING_TOL, TILT_MIN_DEG, recompute_landing
@@ -103,7 +104,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
               solver: str = "auto", land=None, on_blade=None,
-              options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
+              options: SegmentOptions = SegmentOptions(), atlas=None,
+              approach_height=None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.behaviors.library.FLIP_NAMES` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -122,6 +124,9 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         atlas: A warm-start :class:`~flipkit.planning.planners.atlas.Atlas` built for ``cell`` and
             ``options``: each segment starts from the atlas's interpolated solution (and
             from its own initial guess if that fails); ``None`` (default): cold starts.
+        approach_height: Height (m) above the grill that the go to burger keeps the blade's
+            edges until its last two nodes (over other burgers lying on the grill);
+            ``None`` (default): the grill's surface.
 
     Returns:
         The plan. On a segment failure the chain stops there: the plan holds the segments
@@ -141,7 +146,9 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     spot = None if land is None else tg.check_spot(cell, land)
     on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
     q, qd = check_start(planner.models.bare, q_start, qd_start)
-    return planner.chain("flip", Task(location=pb, land=spot, on_blade=on_blade), q, qd,
+    task = Task(location=pb, land=spot, on_blade=on_blade,
+                approach_height=check_approach_height(approach_height))
+    return planner.chain("flip", task, q, qd,
                          guess=seeding(atlas, pb), t0=t0)
 
 

@@ -25,13 +25,15 @@ from flipkit.errors import FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import check_on_blade, check_replan, check_start
+from flipkit.planning.planners.inputs import (check_approach_height, check_on_blade,
+                                              check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
 
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
                solver: str = "auto", on_blade=(0.0, 0.0),
-               options: SegmentOptions = SegmentOptions(), atlas=None) -> Plan:
+               options: SegmentOptions = SegmentOptions(), atlas=None,
+               approach_height=None) -> Plan:
     """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
     22–25), carry with the friction cone throughout, place by a tilt-off, return home.
 
@@ -46,12 +48,15 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             ``"ipopt"``.
         on_blade: Where the burger's centre will sit on the blade (x, y) (m, blade frame)
             during the carry and place; default the blade centre (:func:`replan_serve`
-            re-plans for a sensed one).
+            re-plans for a sensed one). ``None``: where the scoop model
+            (:func:`~flipkit.behaviors.pick.scoop_scenarios`) says the planned scoop leaves
+            it, as the flip does.
         options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
         atlas: A pickup-and-flip :class:`~flipkit.planning.planners.atlas.Atlas` built for ``cell``
             and ``options``: go to burger, scoop and pickup (the flip's first three
             segments, the same NLPs) start from its interpolated solutions, carry, place
             and return home from their own guesses; ``None`` (default): cold starts.
+        approach_height: As :func:`~flipkit.planning.planners.planner.plan_flip`.
 
     Returns:
         The :class:`~flipkit.planning.plans.plan_file.Plan`, behaviour ``serve``: status
@@ -70,16 +75,19 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, burger)
     spot = sv.check_table_spot(cell, table_spot)
-    on_blade = check_on_blade(on_blade, cell)
+    on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
     q, qd = check_start(models.bare, q_start, qd_start)
-    for what, pose in (("carry end", sv.carry_end(cell, spot, on_blade)),
-                       ("place", sv.place_end(cell, spot, on_blade))):
+    at = (0.0, 0.0) if on_blade is None else on_blade  # the reach check before the scoop
+    for what, pose in (("carry end", sv.carry_end(cell, spot, at)),
+                       ("place", sv.place_end(cell, spot, at))):
         try:  # reachability first, one clear line
             solve_pose(models.loaded, pose.p, pose.o, models.bare.q_home)
         except UnreachableError as exc:
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
-    return planner.chain("serve", Task(location=pb, spot=spot, on_blade=on_blade), q, qd,
+    task = Task(location=pb, spot=spot, on_blade=on_blade,
+                approach_height=check_approach_height(approach_height))
+    return planner.chain("serve", task, q, qd,
                          guess=seeding(atlas, pb), t0=t0)
 
 

@@ -1,0 +1,223 @@
+"""Keeping a cook's motions clear of the other burgers on the grill.
+
+Each motion is planned for its own burger alone. :func:`cook_meetings` checks every motion
+of a timeline against the burgers lying on the grill while it runs (known from the
+schedule: dropped, not yet lifted by their own motions), with the geometry of
+:mod:`flipkit.planning.kitchen.sweep`.
+
+:func:`clear_cook` then uses the one freedom the planners leave that changes who lies where:
+**where a flip lands its burger** (``plan_flip(..., land=...)``; by default where it was
+picked up). A burger met where it landed is landed elsewhere; a serve that meets a burger
+(or a flip whose landing does) moves its own burger's landing, which moves where the serve
+scoops from. The new spot is the one nearest the burger's drop place that keeps clear, over
+the burger's stay on its second side, of every other motion's footprint and of every other
+burger, and from which its serve's footprint (the present one, moved with it) meets nobody.
+The cook is planned and scheduled again with the new spots and checked again. The scoop
+itself cannot be turned: the scoop subbehaviour slides the blade along +x at the burger
+(:mod:`flipkit.behaviors.targets`), so a flip that meets a burger still lying where it was
+dropped cannot be avoided this way: the cook is refused (:class:`CookConflictError`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.errors import FlipkitError
+from flipkit.model.robot import Robot
+from flipkit.planning.kitchen.sweep import (Lying, Meeting, default_margin, footprint,
+                                           meetings, points_polygon_distance,
+                                           points_segment_distance)
+
+MAX_ROUNDS = 4  # plan-schedule-check rounds before a cook with meetings left is refused
+LOW_SEGMENTS = ("go_to_burger", "scoop", "pickup")  # a serve's segments that move with its burger
+
+
+class CookConflictError(FlipkitError):
+    """A motion of the cook would meet another burger and no landing spot avoids it."""
+
+
+def lying_burgers(timeline) -> list[Lying]:
+    """Where each burger lies on the grill, when: at its drop place from its drop to the
+    start of its flip (for good if the flip is not executed), then at its flip's predicted
+    landing point from the landing to the start of its serve (for good without one)."""
+    motions = {(m.kind, m.burger): m for m in timeline.motions if m.ok and m.event is not None}
+    out = []
+    for rec in timeline.burgers:
+        b = rec.burger
+        flip, serve = motions.get(("flip", b.burger)), motions.get(("serve", b.burger))
+        out.append(Lying(b.burger, (b.x, b.y), b.t_drop, flip.start if flip else math.inf))
+        if flip is not None:
+            landed = rec.landing if rec.landing is not None else (b.x, b.y)
+            out.append(Lying(b.burger, tuple(landed), flip.event,
+                             serve.start if serve else math.inf, landed=True))
+    return out
+
+
+class Footprints:
+    """Each plan's :func:`~flipkit.planning.kitchen.sweep.footprint`, computed once."""
+
+    def __init__(self, cell: CellConfig):
+        self.cell, self._done, self._robot = cell, {}, None
+
+    def __call__(self, plan):
+        key = id(plan)
+        if key not in self._done:
+            if self._robot is None:
+                self._robot = Robot(self.cell, with_burger=False)
+            self._done[key] = (plan, footprint(plan, self.cell, self._robot))
+        return self._done[key][1]
+
+
+def cook_meetings(timeline, cell: CellConfig, footprints: Footprints | None = None,
+                  margin: float | None = None) -> list[tuple[Meeting, Lying]]:
+    """Every meeting of an executed motion with a burger lying while it runs, with that
+    burger's :class:`Lying` record, in time order."""
+    footprints = footprints or Footprints(cell)
+    lying = lying_burgers(timeline)
+    out = []
+    for m in timeline.motions:
+        if not m.ok or m.event is None or m.plan is None:
+            continue
+        others = [lie for lie in lying if lie.burger != m.burger]
+        for meet in meetings(footprints(m.plan), m.key, m.start, others, cell, margin):
+            lie = next(lie for lie in others if lie.burger == meet.burger
+                       and lie.t0 <= meet.t <= lie.t1)
+            out.append((meet, lie))
+    return sorted(out, key=lambda ml: ml[0].t)
+
+
+def landing_candidates(cell: CellConfig, step: float) -> np.ndarray:
+    """Centres (n×2, m) on the grill, ``step`` apart."""
+    g = cell.grill
+    xs = np.arange(g.x_range[0], g.x_range[1] + 1e-12, step)
+    ys = np.arange(g.y_range[0], g.y_range[1] + 1e-12, step)
+    return np.array([(x, y) for x in xs for y in ys])
+
+
+def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints,
+                 margin: float | None = None, exclude=()) -> tuple | None:
+    """The landing spot (x, y) (m) for ``burger`` nearest its drop place that keeps clear of
+    every other motion and burger over its stay, and whose serve (its present footprint,
+    moved with the spot) meets nobody; ``None`` if there is none. ``exclude``: spots
+    already tried (nothing within ``margin`` of them is offered again)."""
+    margin = default_margin() if margin is None else margin
+    r = cell.burger.diameter / 2
+    motions = {m.key: m for m in timeline.motions if m.ok and m.event is not None}
+    flip, serve = motions.get(f"flip:{burger}"), motions.get(f"serve:{burger}")
+    if flip is None or flip.plan is None:
+        return None
+    rec = next(b for b in timeline.burgers if b.burger.burger == burger)
+    own = footprints(flip.plan)
+    radius = own.landing[2] if own.landing is not None else r
+    t0, t1 = flip.event, serve.start if serve is not None else math.inf
+    P = landing_candidates(cell, margin / 2)
+    ok = np.ones(len(P), bool)
+    for spot in exclude:
+        ok &= np.hypot(*(P - np.asarray(spot)).T) > margin
+    for lie in lying_burgers(timeline):
+        if lie.burger != burger and lie.t0 <= t1 and lie.t1 >= t0:
+            ok &= np.hypot(*(P - np.asarray(lie.xy)).T) >= radius + r + margin
+    for m in motions.values():
+        if m.burger == burger or m.plan is None or m.end < t0 or m.start > t1:
+            continue
+        fp = footprints(m.plan)
+        for t, _seg, poly in fp.blade:
+            if t0 <= m.start + t <= t1:
+                ok &= points_polygon_distance(P, poly) >= r + margin
+        for t, _seg, a, b in fp.carried:
+            if t0 <= m.start + t <= t1:
+                ok &= points_segment_distance(P, a, b) >= 2 * r + margin
+        if fp.landing is not None and t0 <= m.start + fp.landing[0] <= t1:
+            ok &= np.hypot(*(P - np.asarray(fp.landing[1])).T) >= fp.landing[2] + r + margin
+    if serve is not None and serve.plan is not None:  # the serve scoops from the new spot: its low part moves with it
+        fp = footprints(serve.plan)
+        old = np.asarray(rec.landing if rec.landing is not None else (rec.burger.x,
+                                                                      rec.burger.y))
+        there = [lie for lie in lying_burgers(timeline) if lie.burger != burger
+                 and lie.t0 <= serve.end and lie.t1 >= serve.start]
+        for lie in there:
+            d_centre = np.asarray(lie.xy) - (P - old)  # the lying burger, seen from the serve
+            for t, seg, poly in fp.blade:
+                if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
+                    ok &= points_polygon_distance(d_centre, poly) >= r + margin
+            for t, seg, a, b in fp.carried:
+                if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
+                    ok &= points_segment_distance(d_centre, a, b) >= 2 * r + margin
+    if not ok.any():
+        return None
+    drop = np.array([rec.burger.x, rec.burger.y])
+    best = np.argmin(np.where(ok, np.hypot(*(P - drop).T), np.inf))
+    return tuple(float(v) for v in P[best])
+
+
+def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
+               margin: float | None = None, max_rounds: int = MAX_ROUNDS):
+    """Schedule a cook whose motions meet no other burger.
+
+    Args:
+        schedule: ``lands -> Timeline``: plans and schedules the cook with each burger of
+            ``lands`` (id -> (x, y) m) landed there by its flip (e.g.
+            :func:`~flipkit.planning.kitchen.optimal.schedule_cook_cpsat` with ``lands``).
+        cell: The cell. margin: As :func:`~flipkit.planning.kitchen.sweep.meetings`.
+        max_rounds: Plan-schedule-check rounds at most.
+
+    Returns:
+        ``(timeline, lands)``: the first timeline without meetings (or one with a failed
+        plan, which the caller reports as such) and the landing spots it moved.
+
+    Raises:
+        CookConflictError: A meeting that no landing spot avoids (one line naming the
+            motion, the burger it meets and why it cannot be moved).
+    """
+    lands: dict[str, tuple] = {}
+    tried: dict[str, list] = {}
+    for round_ in range(max_rounds + 1):
+        timeline = schedule(dict(lands))
+        failed = [b for b in lands if any(m.burger == b and m.kind == "flip" and not m.ok
+                                          for m in timeline.motions)]
+        if failed:  # a flip that cannot land there: try the next spot
+            for b in failed:
+                tried.setdefault(b, []).append(lands.pop(b))
+            continue
+        if not timeline.ok:
+            return timeline, lands
+        fps = Footprints(cell)
+        found = cook_meetings(timeline, cell, fps, margin)
+        if not found:
+            return timeline, lands
+        if round_ == max_rounds:
+            raise CookConflictError(f"{found[0][0].describe()}; still after {max_rounds} "
+                                    f"rounds of moving landing spots")
+        move = []
+        for meet, lie in found:
+            kind, owner = meet.motion.split(":", 1)
+            if lie.landed:
+                who = lie.burger
+            elif kind == "serve" or meet.part == "landing":
+                who = owner
+            else:
+                raise CookConflictError(
+                    f"{meet.describe()}; burger {lie.burger} still lies where it was dropped "
+                    f"then, and the scoop's direction is fixed: drop them farther apart")
+            if who not in move:
+                move.append(who)
+        for who in move:
+            spot = free_landing(who, timeline, cell, fps, margin,
+                                exclude=tried.get(who, []) + ([lands[who]] if who in lands
+                                                               else []))
+            if spot is None:
+                meet = next(m for m, lie in found if who in (lie.burger, m.motion.split(":")[1]))
+                raise CookConflictError(f"{meet.describe()}; no landing spot for burger {who} "
+                                        f"keeps clear of the other burgers and motions")
+            tried.setdefault(who, []).append(spot)
+            lands[who] = spot
+    raise CookConflictError(f"no landing spot for burgers {', '.join(sorted(tried))} "
+                            f"gives a flip that can be planned")
+
+
+__all__ = ["MAX_ROUNDS", "CookConflictError", "Footprints", "clear_cook", "cook_meetings",
+           "free_landing", "landing_candidates", "lying_burgers"]

@@ -1,0 +1,289 @@
+"""Where a planned motion reaches down among the burgers on the grill, and whom it would meet.
+
+A motion is planned for its own burger alone. On a grill with other burgers it may meet
+them in three ways, each computed from the plan and the cell (no other numbers):
+
+* **The blade.** A burger lying on the grill occupies the cylinder of its disc (diameter
+  ``d``) from the grill surface ``h_g`` up to ``h_g + t`` (``t`` the patty's thickness).
+  The blade is the rectangle ``length × width`` of the spatula frame's x-y plane (its
+  thickness is inside the margin). At each sample of the plan the part of the rectangle
+  between ``h_g`` and ``h_g + t`` (:func:`slab_section`) is projected onto the grill; a
+  lying burger whose disc comes within ``margin`` of that section is met. Only the go to
+  burger, scoop and pickup reach that low; the test does not assume which segments do.
+* **The carried burger.** During the scoop the motion's own burger is pushed from where it
+  lay to where the scoop model leaves it on the blade (the plan's ``burger_on_blade``, else
+  the blade centre): its footprint on the grill is the capsule swept by its disc between
+  the two. From the scoop's end until it is released (flip) or placed (serve) it rides on
+  the blade at that point, and while its underside is below ``h_g + t`` its disc meets any
+  lying disc within ``d + margin`` of its centre.
+* **The landing.** A flipped burger comes down at the plan's landing point; every scenario
+  of its place on the blade lands within the plan's spread of it (``landing.offset`` and the
+  scenarios' offsets). Its disc of radius ``d/2 + spread`` must stay ``margin`` clear of
+  every burger lying there when it lands. The flight itself passes above the flip's height
+  band and meets nobody lying.
+
+``margin`` defaults to the placement spread the robust flips plan for
+(:class:`~flipkit.config.ScoopUncertainty`: ``k_sigma × placement_sigma``): a burger may
+lie that far from where it was recorded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline
+
+from flipkit.config import CellConfig, ScoopUncertainty
+from flipkit.model.robot import Robot
+
+SAMPLE_DT = 0.005  # s between samples of a plan: the blade moves < 2 mm between them
+
+
+@dataclass(frozen=True)
+class Lying:
+    """A burger lying still on the grill at ``xy`` (m) from ``t0`` to ``t1`` (s, cook clock);
+    ``landed``: where its flip put it (else where it was dropped)."""
+
+    burger: str
+    xy: tuple
+    t0: float
+    t1: float
+    landed: bool = False
+
+
+@dataclass(frozen=True)
+class Meeting:
+    """A motion meets a lying burger.
+
+    Attributes:
+        motion: ``kind:burger`` of the motion. burger: The lying burger met.
+        part: ``"blade"``, ``"carried burger"`` or ``"landing"``. segment: The plan segment.
+        t: When (s, cook clock). overlap_m: How far inside the clearance (m, > 0).
+    """
+
+    motion: str
+    burger: str
+    part: str
+    segment: str
+    t: float
+    overlap_m: float
+
+    def describe(self) -> str:
+        """One line: who meets whom, where and by how much."""
+        return (f"{self.motion}: the {self.part} ({self.segment}) meets burger {self.burger} "
+                f"at t = {self.t:.2f} s, {1e3 * self.overlap_m:.0f} mm inside its clearance")
+
+
+@dataclass
+class Footprint:
+    """What a plan puts near the grill, on times from the plan's start (s).
+
+    Attributes:
+        blade: ``(t, segment, polygon)``: the blade's section within the burger's height
+            above the grill, projected (k×2, m), at every sample where it is not empty.
+        carried: ``(t, segment, a, b)``: the own burger's disc swept from centre ``a`` to
+            ``b`` (m) while its underside is below the top of a lying burger.
+        landing: ``(t, point, radius)``: the flipped burger's landing disc, or ``None``.
+    """
+
+    blade: list = field(default_factory=list)
+    carried: list = field(default_factory=list)
+    landing: tuple | None = None
+
+
+def default_margin() -> float:
+    """The clearance kept (m): the robust flips' placement spread (2 σ = 1 cm)."""
+    return ScoopUncertainty().placement
+
+
+def approach_height(cell: CellConfig, margin: float | None = None) -> float:
+    """How high above the grill (m) a cook's motions come in to their burger: over a lying
+    burger's top (its thickness) by the clearance ``margin``
+    (:attr:`~flipkit.behaviors.spec.Task.approach_height`)."""
+    return cell.burger.thickness + (default_margin() if margin is None else margin)
+
+
+def blade_rectangle(R, p, cell: CellConfig) -> np.ndarray:
+    """The blade's four corners (4×3, m, world) for the spatula frame at rotation ``R`` and
+    position ``p`` (the blade centre): ``± length/2`` along its x axis, ``± width/2`` along y."""
+    R, p = np.asarray(R, float), np.asarray(p, float)
+    hl, hw = cell.spatula.length / 2, cell.spatula.width / 2
+    local = np.array([[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw]])
+    return p + local @ R[:, :2].T
+
+
+def slab_section(polygon, z_lo: float, z_hi: float) -> np.ndarray:
+    """The part of a planar convex polygon (k×3, in order) with ``z_lo <= z <= z_hi``,
+    clipped edge by edge (Sutherland–Hodgman on the two planes); (0, 3) when empty."""
+    poly = np.asarray(polygon, float)
+    for sign, bound in ((1.0, z_lo), (-1.0, z_hi)):
+        if len(poly) == 0:
+            break
+        inside = sign * (poly[:, 2] - bound) >= 0
+        out = []
+        for k in range(len(poly)):
+            a, b = poly[k], poly[(k + 1) % len(poly)]
+            ia, ib = inside[k], inside[(k + 1) % len(poly)]
+            if ia:
+                out.append(a)
+            if ia != ib:
+                s = (bound - a[2]) / (b[2] - a[2])
+                out.append(a + s * (b - a))
+        poly = np.array(out).reshape(-1, 3)
+    return poly
+
+
+def point_polygon_distance(point, polygon) -> float:
+    """Distance (m) in the plane from ``point`` to a convex polygon (k×2, in order; also a
+    segment or a point): 0 inside it."""
+    c = np.asarray(point, float)[:2]
+    poly = np.asarray(polygon, float)[:, :2]
+    if len(poly) == 0:
+        return math.inf
+    if len(poly) >= 3:
+        edges = np.roll(poly, -1, axis=0) - poly
+        cross = edges[:, 0] * (c[1] - poly[:, 1]) - edges[:, 1] * (c[0] - poly[:, 0])
+        if np.all(cross >= -1e-15) or np.all(cross <= 1e-15):
+            return 0.0
+    best = math.inf
+    for k in range(len(poly)):
+        best = min(best, point_segment_distance(c, poly[k], poly[(k + 1) % len(poly)]))
+    return best
+
+
+def points_polygon_distance(points, polygon) -> np.ndarray:
+    """:func:`point_polygon_distance` of many points (n×2) at once."""
+    P = np.asarray(points, float)[:, :2]
+    poly = np.asarray(polygon, float)[:, :2]
+    best = np.full(len(P), np.inf)
+    for k in range(len(poly)):
+        best = np.minimum(best, points_segment_distance(P, poly[k], poly[(k + 1) % len(poly)]))
+    if len(poly) >= 3:
+        edges = np.roll(poly, -1, axis=0) - poly
+        cross = (edges[None, :, 0] * (P[:, None, 1] - poly[None, :, 1])
+                 - edges[None, :, 1] * (P[:, None, 0] - poly[None, :, 0]))
+        inside = np.all(cross >= -1e-15, axis=1) | np.all(cross <= 1e-15, axis=1)
+        best[inside] = 0.0
+    return best
+
+
+def points_segment_distance(points, a, b) -> np.ndarray:
+    """:func:`point_segment_distance` of many points (n×2) at once."""
+    P = np.asarray(points, float)[:, :2]
+    a, b = np.asarray(a, float)[:2], np.asarray(b, float)[:2]
+    ab = b - a
+    n = float(ab @ ab)
+    s = np.zeros(len(P)) if n == 0 else np.clip((P - a) @ ab / n, 0.0, 1.0)
+    return np.linalg.norm(P - (a + s[:, None] * ab), axis=1)
+
+
+def point_segment_distance(point, a, b) -> float:
+    """Distance (m) in the plane from ``point`` to the segment from ``a`` to ``b``."""
+    c, a, b = (np.asarray(v, float)[:2] for v in (point, a, b))
+    ab = b - a
+    n = float(ab @ ab)
+    s = 0.0 if n == 0 else min(1.0, max(0.0, float((c - a) @ ab) / n))
+    return float(np.linalg.norm(c - (a + s * ab)))
+
+
+def _samples(seg, dt: float):
+    t = np.asarray(seg.t, float)
+    n = max(2, int(math.ceil((t[-1] - t[0]) / dt)) + 1)
+    ts = np.linspace(t[0], t[-1], n)
+    return ts - t[0], CubicHermiteSpline(t, seg.q, seg.qd, axis=0)(ts)
+
+
+def _on_blade(plan) -> np.ndarray:
+    for seg in plan.segments:
+        landing = getattr(seg, "landing", None) or {}
+        if "burger_on_blade" in landing:
+            return np.asarray(landing["burger_on_blade"], float)[:2]
+        placing = getattr(seg, "placing", None) or {}
+        if "on_blade" in placing:
+            return np.asarray(placing["on_blade"], float)[:2]
+    return np.zeros(2)
+
+
+def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMPLE_DT
+              ) -> Footprint:
+    """The :class:`Footprint` of a solved flip or serve plan (from its joint arrays)."""
+    cell = cell or plan.cell()
+    robot = robot or Robot(cell, with_burger=False)
+    h, top = cell.grill.height, cell.grill.height + cell.burger.thickness
+    on_blade = np.append(_on_blade(plan), 0.0)
+    out, t0, carrying = Footprint(), 0.0, False
+    location = np.asarray(plan.burger["location"], float)[:2]
+    for seg in plan.segments:
+        ts, qs = _samples(seg, dt)
+        release = (getattr(seg, "release", None) or {}).get("time")
+        prev = None
+        for t, q in zip(ts, qs):
+            M = robot.placement(q)
+            R, p = M.rotation, M.translation
+            section = slab_section(blade_rectangle(R, p, cell), h, top)
+            if len(section):
+                out.blade.append((t0 + t, seg.name, section[:, :2]))
+            if carrying and (release is None or t <= release):
+                centre = p + R @ on_blade
+                if centre[2] < top:
+                    out.carried.append((t0 + t, seg.name, (prev if prev is not None
+                                                            else centre)[:2], centre[:2]))
+                prev = centre
+        if seg.name == "scoop":
+            end = robot.placement(qs[-1])
+            centre = end.translation + end.rotation @ on_blade
+            out.carried.append((t0 + ts[-1], seg.name, location, centre[:2]))
+            carrying = True
+        if release is not None:
+            carrying = False
+        landing = getattr(seg, "landing", None)
+        if landing and "point" in landing:
+            spread = max([float(landing.get("offset", 0.0))]
+                         + [float(np.hypot(*(np.asarray(s["point"][:2])
+                                              - np.asarray(landing["point"][:2]))))
+                            for s in landing.get("scenarios", [])])
+            out.landing = (t0 + float(release) + float(landing["time_of_flight"]),
+                           tuple(float(v) for v in landing["point"][:2]),
+                           cell.burger.diameter / 2 + spread)
+        t0 += float(seg.T)
+    return out
+
+
+def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
+             margin: float | None = None) -> list[Meeting]:
+    """Where the motion of footprint ``fp``, started at ``start`` (s, cook clock), meets the
+    ``lying`` burgers (:class:`Lying`; each counts only while it lies, ``t0 <= t <= t1``).
+    One :class:`Meeting` per burger and part: the deepest."""
+    margin = default_margin() if margin is None else margin
+    r = cell.burger.diameter / 2
+    worst: dict[tuple, Meeting] = {}
+
+    def note(b: Lying, part, seg, t, overlap):
+        key = (b.burger, part)
+        if overlap > 0 and (key not in worst or overlap > worst[key].overlap_m):
+            worst[key] = Meeting(motion, b.burger, part, seg, t, overlap)
+
+    for b in lying:
+        def there(t):
+            return b.t0 <= t <= b.t1
+        for t, seg, poly in fp.blade:
+            if there(start + t):
+                note(b, "blade", seg, start + t,
+                     r + margin - point_polygon_distance(b.xy, poly))
+        for t, seg, a, c in fp.carried:
+            if there(start + t):
+                note(b, "carried burger", seg, start + t,
+                     2 * r + margin - point_segment_distance(b.xy, a, c))
+        if fp.landing is not None and there(start + fp.landing[0]):
+            t, point, radius = fp.landing
+            note(b, "landing", "flip", start + t,
+                 radius + r + margin - float(np.hypot(*(np.asarray(b.xy) - point))))
+    return sorted(worst.values(), key=lambda m: (m.t, m.burger))
+
+
+__all__ = ["SAMPLE_DT", "Footprint", "Lying", "Meeting", "approach_height", "blade_rectangle",
+           "default_margin",
+           "footprint", "meetings", "point_polygon_distance", "point_segment_distance",
+           "points_polygon_distance", "points_segment_distance", "slab_section"]

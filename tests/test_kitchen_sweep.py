@@ -1,0 +1,210 @@
+"""A cook's motions against the other burgers on the grill (flipkit.planning.kitchen.sweep and
+.clearance): the blade's section within a lying burger's height, distances to it, who meets
+whom and when, and the landing spot that keeps clear. Hand-built geometry with known answers;
+no planner runs."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from flipkit.config import CellConfig
+from flipkit.planning.kitchen.clearance import (CookConflictError, clear_cook, free_landing,
+                                               lying_burgers)
+from flipkit.planning.kitchen.cook import CookBurger
+from flipkit.planning.kitchen.sweep import (Footprint, Lying, approach_height,
+                                           blade_rectangle, default_margin, meetings,
+                                           point_polygon_distance, point_segment_distance,
+                                           points_polygon_distance, slab_section)
+
+CELL = CellConfig()
+L, W = CELL.spatula.length, CELL.spatula.width
+R = CELL.burger.diameter / 2
+H, T = CELL.grill.height, CELL.burger.thickness
+M = default_margin()
+
+
+def pitched(theta):
+    """Rotation about the world y axis by ``theta`` (tip down for theta > 0)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def yawed(psi):
+    c, s = math.cos(psi), math.sin(psi)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def test_the_blade_rectangle_follows_the_spatula_frame():
+    flat = blade_rectangle(np.eye(3), (0.7, -0.2, H), CELL)
+    assert sorted(np.round(flat[:, 0] - 0.7, 9)) == sorted([L / 2, -L / 2] * 2)
+    assert sorted(np.round(flat[:, 1] + 0.2, 9)) == sorted([W / 2, -W / 2] * 2)
+    assert np.allclose(flat[:, 2], H)
+    turned = blade_rectangle(yawed(math.pi / 2), (0, 0, 0), CELL)
+    assert np.isclose(np.abs(turned[:, 0]).max(), W / 2)  # its length now along world y
+    assert np.isclose(np.abs(turned[:, 1]).max(), L / 2)
+
+
+def test_the_section_of_a_pitched_blade_is_its_part_within_the_slab():
+    theta = 0.314  # the scoop's pitch: the tip (its +x end) low
+    rect = blade_rectangle(pitched(theta), (0, 0, 0), CELL)
+    # the blade plane: z = -x tan(theta); the slab [-h, 0] cuts x in [0, h / tan(theta)]
+    h = 0.015
+    sec = slab_section(rect, -h, 0.0)
+    assert sec[:, 0].min() == pytest.approx(0.0, abs=1e-12)
+    assert sec[:, 0].max() == pytest.approx(min(h / math.sin(theta), L / 2) * math.cos(theta),
+                                            rel=1e-9)
+    assert np.abs(sec[:, 1]).max() == pytest.approx(W / 2)
+    assert (sec[:, 2] >= -h - 1e-12).all() and (sec[:, 2] <= 1e-12).all()
+    assert slab_section(rect + [0, 0, 1.0], -h, 0.0).shape == (0, 3)  # all above
+    flat = blade_rectangle(np.eye(3), (0, 0, 0), CELL)
+    assert len(slab_section(flat, -h, h)) == 4  # all within: unchanged
+
+
+def test_distances_to_a_polygon_inside_along_an_edge_and_at_a_corner():
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    assert point_polygon_distance((0.3, 0.6), square) == 0.0
+    assert point_polygon_distance((1.5, 0.5), square) == pytest.approx(0.5)
+    assert point_polygon_distance((2, 2), square) == pytest.approx(math.sqrt(2))
+    assert point_polygon_distance((0.5, -0.25), square[::-1]) == pytest.approx(0.25)
+    assert point_segment_distance((0.5, 1.0), (0, 0), (1, 0)) == pytest.approx(1.0)
+    assert point_segment_distance((3, 0), (0, 0), (1, 0)) == pytest.approx(2.0)
+    pts = np.random.default_rng(0).uniform(-1, 2, (200, 2))
+    assert np.allclose(points_polygon_distance(pts, square),
+                       [point_polygon_distance(p, square) for p in pts])
+
+
+def blade_at(x, y, t=1.0, seg="scoop"):
+    """A footprint whose blade section is the flat blade at (x, y) at time t."""
+    return Footprint(blade=[(t, seg, blade_rectangle(np.eye(3), (x, y, H), CELL)[:, :2])])
+
+
+def test_a_lying_burger_is_met_within_its_radius_and_the_margin_and_only_while_it_lies():
+    fp = blade_at(0.7, -0.2)
+    edge = -0.2 + W / 2  # the blade's side edge
+    near = Lying("b2", (0.7, edge + R + M - 0.003), 0.0, 1e9)
+    clear = Lying("b3", (0.7, edge + R + M + 0.003), 0.0, 1e9)
+    (meet,) = meetings(fp, "flip:b1", 100.0, [near, clear], CELL)
+    assert (meet.burger, meet.part, meet.segment) == ("b2", "blade", "scoop")
+    assert meet.overlap_m == pytest.approx(0.003)
+    assert meet.t == pytest.approx(101.0)
+    assert "flip:b1" in meet.describe() and "b2" in meet.describe()
+    gone = Lying("b2", near.xy, 0.0, 100.5)  # served before the blade comes
+    assert meetings(fp, "flip:b1", 100.0, [gone], CELL) == []
+    assert meetings(fp, "flip:b1", 100.0, [near], CELL, margin=0.0) == []
+
+
+def test_the_carried_burger_and_the_landing_disc():
+    fp = Footprint(carried=[(0.5, "scoop", (0.70, -0.2), (0.74, -0.2))],
+                   landing=(2.0, (0.70, -0.2), R + 0.02))
+    ahead = Lying("b2", (0.74 + 2 * R + M - 0.002, -0.2), 0.0, 1e9)  # pushed into
+    beside = Lying("b3", (0.70, -0.2 + (R + 0.02) + R + M - 0.004), 0.0, 1e9)  # landed on
+    found = {(m.burger, m.part): m for m in meetings(fp, "flip:b1", 0.0, [ahead, beside], CELL)}
+    assert set(found) == {("b2", "carried burger"), ("b3", "landing")}
+    assert found["b2", "carried burger"].overlap_m == pytest.approx(0.002)
+    assert found["b3", "landing"].overlap_m == pytest.approx(0.004)
+    assert found["b3", "landing"].t == pytest.approx(2.0)
+
+
+def test_the_approach_clears_a_lying_burger_by_the_margin():
+    assert approach_height(CELL) == pytest.approx(T + M)
+    assert M == pytest.approx(0.01)  # the robust flips' placement spread, 2 x 5 mm
+
+
+# ---------------------------------------------------------------- a cook's timeline
+def fake_timeline(landing_b1=(0.64, -0.33)):
+    """b1 flipped at 90 s (landed at ``landing_b1``), b2's flip at 105 s scoops over
+    (0.56..0.72, -0.33 +- W/2); serves later."""
+    b1, b2 = CookBurger("b1", 0, 0.64, -0.33), CookBurger("b2", 15, 0.75, -0.45)
+    plans = {k: object() for k in ("f1", "f2", "s1", "s2")}
+    mk = SimpleNamespace
+    motions = [mk(kind="flip", burger="b1", key="flip:b1", start=87.0, end=91.0, event=90.0,
+                  ok=True, plan=plans["f1"]),
+               mk(kind="flip", burger="b2", key="flip:b2", start=102.0, end=106.0,
+                  event=105.0, ok=True, plan=plans["f2"]),
+               mk(kind="serve", burger="b1", key="serve:b1", start=148.0, end=154.0,
+                  event=150.0, ok=True, plan=plans["s1"]),
+               mk(kind="serve", burger="b2", key="serve:b2", start=163.0, end=169.0,
+                  event=165.0, ok=True, plan=plans["s2"])]
+    burgers = [mk(burger=b1, landing=landing_b1), mk(burger=b2, landing=(0.75, -0.45))]
+    fps = {plans["f1"]: Footprint(landing=(3.0, landing_b1, R + 0.015)),
+           plans["f2"]: blade_at(0.64, -0.33, t=1.0),
+           plans["s1"]: Footprint(), plans["s2"]: Footprint()}
+    return SimpleNamespace(burgers=burgers, motions=motions, ok=True), fps
+
+
+def test_where_each_burger_lies_and_when():
+    tl, _ = fake_timeline()
+    lying = lying_burgers(tl)
+    assert [(lie.burger, lie.landed, lie.t0, lie.t1) for lie in lying] == [
+        ("b1", False, 0, 87.0), ("b1", True, 90.0, 148.0),
+        ("b2", False, 15, 102.0), ("b2", True, 105.0, 163.0)]
+
+
+def test_a_met_burger_is_landed_clear_of_the_blade_nearest_its_drop():
+    tl, fps = fake_timeline()
+    spot = free_landing("b1", tl, CELL, fps.__getitem__)
+    blade = blade_at(0.64, -0.33).blade[0][2]
+    radius = R + 0.015  # b1's landing disc
+
+    def clear(c):  # b2's blade at 103 s, b2 lying (dropped, then landed) over b1's stay
+        return (point_polygon_distance(c, blade) >= R + M
+                and np.hypot(c[0] - 0.75, c[1] + 0.45) >= radius + R + M)
+
+    grid = [(x, y) for x in np.arange(0.60, 0.88 + 1e-9, M / 2)
+            for y in np.arange(-0.50, 0.16 + 1e-9, M / 2)]
+    best = min((c for c in grid if clear(c)), key=lambda c: np.hypot(c[0] - 0.64, c[1] + 0.33))
+    assert spot == pytest.approx(best) and clear(spot) and CELL.grill.contains(spot)
+    assert free_landing("b1", tl, CELL, fps.__getitem__, exclude=[spot]) != pytest.approx(spot)
+
+
+def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypatch):
+    import flipkit.planning.kitchen.clearance as clearance
+
+    tl, fps = fake_timeline()
+    calls = []
+
+    def schedule(lands):
+        calls.append(dict(lands))
+        moved = lands.get("b1")
+        t, f = fake_timeline(moved if moved else (0.64, -0.33))
+        fps.clear()
+        fps.update(f)
+        return t
+
+    monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
+    timeline, lands = clear_cook(schedule, CELL)
+    assert set(lands) == {"b1"} and calls[0] == {} and calls[-1] == lands
+    blade = blade_at(0.64, -0.33).blade[0][2]
+    assert point_polygon_distance(lands["b1"], blade) >= R + M - 1e-9
+
+    def unflipped(lands):  # b1 still lies where it was dropped when b2's blade comes
+        t, f = fake_timeline()
+        t.motions = [m for m in t.motions if m.burger != "b1"]
+        fps.clear()
+        fps.update(f)
+        return t
+
+    with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped"):
+        clear_cook(unflipped, CELL)
+
+
+def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():
+    from flipkit.behaviors.spec import Task
+    from flipkit.behaviors.transcribe import blade_floor
+    from flipkit.errors import ConfigError
+    from flipkit.planning.planners.inputs import check_approach_height
+
+    N, h = 20, approach_height(CELL)
+    plain = blade_floor("go_to_burger", CELL, N)
+    raised = blade_floor("go_to_burger", CELL, N, Task(approach_height=h))
+    assert np.allclose(raised[:N - 1], H + h) and np.array_equal(raised[N - 1:], plain[N - 1:])
+    assert np.array_equal(blade_floor("go_to_burger", CELL, N, Task()), plain)
+    for other in ("scoop", "pickup", "turn_back"):  # only the approach is raised
+        assert np.array_equal(blade_floor(other, CELL, N, Task(approach_height=h)),
+                              blade_floor(other, CELL, N))
+    assert check_approach_height(None) is None and check_approach_height(0.02) == 0.02
+    for bad in (-0.01, math.nan, "x"):
+        with pytest.raises(ConfigError, match="approach_height"):
+            check_approach_height(bad)
