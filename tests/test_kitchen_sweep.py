@@ -14,7 +14,7 @@ from flipkit.planning.kitchen.clearance import (CookConflictError, clear_cook, f
                                                lying_burgers)
 from flipkit.planning.kitchen.cook import CookBurger
 from flipkit.planning.kitchen.sweep import (Footprint, Lying, approach_height,
-                                           blade_rectangle, default_margin, meetings,
+                                           blade_rectangle, blade_section, default_margin, meetings,
                                            point_polygon_distance, point_segment_distance,
                                            points_polygon_distance, slab_section)
 
@@ -60,6 +60,17 @@ def test_the_section_of_a_pitched_blade_is_its_part_within_the_slab():
     assert slab_section(rect + [0, 0, 1.0], -h, 0.0).shape == (0, 3)  # all above
     flat = blade_rectangle(np.eye(3), (0, 0, 0), CELL)
     assert len(slab_section(flat, -h, h)) == 4  # all within: unchanged
+
+
+def test_a_blade_pressed_into_the_grill_counts_whole_and_a_raised_one_not_at_all():
+    pressed = blade_section(np.eye(3), (0.7, -0.2, H - 0.003), CELL)  # the scoop's press
+    assert len(pressed) == 4 and np.allclose(pressed, blade_rectangle(np.eye(3),
+                                                                      (0.7, -0.2, H - 0.003), CELL))
+    assert blade_section(np.eye(3), (0.7, -0.2, H + T + 0.001), CELL).shape == (0, 3)
+    theta = 0.314  # pitched, the tip 3 mm into the grill: the part below the burger's top
+    tip_down = blade_section(pitched(theta), (0.7, -0.2, H - 0.003 + L / 2 * math.sin(theta)),
+                             CELL)
+    assert tip_down[:, 2].max() == pytest.approx(H + T) and tip_down[:, 2].min() < H
 
 
 def test_distances_to_a_polygon_inside_along_an_edge_and_at_a_corner():

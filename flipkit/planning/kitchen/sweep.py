@@ -7,7 +7,8 @@ them in three ways, each computed from the plan and the cell (no other numbers):
   ``d``) from the grill surface ``h_g`` up to ``h_g + t`` (``t`` the patty's thickness).
   The blade is the rectangle ``length × width`` of the spatula frame's x-y plane (its
   thickness is inside the margin). At each sample of the plan the part of the rectangle
-  between ``h_g`` and ``h_g + t`` (:func:`slab_section`) is projected onto the grill; a
+  below ``h_g + t`` (:func:`blade_section`; a blade pressed below ``h_g`` is on the grill,
+  sliding under whatever lies there) is projected onto the grill; a
   lying burger whose disc comes within ``margin`` of that section is met. Only the go to
   burger, scoop and pickup reach that low; the test does not assume which segments do.
 * **The carried burger.** During the scoop the motion's own burger is pushed from where it
@@ -114,6 +115,14 @@ def blade_rectangle(R, p, cell: CellConfig) -> np.ndarray:
     return p + local @ R[:, :2].T
 
 
+def blade_section(R, p, cell: CellConfig) -> np.ndarray:
+    """The part (k×3, m, world) of the blade at rotation ``R`` and centre ``p`` that is
+    below the top of a burger lying on the grill (``h_g + t``): also where it is pressed
+    below the grill's surface, since a pressed blade lies on the grill; (0, 3) when none."""
+    top = cell.grill.height + cell.burger.thickness
+    return slab_section(blade_rectangle(R, p, cell), -math.inf, top)
+
+
 def slab_section(polygon, z_lo: float, z_hi: float) -> np.ndarray:
     """The part of a planar convex polygon (k×3, in order) with ``z_lo <= z <= z_hi``,
     clipped edge by edge (Sutherland–Hodgman on the two planes); (0, 3) when empty."""
@@ -211,7 +220,7 @@ def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMP
     """The :class:`Footprint` of a solved flip or serve plan (from its joint arrays)."""
     cell = cell or plan.cell()
     robot = robot or Robot(cell, with_burger=False)
-    h, top = cell.grill.height, cell.grill.height + cell.burger.thickness
+    top = cell.grill.height + cell.burger.thickness
     on_blade = np.append(_on_blade(plan), 0.0)
     out, t0, carrying = Footprint(), 0.0, False
     location = np.asarray(plan.burger["location"], float)[:2]
@@ -222,7 +231,7 @@ def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMP
         for t, q in zip(ts, qs):
             M = robot.placement(q)
             R, p = M.rotation, M.translation
-            section = slab_section(blade_rectangle(R, p, cell), h, top)
+            section = blade_section(R, p, cell)
             if len(section):
                 out.blade.append((t0 + t, seg.name, section[:, :2]))
             if carrying and (release is None or t <= release):
@@ -284,6 +293,7 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
 
 
 __all__ = ["SAMPLE_DT", "Footprint", "Lying", "Meeting", "approach_height", "blade_rectangle",
+           "blade_section",
            "default_margin",
            "footprint", "meetings", "point_polygon_distance", "point_segment_distance",
            "points_polygon_distance", "points_segment_distance", "slab_section"]
