@@ -19,7 +19,7 @@ from flipkit.planning.kitchen.cook import CookBurger
 from flipkit.planning.kitchen.motions import PlannedMotion, cached_planners, default_planners
 from flipkit.planning.kitchen.schedule import schedule_cook
 from flipkit.planning.kitchen.windows import Windows
-from flipkit.simulation.cook import CookNotSimulatedError, simulate_cook
+from flipkit.simulation.cook import CookNotSimulatedError, sensed_serve, simulate_cook
 from flipkit.simulation.scene import PARK_ORIGIN, build_scene, park_burger, place_burger
 
 CELL = CellConfig()
@@ -188,7 +188,8 @@ def test_simulate_cook_refuses_a_failed_timeline(monkeypatch):
 
 
 @pytest.mark.parametrize("argv, expect", [
-    (["--film", "x.gif"], "--film and --mode go with --simulate"),
+    (["--film", "x.gif"], "--film, --mode and --sense go with --simulate"),
+    (["--sense"], "--film, --mode and --sense go with --simulate"),
     (["--simulate", "--film", "x.avi"], "unknown output format"),
 ])
 def test_bad_simulation_options_are_one_line_and_exit_2(argv, expect, tmp_path, capsys):
@@ -198,3 +199,36 @@ def test_bad_simulation_options_are_one_line_and_exit_2(argv, expect, tmp_path, 
     code = cli.main(["schedule", str(path), "--json", str(tmp_path / "t.json")] + argv)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and expect in err[0]
+
+
+def test_a_sensed_serve_runs_only_a_solved_re_plan_no_longer_than_the_scheduled_one():
+    from types import SimpleNamespace as NS
+
+    def plan(T, status="solved", xy=(0.70, -0.20)):
+        return NS(status=status, segments=[NS(T=T / 2), NS(T=T / 2)],
+                  burger={"location": [xy[0], xy[1], 0.072]})
+
+    scene = build_scene(burgers=2)
+    place_burger(scene, (0.71, -0.18), burger=1)
+    scheduled = plan(6.0)
+    mo = NS(burger="b2", plan=scheduled)
+    seen = []
+
+    def replan_with(new):
+        def replan(motion, xy):
+            seen.append(np.array(xy))
+            return new
+        return replan
+
+    for new, runs, why in ((plan(6.0), "new", None), (plan(6.1), "old", "longer"),
+                           (plan(6.0, "failed"), "old", "failed"), (None, "old", "failed")):
+        records = []
+        got = sensed_serve(mo, scene, 1, replan_with(new), (0.003, -0.004), records)
+        assert got is (new if runs == "new" else scheduled)
+        (r,) = records
+        assert r["replanned"] == (runs == "new") and (why is None) == (r["why"] is None)
+        if why:
+            assert why in r["why"]
+        assert np.allclose(seen[-1], (0.713, -0.184), atol=1e-9)  # true place + the error
+        assert r["true_xy"] == pytest.approx([0.71, -0.18], abs=1e-9)
+        assert r["planned_xy"] == [0.7, -0.2]

@@ -28,6 +28,12 @@ skip are reported (:attr:`CookSimulation.skip_speed`), and ``step_idle=True`` st
 instead (the arm holding its last command), for comparison. A motion that starts less
 than one control step after the previous one's settling ends skips that fraction too.
 
+With ``sense_serve`` a serve is sense-plan-act: at its start the camera sees where its burger
+lies on the grill (the true place plus the camera's error, :data:`SENSING_SIGMA` per axis,
+seeded) and the serve is re-planned for that place; the new plan runs if it is verified and
+no longer than the planned one (the schedule is kept), else the planned one does. Planning
+happens while the burger cooks its second side, so it takes no cook time.
+
 The burgers are judged one by one on their own trajectories
 (:mod:`flipkit.simulation.cook_judges`); a burger moved while it lay untouched by its own
 motions is reported as knocked (:mod:`flipkit.simulation.cook_record`).
@@ -36,7 +42,7 @@ motions is reported as knocked (:mod:`flipkit.simulation.cook_record`).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -54,6 +60,9 @@ from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger
 
 REST_SPEED = 1e-3  # m/s (burger centres) and rad/s (arm joints): "at rest" before a skip
 MAX_SETTLE_S = 5.0  # s after a motion's end: the longest the cell is stepped to come to rest
+# m per axis: the camera's error on a burger's place, as sense-plan-act's on the blade
+# (flipkit.experiments.perturbations.Perturbations.sensing_sigma, with its source)
+SENSING_SIGMA = 0.005
 
 
 class CookNotSimulatedError(ConfigError):
@@ -78,6 +87,9 @@ class CookSimulation:
         scene: The cell, in its final state.
         runs: ``{(burger id, kind): BurgerRun}``: each burger's own trajectory over its flip
             and serve windows, on times from the motion's start (what the judges read).
+        sensed: One record per sensed serve (``sense_serve``): ``burger``, ``true_xy``,
+            ``sensed_xy``, ``planned_xy`` (m), ``replanned`` and ``why`` (the planned serve
+            ran), ``wall_s`` of the re-plan.
     """
 
     burgers: list[BurgerResult]
@@ -91,6 +103,7 @@ class CookSimulation:
     frames: list
     scene: Scene
     runs: dict
+    sensed: list = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -105,7 +118,7 @@ class CookSimulation:
                                    else round(self.min_distance_m, 6)),
                 "stepped_s": round(self.stepped_s, 3), "skipped_s": round(self.skipped_s, 3),
                 "skip_speed": {k: float(f"{v:.3g}") for k, v in self.skip_speed.items()},
-                "wall_s": round(self.wall_s, 2)}
+                "wall_s": round(self.wall_s, 2), "sensed_serves": self.sensed}
 
 
 def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) -> list:
@@ -126,7 +139,8 @@ def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) ->
 
 def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated",
                   cell: CellConfig | None = None, rate_hz: float = 1000.0,
-                  film_fps: float = 0.0, step_idle: bool = False) -> CookSimulation:
+                  film_fps: float = 0.0, step_idle: bool = False, sense_serve=None,
+                  sensing_sigma: float = SENSING_SIGMA, seed: int = 0) -> CookSimulation:
     """Simulate the whole cook of ``timeline`` (module docstring).
 
     Args:
@@ -138,6 +152,10 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         rate_hz: Joint controller rate (Hz).
         film_fps: Keep a frame every 1/film_fps s of stepped cook time (0: none).
         step_idle: Step the idle intervals instead of skipping them.
+        sense_serve: ``sense_serve(motion, xy) -> plan | None``: the serve of ``motion``
+            re-planned for its burger seen at ``xy`` (m) on the grill (module docstring);
+            ``None`` (default): every serve runs open loop as planned.
+        sensing_sigma: The camera's error (m, per axis). seed: Seed of its draws.
 
     Raises:
         CookNotSimulatedError: A failed schedule or one without plans.
@@ -177,7 +195,8 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
     now = min(b.burger.t_drop for b in records)
     stepped = skipped = 0.0
     speed = {"burger_m_s": 0.0, "arm_rad_s": 0.0}
-    refs_of = {}
+    refs_of, plans, sensed = {}, {}, []
+    rng = np.random.default_rng(seed)
     for i, mo in enumerate(motions):
         if mo.start > now + 1e-9:  # idle: skipped (module docstring)
             _note_speed(scene, rec, speed)
@@ -185,10 +204,14 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         apply_events(mo.start)
         rec.skipped_to(mo.start)
         nxt = motions[i + 1].start if i + 1 < len(motions) else np.inf
-        T = float(sum(s.T for s in mo.plan.segments))
+        plan = plans[i] = mo.plan
+        if sense_serve is not None and mo.kind == "serve":
+            plan = plans[i] = sensed_serve(mo, scene, index[mo.burger], sense_serve,
+                                            rng.normal(0.0, sensing_sigma, 2), sensed)
+        T = float(sum(s.T for s in plan.segments))
         gap = nxt - mo.end
         hold = gap if step_idle and np.isfinite(gap) else min(max(gap, 0.0), MAX_SETTLE_S)
-        refs = plan_references(mo.plan, robot, cell.physics, mode, command, dt, hold)
+        refs = plan_references(plan, robot, cell.physics, mode, command, dt, hold)
         refs_of[i] = refs
         d.time = mo.start
 
@@ -212,12 +235,33 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         runs = {}
         for i, (mo, w) in enumerate(zip(motions, watches)):
             if w.burger == k:
-                runs[mo.kind] = (mo.plan, w.run(scene, mo.start), refs_of[i].bounds, mo.start)
+                runs[mo.kind] = (plans[i], w.run(scene, mo.start), refs_of[i].bounds, mo.start)
                 all_runs[(mo.burger, mo.kind)] = runs[mo.kind][1]
         results.append(judge_burger(b, runs.get("flip"), runs.get("serve"), cell.table,
                                     rec.knocked_m[k], rec.contact_s[k]))
     return CookSimulation(results, mode, command, rec.min_distance_m, stepped, skipped, speed,
-                          time.perf_counter() - started, rec.frames, scene, all_runs)
+                          time.perf_counter() - started, rec.frames, scene, all_runs, sensed)
+
+
+def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
+    """The serve plan to run for motion ``mo``: re-planned for burger ``k`` where the camera
+    sees it (true place + ``error``), if verified and no longer than the planned one."""
+    true_xy = np.array(scene.data.qpos[scene.qpos_of(k)][:2], float)
+    xy = true_xy + np.asarray(error, float)
+    t0 = time.perf_counter()
+    new = sense_serve(mo, xy)
+    wall = time.perf_counter() - t0
+    T_old = float(sum(s.T for s in mo.plan.segments))
+    why = None
+    if new is None or new.status != "solved":
+        why = "the re-plan failed"
+    elif float(sum(s.T for s in new.segments)) > T_old + 1e-9:
+        why = "the re-plan is longer than the scheduled serve"
+    sensed.append({"burger": mo.burger, "true_xy": [round(float(v), 5) for v in true_xy],
+                   "sensed_xy": [round(float(v), 5) for v in xy],
+                   "planned_xy": [round(float(v), 5) for v in mo.plan.burger["location"][:2]],
+                   "replanned": why is None, "why": why, "wall_s": round(wall, 3)})
+    return mo.plan if why is not None else new
 
 
 def _at_rest(scene: Scene, active: np.ndarray) -> bool:
@@ -238,5 +282,5 @@ def _note_speed(scene: Scene, rec: CookRecorder, speed: dict) -> None:
                                   float(np.linalg.norm(d.qvel[scene.qvel_of(k)][:3])))
 
 
-__all__ = ["MAX_SETTLE_S", "REST_SPEED", "CookNotSimulatedError", "CookSimulation",
+__all__ = ["MAX_SETTLE_S", "REST_SPEED", "SENSING_SIGMA", "sensed_serve", "CookNotSimulatedError", "CookSimulation",
            "simulate_cook"]

@@ -123,7 +123,9 @@ def run(args: argparse.Namespace) -> int:
                                       args.minutes).to_dict()
     sim = None
     if getattr(args, "simulate", False) and timeline.ok:  # a failed schedule is not simulated
-        sim = simulate_cook(timeline, mode=args.mode, film_fps=FILM_FPS if args.film else 0.0)
+        sense = (motions.serve_replanner(cell, args.solver, atlas) if args.sense else None)
+        sim = simulate_cook(timeline, mode=args.mode, film_fps=FILM_FPS if args.film else 0.0,
+                            sense_serve=sense, seed=args.seed)
         doc["simulation"] = sim.to_dict()
     write_json(timeline_path, doc)
     if args.figure:
@@ -157,6 +159,12 @@ def _report_simulation(sim, args: argparse.Namespace) -> int:
               f"{'yes' if b.served else 'no'} ({dist} cm from its spot, "
               f"{s(b.deviation_s['serve'])} s from its mark), knocked {1000 * b.knocked_m:.1f} "
               f"mm{'' if b.ok else '; ' + b.failure}")
+    for r in sim.sensed:
+        print(f"sensed serve {r['burger']}: seen at ({r['sensed_xy'][0]:.3f}, "
+              f"{r['sensed_xy'][1]:.3f}), planned for ({r['planned_xy'][0]:.3f}, "
+              f"{r['planned_xy'][1]:.3f}); " + (f"re-planned in {r['wall_s']:.2f} s"
+                                                if r["replanned"] else
+                                                f"scheduled serve ran: {r['why']}"))
     film = ""
     if args.film:
         replace_with(args.film, lambda tmp: write_cook_film(sim, tmp,

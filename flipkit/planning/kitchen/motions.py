@@ -20,7 +20,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
-from flipkit.planning.planners.serve import plan_serve
+from flipkit.planning.planners.serve import plan_serve, table_spot
 
 KINDS = ("flip", "serve")
 
@@ -166,6 +166,29 @@ def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = 
             raise InvalidChoiceError("motion kind", kind, KINDS)
         out[kind] = makers[kind](cell, solver, atlas)
     return out
+
+
+def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
+                    ) -> Callable:
+    """Sense, plan, act for a cook's serves: ``replan(motion, xy) -> Plan | None`` plans the
+    serve of ``motion`` (a scheduled serve with its ``plan``) again, from the same start
+    configuration to the same table spot, for its burger seen at ``xy`` (m) on the grill,
+    coming in above the other burgers as :func:`serve_planner` does; ``None`` when the
+    place is off the grill or the plan fails (the caller then runs the scheduled serve)."""
+    cell = cell or CellConfig()
+
+    def replan(motion, xy):
+        old = motion.plan
+        location = (float(xy[0]), float(xy[1]), float(old.burger["location"][2]))
+        try:
+            plan = plan_serve(location, table_spot(old), q_start=old.segments[0].q[0],
+                              cell=cell, solver=solver, on_blade=None, atlas=atlas,
+                              approach_height=approach_height(cell))
+        except FlipkitError:
+            return None
+        return plan if plan.status == "solved" else None
+
+    return replan
 
 
 def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPlanner]:
