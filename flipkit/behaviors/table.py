@@ -36,8 +36,11 @@ CARRY = Subbehavior(
     end_pose=lambda ctx: sv.carry_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), cone_on_blade=True, guess=_to_table,
     record=record_placing, doc="to above the place pose, flat, cone on every node")
+# The tilt-off holds the burger in the cone planned for the least sticky burger (μ 0.16,
+# docs/robust-flips.md §2): within 0.8 s it had no solution at any serve tried, and every
+# serve spent an SQP and an IPOPT solve (~2 s) before its bound was stretched to 1.2 s.
 PLACE = Subbehavior(
-    "place", duration=(0.3, 0.8), carries_burger=True, end="rest", needs=("spot",),
+    "place", duration=(0.3, 1.2), carries_burger=True, end="rest", needs=("spot",),
     floor=sv.table_floor, exempt=tool_at_table, path=sv.place_pivot,
     end_pose=lambda ctx: sv.place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=place_cone, cone_on_blade=True, guess=_to_table, record=record_placing,
