@@ -278,3 +278,25 @@ def test_return_home_guess_makes_the_withdrawal():
     nodes = nlp.layout.nodes(nlp.x0)
     assert np.abs(nodes[-1, 0] - models.bare.q_home).max() < 0.02
     np.testing.assert_allclose(nodes[-1, 1], 0.0, atol=1e-9)
+
+
+def test_a_cook_serve_is_replanned_for_where_the_burger_is_seen(plan):
+    """motions.serve_replanner: the same start and table spot, the scoop at the seen place;
+    a place off the grill gives None (the scheduled serve then runs), never an exception."""
+    from types import SimpleNamespace
+
+    from flipkit.planning.kitchen.motions import serve_replanner
+
+    replan = serve_replanner()
+    motion = SimpleNamespace(plan=plan, burger="b1")
+    seen = (BURGER[0] + 0.012, BURGER[1] - 0.008)
+    new = replan(motion, seen)
+    assert new is not None and new.status == "solved" and verify_plan(new).ok
+    assert np.allclose(new.burger["location"], (*seen, BURGER[2]))
+    assert np.allclose(table_spot(new), table_spot(plan))
+    assert np.allclose(new.segments[0].q[0], plan.segments[0].q[0])
+    from flipkit.model.robot import Robot  # the scoop ends with the blade centre under it
+    robot = Robot(new.cell())
+    scoop = next(s for s in new.segments if s.name == "scoop")
+    assert np.allclose(robot.position(scoop.q[-1])[:2], seen, atol=2e-3)
+    assert replan(motion, (2.0, 0.0)) is None
