@@ -138,13 +138,15 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                   ) -> MotionPlanner:
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
-    job's table spot, carrying and placing the burger where the scoop model says its scoop
-    leaves it on the blade, coming in above the other burgers as the flip does; ``atlas`` (a
-    pickup-and-flip atlas) warm-starts its go to burger, scoop and pickup."""
+    job's table spot, placing the burger as if it lay at the blade centre (``plan_serve``'s
+    default: planned for the scoop model's predicted place, serves rested farther from their
+    spots in simulation, docs/benchmarks/2026-11-26-kitchen.md), coming in above the other
+    burgers as the flip does; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to
+    burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell, solver=solver,
-                       on_blade=None, atlas=atlas,
+                       atlas=atlas,
                        approach_height=approach_height(cell or CellConfig()))
         return from_plan(p, "serve", time.perf_counter() - t0)
 
@@ -182,7 +184,7 @@ def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=
         location = (float(xy[0]), float(xy[1]), float(old.burger["location"][2]))
         try:
             plan = plan_serve(location, table_spot(old), q_start=old.segments[0].q[0],
-                              cell=cell, solver=solver, on_blade=None, atlas=atlas,
+                              cell=cell, solver=solver, atlas=atlas,
                               approach_height=approach_height(cell))
         except FlipkitError:
             return None
