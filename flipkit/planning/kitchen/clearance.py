@@ -114,11 +114,12 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
     own = footprints(flip.plan)
     radius = own.landing[2] if own.landing is not None else r
     t0, t1 = flip.event, serve.start if serve is not None else math.inf
+    lying = lying_burgers(timeline)
     P = landing_candidates(cell, margin / 2)
     ok = np.ones(len(P), bool)
     for spot in exclude:
         ok &= np.hypot(*(P - np.asarray(spot)).T) > margin
-    for lie in lying_burgers(timeline):
+    for lie in lying:
         if lie.burger != burger and lie.t0 <= t1 and lie.t1 >= t0:
             ok &= np.hypot(*(P - np.asarray(lie.xy)).T) >= radius + r + margin
     for m in motions.values():
@@ -137,7 +138,7 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
         fp = footprints(serve.plan)
         old = np.asarray(rec.landing if rec.landing is not None else (rec.burger.x,
                                                                       rec.burger.y))
-        there = [lie for lie in lying_burgers(timeline) if lie.burger != burger
+        there = [lie for lie in lying if lie.burger != burger
                  and lie.t0 <= serve.end and lie.t1 >= serve.start]
         for lie in there:
             d_centre = np.asarray(lie.xy) - (P - old)  # the lying burger, seen from the serve

@@ -49,6 +49,13 @@ class MotionJob:
     table_spot: tuple | None = None
     land: tuple | None = None
 
+    @property
+    def key(self) -> tuple:
+        """What makes two jobs the same motion: every field, positions to 1e-9 m."""
+        def r(v):
+            return None if v is None else tuple(np.round(np.asarray(v, float), 9))
+        return (self.kind, self.burger, r(self.location), r(self.table_spot), r(self.land))
+
 
 @dataclass
 class PlannedMotion:
@@ -202,10 +209,7 @@ def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPl
 
     def maker(kind: str) -> MotionPlanner:
         def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
-            key = (kind, job.burger, tuple(np.round(job.location, 9)),
-                   None if job.table_spot is None else tuple(np.round(job.table_spot, 9)),
-                   None if job.land is None else tuple(np.round(job.land, 9)),
-                   tuple(np.round(np.asarray(q_start, float), 9)))
+            key = (kind, *job.key[1:], tuple(np.round(np.asarray(q_start, float), 9)))
             if key not in done:
                 done[key] = planners[kind](job, q_start)
             return done[key]

@@ -59,29 +59,24 @@ class PrefetchPlanners(Mapping):
             self._submit(MotionJob("flip", b.burger, b.location(cell)))
         self.on_demand = 0  # motions planned in this process (no prefetched match)
 
-    def _key(self, job: MotionJob) -> tuple:
-        return (job.kind, job.burger, tuple(np.round(job.location, 9)),
-                None if job.table_spot is None else tuple(np.round(job.table_spot, 9)),
-                None if job.land is None else tuple(np.round(job.land, 9)))
-
     def _submit(self, job: MotionJob) -> None:
         fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
                                    self.solver, self.atlas)
-        key = self._key(job)
+        key = job.key
         fut.add_done_callback(lambda _f, key=key: self._ready.setdefault(
             key, time.perf_counter() - self._t0))
         self._futures[key] = fut
 
     def prefetch(self, job: MotionJob) -> None:
         """Start planning ``job`` from the rest configuration now, unless it is already."""
-        if self._key(job) not in self._futures:
+        if job.key not in self._futures:
             self._submit(job)
 
     def _result(self, job: MotionJob, q_start) -> PlannedMotion:
         at_rest = np.abs(np.asarray(q_start, float) - self.q_rest).max() <= REST_TOL
         if at_rest:  # a job made later (another landing spot) is planned by a worker too
             self.prefetch(job)
-        fut = self._futures.get(self._key(job))
+        fut = self._futures.get(job.key)
         if fut is None or not at_rest:
             self.on_demand += 1
             t = time.perf_counter()
@@ -90,7 +85,7 @@ class PrefetchPlanners(Mapping):
             pm.planning_time_s = time.perf_counter() - t
             return pm
         pm = fut.result()
-        pm.ready_s = self._ready.get(self._key(job), time.perf_counter() - self._t0)
+        pm.ready_s = self._ready.get(job.key, time.perf_counter() - self._t0)
         if job.kind == "flip" and "serve" in self.kinds and pm.ok and job.burger in self._spots:
             self._submit(MotionJob("serve", job.burger, (*pm.landing, self.cell.grill.height),
                                    self._spots[job.burger]))

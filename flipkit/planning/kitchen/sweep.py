@@ -146,20 +146,8 @@ def slab_section(polygon, z_lo: float, z_hi: float) -> np.ndarray:
 
 def point_polygon_distance(point, polygon) -> float:
     """Distance (m) in the plane from ``point`` to a convex polygon (k×2, in order; also a
-    segment or a point): 0 inside it."""
-    c = np.asarray(point, float)[:2]
-    poly = np.asarray(polygon, float)[:, :2]
-    if len(poly) == 0:
-        return math.inf
-    if len(poly) >= 3:
-        edges = np.roll(poly, -1, axis=0) - poly
-        cross = edges[:, 0] * (c[1] - poly[:, 1]) - edges[:, 1] * (c[0] - poly[:, 0])
-        if np.all(cross >= -1e-15) or np.all(cross <= 1e-15):
-            return 0.0
-    best = math.inf
-    for k in range(len(poly)):
-        best = min(best, point_segment_distance(c, poly[k], poly[(k + 1) % len(poly)]))
-    return best
+    segment or a point): 0 inside it; ``inf`` for no polygon."""
+    return float(points_polygon_distance(np.asarray(point, float)[None, :2], polygon)[0])
 
 
 def points_polygon_distance(points, polygon) -> np.ndarray:
@@ -190,11 +178,7 @@ def points_segment_distance(points, a, b) -> np.ndarray:
 
 def point_segment_distance(point, a, b) -> float:
     """Distance (m) in the plane from ``point`` to the segment from ``a`` to ``b``."""
-    c, a, b = (np.asarray(v, float)[:2] for v in (point, a, b))
-    ab = b - a
-    n = float(ab @ ab)
-    s = 0.0 if n == 0 else min(1.0, max(0.0, float((c - a) @ ab) / n))
-    return float(np.linalg.norm(c - (a + s * ab)))
+    return float(points_segment_distance(np.asarray(point, float)[None, :2], a, b)[0])
 
 
 def _samples(seg, dt: float):
