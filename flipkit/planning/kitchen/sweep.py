@@ -258,21 +258,29 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
         if overlap > 0 and (key not in worst or overlap > worst[key].overlap_m):
             worst[key] = Meeting(motion, b.burger, part, seg, t, overlap)
 
-    for b in lying:
-        def there(t):
-            return b.t0 <= t <= b.t1
-        for t, seg, poly in fp.blade:
-            if there(start + t):
-                note(b, "blade", seg, start + t,
-                     r + margin - point_polygon_distance(b.xy, poly))
-        for t, seg, a, c in fp.carried:
-            if there(start + t):
-                note(b, "carried burger", seg, start + t,
-                     2 * r + margin - point_segment_distance(b.xy, a, c))
-        if fp.landing is not None and there(start + fp.landing[0]):
-            t, point, radius = fp.landing
-            note(b, "landing", "flip", start + t,
-                 radius + r + margin - float(np.hypot(*(np.asarray(b.xy) - point))))
+    lying = list(lying)
+    if not lying:
+        return []
+    xy = np.array([b.xy for b in lying], float)
+    since, until = (np.array([getattr(b, f) for b in lying], float) for f in ("t0", "t1"))
+
+    def check(t, part, seg, depth_of):  # every burger lying at t, at once
+        live = (since <= t) & (t <= until)
+        if live.any():
+            depth = depth_of()
+            for k in np.flatnonzero(live & (depth > 0)):
+                note(lying[k], part, seg, t, float(depth[k]))
+
+    for t, seg, poly in fp.blade:
+        check(start + t, "blade", seg,
+              lambda: r + margin - points_polygon_distance(xy, poly))
+    for t, seg, a, c in fp.carried:
+        check(start + t, "carried burger", seg,
+              lambda: 2 * r + margin - points_segment_distance(xy, a, c))
+    if fp.landing is not None:
+        t, point, radius = fp.landing
+        check(start + t, "landing", "flip",
+              lambda: radius + r + margin - np.hypot(*(xy - np.asarray(point)).T))
     return sorted(worst.values(), key=lambda m: (m.t, m.burger))
 
 
