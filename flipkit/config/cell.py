@@ -74,7 +74,9 @@ class SpatulaConfig:
     Attributes:
         length: Blade length l_l along its x axis (m).
         width: Blade width l_w (m).
-        thickness: Blade thickness (m), for the MuJoCo box.
+        thickness: Thickness (m) of the blade's box below its top face in the planner's
+            collision model and inertia (and the prescribed-blade simulator's): 3 mm, an
+            envelope of the simulated blade (``physics.blade_thickness``, 0.45-2 mm).
         handle: Distance from the tool flange to the blade centre along the tool z axis (m).
         mass: Total mass (kg), lumped at the blade centre for dynamics.
     """

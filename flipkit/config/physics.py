@@ -189,6 +189,33 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
 sensitivity study sweeps one at a time (see :func:`with_parameter`)."""
 
 
+KNOWN_PARAMETERS = ("physics.blade_thickness", "physics.bevel_length", "physics.edge_thickness",
+                    "physics.servo_rate_hz")
+"""The parameters of :data:`PHYSICAL_RANGES` that a cell knows: it chose its spatula (the
+blade's geometry) and its robot controller (the servo rate: a CB-series arm streams at
+125 Hz, an e-Series at 500 Hz). The others it cannot measure: the burger, the frictions, the
+contact damping, the servo's gains and latency. A plan is made for what the cell knows. The
+planner models the blade as its top face with a 3 mm collision box (``spatula.thickness``,
+an envelope of the blade's thickness range), so the blade's geometry does not change a plan.
+The servo rate changes the position commands (:func:`known_physics`)."""
+
+
+def known_physics(physics: PhysicsConfig, values: dict) -> PhysicsConfig:
+    """The cell's model of its own physics, as the commands use it: ``physics`` with the
+    known parameters among ``values`` (``{dotted name: value}``, keys of
+    :data:`PHYSICAL_RANGES`) set; every other entry is left at ``physics``'s value.
+
+    Raises:
+        InvalidChoiceError: A key that is not a parameter of :data:`PHYSICAL_RANGES`.
+    """
+    for name in values:
+        if name not in PHYSICAL_RANGES:
+            raise InvalidChoiceError("physical parameter", name, PHYSICAL_RANGES)
+    known = {name.split(".")[1]: float(v) for name, v in values.items()
+             if name in KNOWN_PARAMETERS}
+    return replace(physics, **known) if known else physics
+
+
 def with_parameter(cell: "CellConfig", name: str, value: float) -> "CellConfig":
     """``cell`` with one dotted parameter (a key of :data:`PHYSICAL_RANGES`) replaced."""
     if name not in PHYSICAL_RANGES:

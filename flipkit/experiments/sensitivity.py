@@ -1,9 +1,11 @@
 """One-at-a-time sensitivity of the simulated Table I trials to the physical parameters.
 
 Each parameter of :data:`flipkit.config.PHYSICAL_RANGES` is set to the low and to the high
-end of its plausible range, everything else nominal, in the simulated cell only (the plans
-and the replans keep the nominal model, as a real cell's planner would not know the true
-value); the Table I trials (:func:`flipkit.experiments.trials.run_trial`, by default the package's
+end of its plausible range, everything else nominal, in the simulated cell. The plans and
+the replans keep the nominal model, as a real cell's planner would not know the true value,
+except for what the cell knows (:data:`flipkit.config.KNOWN_PARAMETERS`: its blade's
+geometry, which no plan depends on, and its servo rate, for which the position commands are
+made, :func:`flipkit.config.known_physics`); the Table I trials (:func:`flipkit.experiments.trials.run_trial`, by default the package's
 sense-plan-act pipeline in feed-forward mode) run over the given plans at each setting, and
 the scoop, pickup and flip successes are counted (cumulative, as in Table I). The nominal
 cell runs on the same draws for reference. All trials are one sweep

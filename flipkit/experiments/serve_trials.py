@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flipkit.config import with_parameter
+from flipkit.config import known_physics, with_parameter
 from flipkit.errors import ConfigError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
@@ -52,7 +52,8 @@ def run_serve_trial(job: dict) -> dict:
     replan = replan_serve if job.get("replan", False) else None
     mode = job.get("mode", FEEDFORWARD)
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan, command=job.get("command", "compensated"))
+                      replan=replan, command=job.get("command", "compensated"),
+                      servo=known_physics(plan.cell().physics, job.get("physics") or {}))
     run, bounds = ex.run, ex.bounds
     spot = table_spot(ex.plan)
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])

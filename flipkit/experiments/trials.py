@@ -24,7 +24,7 @@ import numpy as np
 from flipkit.behaviors import targets as tg
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
                                       judge_flip, judge_pickup, judge_scoop)
-from flipkit.config import CellConfig, with_parameter
+from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.perturbations import Perturbations
@@ -122,7 +122,9 @@ def run_trial(job: dict) -> dict:
             optionally ``replan`` (bool, see :func:`validate`) and ``physics``
             (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
             simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
-            and any replan keep the nominal model).
+            and any replan keep the nominal model, and the position commands use the values
+            the cell knows, :data:`flipkit.config.KNOWN_PARAMETERS`, through
+            :func:`flipkit.config.known_physics`).
 
     Returns:
         ``trial``, ``ok`` ({stage: bool}, cumulative), ``independent`` ({stage: bool}, each
@@ -142,8 +144,9 @@ def run_trial(job: dict) -> dict:
         cell = with_parameter(cell, name, value)
     replan = replan_flip if job.get("replan", False) else None
     command = job.get("command", "compensated")
+    servo = known_physics(plan.cell().physics, job.get("physics") or {})
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan, command=command)
+                      replan=replan, command=command, servo=servo)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))

@@ -73,18 +73,21 @@ class References:
 
 
 def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: float,
-                    hold: float, t_pause: float = np.inf, pause: float = 0.0) -> References:
+                    hold: float, t_pause: float = np.inf, pause: float = 0.0,
+                    servo=None) -> References:
     """The references of ``plan`` every ``dt`` s until ``hold`` s after its end (module
     docstring: the two controllers), the plan paused ``pause`` s at ``t_pause`` (a replan).
 
     Args:
         plan: A solved plan. robot: The arm (position mode's controller model).
-        physics: The plant's :class:`~flipkit.config.PhysicsConfig` (servo rate, latency);
-            commands use the plan's nominal servo model (``plan.cell().physics``).
+        physics: The plant's :class:`~flipkit.config.PhysicsConfig` (servo rate, latency).
         mode, command: As :func:`execute_plan`. dt: Controller period (s).
         hold: Time (s) the last desired state is held after the plan.
+        servo: The cell's model of its servo, which the commands use (a
+            :class:`~flipkit.config.PhysicsConfig`); default the plan's nominal one
+            (``plan.cell().physics``).
     """
-    nominal = plan.cell().physics  # the cell's model of its servo, which commands use
+    nominal = plan.cell().physics if servo is None else servo
     T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments) + pause
     t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
     q_des, qd_des, u_ff, bounds = desired(plan, paused(t, t_pause, pause))

@@ -113,7 +113,7 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None,
-                 command: str = "compensated") -> Execution:
+                 command: str = "compensated", servo=None) -> Execution:
     """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
@@ -134,9 +134,13 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
         command: ``position`` mode's command stream, one of
             :data:`~flipkit.planning.plans.servo_command.COMMANDS`: ``"compensated"`` (default) sends
-            q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the nominal latency and half a servo period,
-            ``"raw"`` the plan's (q, q̇) as they are. Commands use the plan's nominal servo
-            model; the servo itself follows ``cell.physics``.
+            q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the modelled latency and half a servo period,
+            ``"raw"`` the plan's (q, q̇) as they are. Commands use ``servo``; the servo itself
+            follows ``cell.physics``.
+        servo: The cell's model of its servo for position commands (a
+            :class:`~flipkit.config.PhysicsConfig`: rate, latency, gains); default the plan's
+            nominal one. A cell that knows a parameter (its controller's servo rate) passes
+            :func:`~flipkit.config.known_physics` of it.
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
             rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
@@ -167,7 +171,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     control = ArmController.of(robot, ph, mode, rate_hz, m.opt.timestep)
     dt = control.substeps * m.opt.timestep
 
-    refs = plan_references(plan, robot, ph, mode, command, dt, hold)
+    refs = plan_references(plan, robot, ph, mode, command, dt, hold, servo=servo)
     t_sense = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
 
     pb = np.asarray(plan.burger["location"], float)
@@ -212,7 +216,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         # The arm held at rest while the replan ran: the rest of the run starts after that
         # pause, a whole number of control steps long.
         pause = dt * np.ceil(sense["time"] / dt - 1e-9)
-        new_refs = plan_references(new, robot, ph, mode, command, dt, hold, t[k], pause)
+        new_refs = plan_references(new, robot, ph, mode, command, dt, hold, t[k], pause,
+                                   servo=servo)
         if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):
             raise ConfigError("the replanned run does not extend the executed one")
         return new_refs
