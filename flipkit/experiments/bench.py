@@ -416,6 +416,9 @@ def main(argv=None) -> int:
     parser.add_argument("--validate", metavar="FILE",
                         help="replan: the sensed places of this `flipkit validate --replan "
                              "--json` result (default: run Table I, 3 trials, position mode)")
+    parser.add_argument("--contingencies", action="store_true",
+                        help="replan: also prepare each plan's contingency flips and time the "
+                             "re-plan that uses them")
     parser.add_argument("--locations", type=int, default=len(TABLE1_LOCATIONS), metavar="N",
                         help="flip: the first N Table I locations (default all ten)")
     parser.add_argument("--batch", type=int, default=5, metavar="K",
@@ -446,7 +449,8 @@ def main(argv=None) -> int:
         result = bench_translate(cell, args.full, args.jit)
     elif args.which == "replan":
         print(machine())
-        result = bench_replan(load_result(args.validate) if args.validate else run_validation())
+        result = bench_replan(load_result(args.validate) if args.validate else run_validation(),
+                              args.contingencies)
     else:
         atlas = None
         if not args.no_atlas:

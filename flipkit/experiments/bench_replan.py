@@ -10,7 +10,12 @@ after the other on an otherwise idle machine. It prints the median and the worst
 many places the robust plan already served as it was (no solve: the place lies in its
 scenarios' hull, or its own flight lands it within ``r_scenario``).
 
-Run as ``python -m flipkit.experiments.bench replan [--validate FILE]``.
+With ``--contingencies`` it also prepares each plan's contingency flips
+(:class:`~flipkit.planning.planners.contingency.Contingencies`, one after the other in this
+process, timed) and times the re-plan that uses them at the same places: kept, handed a
+contingency, or solved.
+
+Run as ``python -m flipkit.experiments.bench replan [--validate FILE] [--contingencies]``.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import FlipkitError
 from flipkit.experiments.trials import validate_locations
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.contingency import Contingencies
 from flipkit.planning.planners.planner import covers, plan_flip, replan_flip
 
 TARGET_S = 0.15  # s, the latency the sense-plan-act cycle is to stay within
@@ -51,28 +57,45 @@ def run_validation(trials: int = 3, seed: int = 3) -> dict:
                                   replan=True, executor=pool, progress=False)
 
 
-def bench_replan(result: dict) -> dict:
-    """Time ``replan_flip`` at every sensed place of ``result``; print; return the rows."""
-    atlas, rows = default_atlas(), []
+def _timed(fn, *args):
+    t0 = time.perf_counter()
+    out = fn(*args)
+    return out, time.perf_counter() - t0
+
+
+def bench_replan(result: dict, contingencies: bool = False) -> dict:
+    """Time ``replan_flip`` at every sensed place of ``result`` (and, with
+    ``contingencies``, the re-plan through each plan's :class:`Contingencies`); print;
+    return the rows and the summary."""
+    atlas, rows, prepared = default_atlas(), [], []
     print(f"{'location (m)':<24}{'sensed (mm)':>16}{'in hull':>9}{'kept':>6}{'replan s':>10}"
-          f"{'status':>8}")
+          f"{'status':>8}" + (f"{'with contingencies':>20}{'s':>7}" if contingencies else ""))
     for loc, places in sensed_places(result):
         plan = plan_flip(loc, atlas=atlas)
         if plan.status != "solved":
             print(f"{str(loc):<24} plan failed: {plan.failure}")
             continue
         landing = next(s for s in plan.segments if s.name == "flip").landing
+        extra = Contingencies.prepare(plan) if contingencies else None
+        if extra is not None:
+            prepared.append({"location": loc, "time_s": extra.wall_time_s,
+                             "solved": len(extra.flips), "failed": len(extra.failed)})
         for xy in places:
-            t0 = time.perf_counter()
-            new = replan_flip(plan, xy)
-            dt = time.perf_counter() - t0
+            new, dt = _timed(replan_flip, plan, xy)
             row = {"location": loc, "sensed": list(xy), "covered": covers(landing, xy),
                    "kept": new is plan, "time_s": dt, "status": new.status}
+            line = (f"{'(' + ', '.join(f'{v:.3f}' for v in loc) + ')':<24}"
+                    f"{f'({1e3 * xy[0]:.1f}, {1e3 * xy[1]:.1f})':>16}{str(row['covered']):>9}"
+                    f"{str(row['kept']):>6}{dt:10.3f}{new.status:>8}")
+            if extra is not None:
+                got, dt_c = _timed(extra, plan, xy)
+                how = ("kept" if got is plan else "contingency"
+                       if any(got is p for _, p in extra.flips) else "solved")
+                row.update(contingency_time_s=dt_c, contingency_how=how,
+                           contingency_status=got.status)
+                line += f"{how:>20}{dt_c:7.3f}"
             rows.append(row)
-            print(f"{'(' + ', '.join(f'{v:.3f}' for v in loc) + ')':<24}"
-                  f"{f'({1e3 * xy[0]:.1f}, {1e3 * xy[1]:.1f})':>16}{str(row['covered']):>9}"
-                  f"{str(row['kept']):>6}"
-                  f"{dt:10.3f}{new.status:>8}", flush=True)
+            print(line, flush=True)
     times = np.array([r["time_s"] for r in rows])
     solved = np.array([r["time_s"] for r in rows if not r["kept"]])
     summary = {"replans": len(rows), "covered": int(sum(r["covered"] for r in rows)),
@@ -81,6 +104,26 @@ def bench_replan(result: dict) -> dict:
                "median_s": float(np.median(times)), "worst_s": float(times.max()),
                "median_solving_s": float(np.median(solved)) if solved.size else None,
                "within_target": int(np.sum(times <= TARGET_S)), "target_s": TARGET_S}
+    if contingencies:
+        with_c = np.array([r["contingency_time_s"] for r in rows])
+        prep = np.array([p["time_s"] for p in prepared])
+        summary["contingencies"] = {
+            "prepare_median_s": float(np.median(prep)), "prepare_worst_s": float(prep.max()),
+            "median_s": float(np.median(with_c)), "worst_s": float(with_c.max()),
+            "served": {h: sum(r["contingency_how"] == h for r in rows)
+                       for h in ("kept", "contingency", "solved")},
+            "solved_ok": int(sum(r["contingency_status"] == "solved" for r in rows)),
+            "within_target": int(np.sum(with_c <= TARGET_S)),
+            "prepared": prepared}
+        c = summary["contingencies"]
+        made = sum(p["solved"] for p in prepared)
+        print(f"with contingencies ({made} of {made + sum(p['failed'] for p in prepared)} "
+              f"solved over {len(prepared)} plans, each plan's prepared in a median "
+              f"{c['prepare_median_s']:.2f} s, worst {c['prepare_worst_s']:.2f} s, one after "
+              f"the other): {c['served']['kept']} kept, {c['served']['contingency']} handed a "
+              f"contingency, {c['served']['solved']} solved; latency median "
+              f"{c['median_s']:.3f} s, worst {c['worst_s']:.3f} s; "
+              f"{c['within_target']}/{len(rows)} within {TARGET_S} s")
     print(f"{summary['replans']} replans: {summary['kept']} kept the robust plan (no solve; "
           f"{summary['covered']} inside its scenarios' hull), {summary['solved_ok']} solved; "
           f"latency median {summary['median_s']:.3f} s, "

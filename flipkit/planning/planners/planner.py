@@ -178,6 +178,24 @@ def landing_miss(flip, on_blade, models) -> float:
     return float(np.hypot(*(pred["point"][:2] - np.asarray(flip.landing["target"], float))))
 
 
+def promise(plan: Plan) -> float:
+    """The radius (m) within which a solved flip plan promises to land a burger lying at any
+    of its scenarios' places: the scenarios' ``r_land`` (``r_scenario``), or the nominal
+    ``r_land`` of a plan without scenarios."""
+    landing = next(s for s in plan.segments if s.name == "flip").landing
+    return max((row["r_land"] for row in landing.get("scenarios", ())),
+               default=landing["r_land"])
+
+
+def keeps_promise(plan: Plan, on_blade, models) -> bool:
+    """Whether a solved flip plan, as it is, lands a burger measured at ``on_blade`` (x, y)
+    (m) within :func:`promise`: the place lies in its scenarios' hull (:func:`covers`), or
+    its own release and flight land it so (:func:`landing_miss`)."""
+    flip = next(s for s in plan.segments if s.name == "flip")
+    return (covers(flip.landing, on_blade)
+            or landing_miss(flip, on_blade, models) <= promise(plan))
+
+
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
                 options: SegmentOptions = SegmentOptions(), keep: bool = True) -> Plan:
     """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
@@ -213,10 +231,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     flip = next(s for s in plan.segments if s.name == "flip")
     planner = Planner(cell, solver=solver,
                       options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
-    radius = max((row["r_land"] for row in flip.landing.get("scenarios", ())),
-                 default=flip.landing["r_land"])
-    if keep and (covers(flip.landing, on_blade)
-                 or landing_miss(flip, on_blade, planner.models) <= radius):
+    if keep and keeps_promise(plan, on_blade, planner.models):
         return plan
     done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
     before = {s.name: s for s in plan.segments}
@@ -318,5 +333,6 @@ def format_summary(rows) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "landing_miss",
-           "plan_batch", "plan_flip", "plan_translate", "replan_flip", "summary_table"]
+__all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "keeps_promise",
+           "landing_miss", "plan_batch", "plan_flip", "plan_translate", "promise", "replan_flip",
+           "summary_table"]

@@ -1,0 +1,134 @@
+"""Contingency flips: the re-plans that sense-plan-act is likely to need, made ahead.
+
+After the scoop the cell measures where the burger lies on the blade and re-plans the flip
+(:func:`~flipkit.planning.planners.planner.replan_flip`). A robust plan lands every place
+within its scenarios' promise, and then the re-plan returns it at once. A place outside
+costs an SQP solve of flip and turn back (about 0.5 s on the 2-core machine) while the arm
+holds. Such places lie beyond the scenario set: in the tails of the placement and sensing
+errors, and where the scoop's unmodelled drift takes the burger, further along the blade or
+to its side (``docs/robust-flips.md`` §4). :class:`Contingencies` solves the flips for four
+such places before they are needed, which a cell can do while the arm goes to the burger
+and scoops (1.35 s). At the measurement it hands out the one whose own release and flight
+land the measured place within the plan's promise: a check of milliseconds instead of a
+solve.
+
+Every contingency is a re-plan as :func:`replan_flip` makes it (go to burger, scoop and
+pickup kept), solved and verified; a place that none of them lands is solved as before.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from flipkit.errors import ConfigError
+from flipkit.planning.planners.chain import Planner
+from flipkit.planning.planners.inputs import check_replan
+from flipkit.planning.planners.planner import keeps_promise, landing_miss, promise, replan_flip
+from flipkit.planning.plans.plan_file import Plan
+
+# m: how far past the scenario set's extremes the contingency places lie: along the blade,
+# and to its side. The side margin is larger: the scoop's sideways drift is not in the
+# scenario set (docs/benchmarks/2026-11-27-landing-budget.md).
+MARGIN = (0.015, 0.025)
+
+
+def contingency_places(plan: Plan, margin=MARGIN) -> list[tuple[float, float]]:
+    """Four places (x, y) (m, blade frame) beyond a robust flip plan's scenario set:
+    ``margin[0]`` past its extremes along the blade (at the predicted place's y) and
+    ``margin[1]`` past them to each side (at the predicted x), clipped to the blade.
+
+    Raises:
+        ConfigError: ``plan`` is not a solved flip plan.
+    """
+    cell, _ = check_replan(plan, "flip", (0.0, 0.0))
+    landing = next(s for s in plan.segments if s.name == "flip").landing
+    x0, y0 = (float(v) for v in landing["burger_on_blade"][:2])
+    pts = np.array([row["burger_on_blade"][:2] for row in landing.get("scenarios", ())]
+                   or [(x0, y0)], float)
+    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    mx, my = (float(v) for v in margin)
+    places = [(pts[:, 0].min() - mx, y0), (pts[:, 0].max() + mx, y0),
+              (x0, pts[:, 1].min() - my), (x0, pts[:, 1].max() + my)]
+    return [tuple(float(v) for v in np.clip(p, -half, half)) for p in places]
+
+
+def solve_contingency(job: tuple) -> Plan:
+    """``replan_flip(plan, place, solver=solver, keep=False)`` of ``job = (plan, place,
+    solver)`` (a worker)."""
+    plan, place, solver = job
+    return replan_flip(plan, place, solver=solver, keep=False)
+
+
+@dataclass
+class Contingencies:
+    """Solved re-plans of one robust flip plan for places on the blade, and their lookup.
+
+    Attributes:
+        plan: The flip plan they belong to.
+        flips: ``[(place, plan)]``: each place (x, y) (m, blade frame) whose re-plan was
+            solved, and that re-plan.
+        failed: The places whose re-plan failed (never handed out).
+        wall_time_s: Wall time (s) of :meth:`prepare`.
+    """
+
+    plan: Plan
+    flips: list
+    failed: list
+    wall_time_s: float
+
+    @classmethod
+    def prepare(cls, plan: Plan, places=None, *, solver: str = "auto",
+                executor=None) -> "Contingencies":
+        """Solve the re-plans of ``plan`` for ``places`` (default
+        :func:`contingency_places`), on ``executor`` (an Executor) if given.
+
+        Raises:
+            ConfigError: ``plan`` is not a solved flip plan, or a place is off the blade.
+        """
+        t0 = time.perf_counter()
+        places = contingency_places(plan) if places is None else [
+            tuple(float(v) for v in check_replan(plan, "flip", p)[1]) for p in places]
+        jobs = [(plan, p, solver) for p in places]
+        made = (list(executor.map(solve_contingency, jobs)) if executor is not None
+                else [solve_contingency(j) for j in jobs])
+        return cls(plan, [(p, m) for p, m in zip(places, made) if m.status == "solved"],
+                   [p for p, m in zip(places, made) if m.status != "solved"],
+                   time.perf_counter() - t0)
+
+    def lookup(self, on_blade) -> Plan | None:
+        """The contingency, nearest place first, whose own release and flight land a burger
+        at ``on_blade`` (x, y) (m) within the plan's promise (:func:`promise`); ``None``
+        when none does.
+
+        Raises:
+            ConfigError: ``on_blade`` is off the blade.
+        """
+        cell, xy = check_replan(self.plan, "flip", on_blade)
+        models, radius = Planner(cell).models, promise(self.plan)
+        for _, plan in sorted(self.flips, key=lambda f: float(np.hypot(*(np.subtract(f[0], xy))))):
+            if landing_miss(next(s for s in plan.segments if s.name == "flip"), xy,
+                            models) <= radius:
+                return plan
+        return None
+
+    def __call__(self, plan: Plan, on_blade) -> Plan:
+        """Sense-plan-act's re-plan (``execute_plan(..., replan=contingencies)``): ``plan``
+        itself where it keeps its promise, else the contingency that lands the measured
+        place, else :func:`replan_flip`'s solve.
+
+        Raises:
+            ConfigError: ``plan`` is not the plan these contingencies were made for, or
+                ``on_blade`` is off the blade.
+        """
+        if plan is not self.plan:
+            raise ConfigError("these contingencies were made for another plan")
+        cell, xy = check_replan(plan, "flip", on_blade)
+        if keeps_promise(plan, xy, Planner(cell).models):
+            return plan
+        return self.lookup(xy) or replan_flip(plan, xy, keep=False)
+
+
+__all__ = ["MARGIN", "Contingencies", "contingency_places", "solve_contingency"]
