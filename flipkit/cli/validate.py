@@ -2,9 +2,10 @@
 
 Exit status: 0 the trials ran (whatever their outcomes); 2 bad input (missing or malformed
 plan file, a plan that is not a solved flip or serve plan or fails ``flipkit verify``,
-trials outside [1, 10000], a rate outside [10, 100000] Hz, a location off the grill, an
-unreachable scheduler, an output that is not a writable ``.json`` file or is the plan) — one
-line on stderr, checked before any trial runs, nothing written.
+``--contingencies`` without ``--replan`` or with a serve plan, trials outside [1, 10000], a
+rate outside [10, 100000] Hz, a location off the grill, an unreachable scheduler, an output
+that is not a writable ``.json`` file or is the plan) — one line on stderr, checked before
+any trial runs, nothing written.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import argparse
 
 from flipkit.cli.common import (MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
                                 check_float, check_int, deferred, precheck_plan)
+from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 
 RATE_RANGE = (10.0, 100_000.0)  # Hz, --rate of the PD controller
@@ -54,6 +56,11 @@ def register(subparsers) -> None:
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
                              "(serve: at the end of the carry, re-plan place and return home)")
+    parser.add_argument("--contingencies", action="store_true",
+                        help="with --replan, flips only: prepare each plan's contingency flips "
+                             "once and let the re-plans hand them out (docs/robust-flips.md "
+                             "section 4); the arm also waits for what the preparation took "
+                             "beyond the scoop's end")
     add_sweep_arguments(parser)
     parser.add_argument("--json", required=True, metavar="OUT.json",
                         help="output file (.json; not the plan)")
@@ -80,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
     """Check the options, the outputs and the plan file cheaply, then verify the plan and run
     the trials (:mod:`flipkit.cli.commands.validate`)."""
     check_int("--trials", args.trials, 1, MAX_TRIALS)
+    if args.contingencies and not args.replan:
+        raise ConfigError("--contingencies needs --replan: they are re-plans made ahead")
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")
     if args.workers is not None:
         check_int("--workers", args.workers, 1, MAX_WORKERS)

@@ -40,9 +40,13 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
 
 
 def trial_key(job: dict) -> dict:
-    """Cache key of a trial job: the plan's digest instead of its text."""
-    return {**{k: v for k, v in job.items() if k != "plan_text"},
-            "plan": stable_hash(job["plan_text"])}
+    """Cache key of a trial job: the plan's digest instead of its text, and the contingency
+    record's (:mod:`flipkit.experiments.contingent`) instead of it."""
+    key = {**{k: v for k, v in job.items() if k != "plan_text"},
+           "plan": stable_hash(job["plan_text"])}
+    if "contingencies" in job:
+        key["contingencies"] = stable_hash(job["contingencies"])
+    return key
 
 
 def merge_tracking(errors: list) -> dict:

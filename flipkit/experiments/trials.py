@@ -26,6 +26,7 @@ from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.serve_trials import validate_serve
@@ -119,7 +120,9 @@ def run_trial(job: dict) -> dict:
             rate, Hz), ``mode`` (:data:`flipkit.simulation.modes.MODES`; default ``"feedforward"``),
             ``command`` (position mode's command stream,
             :data:`flipkit.planning.plans.servo_command.COMMANDS`; default ``"compensated"``),
-            optionally ``replan`` (bool, see :func:`validate`) and ``physics``
+            optionally ``replan`` (bool, see :func:`validate`), ``contingencies`` (the
+            plan's contingency record, :func:`flipkit.experiments.contingent.prepare`: the
+            re-plan hands them out) and ``physics``
             (``{dotted name: value}``, keys of :data:`flipkit.config.PHYSICAL_RANGES`: the
             simulated cell's parameters set by :func:`flipkit.config.with_parameter`; the plan
             and any replan keep the nominal model, and the position commands use the values
@@ -142,11 +145,13 @@ def run_trial(job: dict) -> dict:
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
-    replan = replan_flip if job.get("replan", False) else None
+    replan, wait = (replan_flip if job.get("replan", False) else None), 0.0
+    if replan is not None and "contingencies" in job:
+        replan, wait = replanner(plan, job["contingencies"]), job["contingencies"]["wait_s"]
     command = job.get("command", "compensated")
     servo = known_physics(plan.cell().physics, job.get("physics") or {})
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan, command=command, servo=servo)
+                      replan=replan, command=command, servo=servo, replan_wait_s=wait)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
@@ -217,7 +222,8 @@ def plan_location(job: dict) -> dict:
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
              rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
-             replan: bool = False, command: str = "compensated") -> dict:
+             replan: bool = False, command: str = "compensated",
+             contingencies: bool = False) -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -232,6 +238,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             and re-plan pickup, flip and turn back for it (:func:`flipkit.planning.planners.planner.replan_flip`);
             ``False`` runs the plans open loop.
         command: Position mode's command stream (:data:`flipkit.planning.plans.servo_command.COMMANDS`).
+        contingencies: With ``replan``: each plan's contingency flips are prepared once (on
+            ``executor``) and the re-plans hand them out (:mod:`flipkit.experiments.contingent`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
 
     Returns:
@@ -249,12 +257,19 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan,
                              command=command)
             jobs, owner = jobs + new, owner + [k] * len(new)
+    records = {}
+    if contingencies and replan:
+        jobs, records = attach(jobs, executor)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
+    for entry, (_, _, text) in zip(entries, targets):
+        if text in records:
+            entry["contingencies"] = contingency_summary(records[text])
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
+            "contingencies": bool(contingencies and replan),
             "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),

@@ -7,6 +7,7 @@ import argparse
 
 from flipkit.cli.common import write_json
 from flipkit.cli.validate import format_table
+from flipkit.errors import ConfigError
 from flipkit.experiments.compare_ik import LOCATION_SETS
 from flipkit.experiments.sweep import make_executor
 from flipkit.experiments.trials import validate_locations, validate_plan_file
@@ -16,9 +17,13 @@ from flipkit.planning.plans.verify import load_verified
 def run(args: argparse.Namespace) -> int:
     """Verify the plan, run the trials, write the JSON, print the table."""
     if args.plan is not None:
-        load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
+        plan = load_verified(args.plan, ("flip", "serve"))  # refused before any worker starts
+        if args.contingencies and plan.behavior != "flip":
+            raise ConfigError(f"{args.plan}: --contingencies needs a flip plan, got a "
+                              f"{plan.behavior} plan")
     common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
-                  replan=args.replan, command=args.command)
+                  replan=args.replan, command=args.command,
+                  **({"contingencies": True} if args.contingencies else {}))
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,

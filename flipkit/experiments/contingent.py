@@ -1,0 +1,91 @@
+"""Sense-plan-act trials whose re-plans come from contingency flips made ahead
+(``flipkit validate --replan --contingencies``).
+
+A cell prepares a plan's contingency flips once
+(:class:`~flipkit.planning.planners.contingency.Contingencies`). It starts when the plan
+starts: the arm goes to the burger and scoops, and the camera looks at the blade only when
+the scoop has ended. Here they are prepared once per plan, in this process, on the sweep's
+executor when one is given, and every trial of that plan hands them to its re-plan. The arm
+holds at the sense for the re-plan's own wall time (a check, or a solve where no contingency
+lands the place), plus whatever the preparation took beyond the time the plan spends
+before the sense (``wait_s``). So a preparation slower than the motion it overlaps shows in
+the executed run.
+
+Each contingency is checked by :func:`~flipkit.planning.plans.verify.verify_plan` after the
+round trip through its file text, before any trial can receive it.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from flipkit.errors import FlipkitError
+from flipkit.experiments.trial_jobs import plan_from_text
+from flipkit.planning.planners.contingency import Contingencies
+from flipkit.planning.plans.verify import verify_plan
+from flipkit.simulation.execute import SENSE_AFTER
+
+
+def plan_text(plan) -> str:
+    """The text of ``plan``'s file."""
+    with tempfile.TemporaryDirectory() as tmp:
+        return plan.to_json(Path(tmp) / "plan.json").read_text()
+
+
+def sense_time(plan) -> float:
+    """Time (s) from a flip plan's start to its sense: the end of its scoop."""
+    total = 0.0
+    for seg in plan.segments:
+        total += float(seg.T)
+        if seg.name == SENSE_AFTER[plan.behavior]:
+            return total
+    raise FlipkitError(f"a {plan.behavior} plan without a {SENSE_AFTER[plan.behavior]}")
+
+
+def prepare(text: str, executor=None) -> dict:
+    """The contingency record of the flip plan of file text ``text``, as trial jobs carry it:
+    ``{"places": [[x, y] ...], "texts": [plan text ...], "prepare_s": wall time (s),
+    "wait_s": max(0, prepare_s − the plan's sense time), "failed": [[x, y] ...]}``.
+
+    Raises:
+        FlipkitError: A contingency that fails verification after its round trip.
+    """
+    plan = plan_from_text(text)
+    made = Contingencies.prepare(plan, executor=executor)
+    texts = []
+    for place, flip in made.flips:
+        texts.append(plan_text(flip))
+        report = verify_plan(plan_from_text(texts[-1]))
+        if not report.ok:
+            raise FlipkitError(f"contingency at {place}: {report.summary()}")
+    return {"places": [list(p) for p, _ in made.flips], "texts": texts,
+            "prepare_s": made.wall_time_s,
+            "wait_s": max(0.0, made.wall_time_s - sense_time(plan)),
+            "failed": [list(p) for p in made.failed]}
+
+
+def attach(jobs: list, executor=None) -> tuple[list, dict]:
+    """``jobs`` (trial jobs with ``replan``) with each plan's contingency record under
+    ``"contingencies"``, prepared once per plan text; and ``{plan text: record}``."""
+    records = {}
+    for job in jobs:
+        if job["plan_text"] not in records:
+            records[job["plan_text"]] = prepare(job["plan_text"], executor)
+    return [{**job, "contingencies": records[job["plan_text"]]} for job in jobs], records
+
+
+def summary(record: dict) -> dict:
+    """What a validate result records of a plan's contingencies: ``places``, ``failed``
+    (m), ``prepare_s`` and ``wait_s`` (s)."""
+    return {k: record[k] for k in ("places", "failed", "prepare_s", "wait_s")}
+
+
+def replanner(plan, record: dict) -> Contingencies:
+    """The re-plan of a trial of ``plan`` from its job's contingency record."""
+    flips = [(tuple(p), plan_from_text(t)) for p, t in zip(record["places"], record["texts"])]
+    return Contingencies(plan, flips, [tuple(p) for p in record["failed"]],
+                         float(record["prepare_s"]))
+
+
+__all__ = ["attach", "plan_text", "prepare", "replanner", "sense_time", "summary"]

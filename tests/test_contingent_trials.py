@@ -1,0 +1,89 @@
+"""Sense-plan-act trials whose re-plans come from contingency flips made ahead
+(flipkit.experiments.contingent, flipkit validate --replan --contingencies)."""
+
+import pytest
+
+from flipkit.cli import main
+from flipkit.experiments import contingent
+from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.trial_jobs import plan_from_text, trial_jobs, trial_key
+from flipkit.experiments.trials import run_trial, validate
+from flipkit.planning.planners.contingency import contingency_places
+from flipkit.simulation.execute import execute_plan
+
+
+@pytest.fixture(scope="module")
+def record(flip_plan_file):
+    return contingent.prepare(flip_plan_file.read_text())
+
+
+def test_the_record_holds_every_contingency_verified_and_the_wait_beyond_the_scoop(
+        flip_plan, record):
+    assert record["places"] == [list(p) for p in contingency_places(flip_plan)]
+    assert len(record["texts"]) == 4 and record["failed"] == []
+    sense = sum(float(s.T) for s in flip_plan.segments[:2])  # go to burger, scoop
+    assert contingent.sense_time(flip_plan) == pytest.approx(sense)
+    assert record["wait_s"] == pytest.approx(max(0.0, record["prepare_s"] - sense))
+
+
+def test_the_replanner_hands_out_the_contingency_of_a_place(flip_plan_file, record):
+    plan = plan_from_text(flip_plan_file.read_text())
+    replan = contingent.replanner(plan, record)
+    place = record["places"][2]
+    got = replan(plan, place)
+    assert got is replan.flips[2][1]
+    flip = next(s for s in got.segments if s.name == "flip")
+    assert flip.landing["burger_on_blade"][:2] == pytest.approx(place)
+
+
+def test_the_arm_waits_for_an_unfinished_preparation(flip_plan):
+    keep = lambda plan, on_blade: plan  # noqa: E731  (a re-plan that keeps the plan)
+    quick = execute_plan(flip_plan, "feedforward", None, replan=keep)
+    late = execute_plan(flip_plan, "feedforward", None, replan=keep, replan_wait_s=0.3)
+    assert late.replan_time_s == pytest.approx(quick.replan_time_s + 0.3, abs=0.05)
+    shift = late.bounds["pickup"][0] - quick.bounds["pickup"][0]
+    assert 0.29 <= shift <= 0.36
+    with pytest.raises(Exception, match="replan_wait_s"):
+        execute_plan(flip_plan, "feedforward", None, replan=keep, replan_wait_s=-1.0)
+
+
+def test_a_trial_with_contingencies_and_its_cache_key(flip_plan_file, record):
+    job = trial_jobs(flip_plan_file.read_text(), 1, 3, Perturbations(), replan=True)[0]
+    with_c = {**job, "contingencies": record}
+    key = trial_key(with_c)
+    assert isinstance(key["contingencies"], str) and key != trial_key(job)
+    out = run_trial(with_c)
+    assert out["replan"]["time_s"] >= record["wait_s"]
+    assert set(out["ok"]) == {"scoop", "pickup", "flip"}
+
+
+def test_validate_prepares_once_per_plan(flip_plan_file, monkeypatch):
+    calls = []
+    real = contingent.prepare
+
+    def counting(text, executor=None):
+        calls.append(text)
+        return real(text, executor)
+
+    monkeypatch.setattr(contingent, "prepare", counting)
+    text = flip_plan_file.read_text()
+    out = validate([([0.69, -0.16, 0.072], {}, text)], 2, seed=3, replan=True,
+                   contingencies=True, progress=False)
+    assert out["contingencies"] is True and len(calls) == 1
+    assert out["summary"]["trials"] == 2
+    rec = out["locations"][0]["contingencies"]
+    assert len(rec["places"]) == 4 and rec["wait_s"] >= 0 and rec["prepare_s"] > 0
+    off = validate([([0.69, -0.16, 0.072], {}, text)], 1, seed=3, replan=False,
+                   contingencies=True, progress=False)
+    assert off["contingencies"] is False and len(calls) == 1  # open loop: nothing prepared
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--contingencies"], "--contingencies needs --replan"),
+])
+def test_contingencies_need_replan(tmp_path, capsys, flip_plan_file, extra, message):
+    code = main(["validate", "--plan", str(flip_plan_file), "--trials", "1", "--json",
+                 str(tmp_path / "v.json"), *extra])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0]
+    assert not (tmp_path / "v.json").exists()
