@@ -40,6 +40,8 @@ def test_places_lie_past_the_scenarios_by_the_margin(flip_plan):
 
 def test_each_contingency_is_a_verified_replan_for_its_place(flip_plan, side):
     assert len(side.flips) == 2 and not side.failed and side.wall_time_s > 0
+    assert len(side.ready_s) == 2 and side.ready_s[0] < side.ready_s[1] <= side.wall_time_s
+    assert side.sense_s is None and side.wait_s(1) == 0.0  # no sense time: all count ready
     models = Planner(flip_plan.cell()).models
     for place, plan in side.flips:
         assert plan.status == "solved" and verify_plan(plan).ok
@@ -95,3 +97,14 @@ def test_bench_replan_times_the_replan_with_and_without_contingencies(capsys):
     assert c["served"] == {"kept": 1, "contingency": 1, "solved": 0}
     assert c["prepared"][0]["solved"] == 4 and c["prepare_worst_s"] > 0
     assert "handed a contingency" in capsys.readouterr().out
+
+
+def test_prepared_on_an_executor_the_contingencies_are_the_same(flip_plan, side):
+    from concurrent.futures import ThreadPoolExecutor
+
+    place, plan = side.flips[0]
+    with ThreadPoolExecutor(1) as pool:
+        pooled = Contingencies.prepare(flip_plan, [place], executor=pool)
+    (same, other), = pooled.flips
+    assert same == pytest.approx(place) and len(pooled.ready_s) == 1
+    np.testing.assert_array_equal(_flip(other).q, _flip(plan).q)

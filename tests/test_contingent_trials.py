@@ -9,7 +9,6 @@ from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.trial_jobs import plan_from_text, trial_jobs, trial_key
 from flipkit.experiments.trials import run_trial, validate
 from flipkit.planning.planners.contingency import contingency_places
-from flipkit.simulation.execute import execute_plan
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +22,9 @@ def test_the_record_holds_every_contingency_verified_and_the_wait_beyond_the_sco
     assert len(record["texts"]) == 4 and record["failed"] == []
     sense = sum(float(s.T) for s in flip_plan.segments[:2])  # go to burger, scoop
     assert contingent.sense_time(flip_plan) == pytest.approx(sense)
-    assert record["wait_s"] == pytest.approx(max(0.0, record["prepare_s"] - sense))
+    assert record["sense_s"] == pytest.approx(sense)
+    assert len(record["ready_s"]) == 4
+    assert 0 < min(record["ready_s"]) and max(record["ready_s"]) <= record["prepare_s"]
 
 
 def test_the_replanner_hands_out_the_contingency_of_a_place(flip_plan_file, record):
@@ -36,15 +37,22 @@ def test_the_replanner_hands_out_the_contingency_of_a_place(flip_plan_file, reco
     assert flip.landing["burger_on_blade"][:2] == pytest.approx(place)
 
 
-def test_the_arm_waits_for_an_unfinished_preparation(flip_plan):
-    keep = lambda plan, on_blade: plan  # noqa: E731  (a re-plan that keeps the plan)
-    quick = execute_plan(flip_plan, "feedforward", None, replan=keep)
-    late = execute_plan(flip_plan, "feedforward", None, replan=keep, replan_wait_s=0.3)
-    assert late.replan_time_s == pytest.approx(quick.replan_time_s + 0.3, abs=0.05)
-    shift = late.bounds["pickup"][0] - quick.bounds["pickup"][0]
-    assert 0.29 <= shift <= 0.36
-    with pytest.raises(Exception, match="replan_wait_s"):
-        execute_plan(flip_plan, "feedforward", None, replan=keep, replan_wait_s=-1.0)
+def test_a_contingency_not_ready_at_the_sense_is_waited_for(flip_plan_file, record):
+    import time
+
+    plan = plan_from_text(flip_plan_file.read_text())
+    late = {**record, "ready_s": [record["sense_s"] + 0.3] * 4}  # all ready 0.3 s too late
+    replan = contingent.replanner(plan, late)
+    assert replan.wait_s(2) == pytest.approx(0.3)
+    t0 = time.perf_counter()
+    assert replan(plan, record["places"][2]) is replan.flips[2][1]
+    assert time.perf_counter() - t0 >= 0.3
+    x0, y0 = next(s for s in plan.segments if s.name == "flip").landing["burger_on_blade"][:2]
+    t0 = time.perf_counter()
+    assert replan(plan, (x0, y0)) is plan  # kept: nothing to wait for
+    assert time.perf_counter() - t0 < 0.3
+    early = contingent.replanner(plan, {**record, "ready_s": [0.0] * 4})
+    assert early.wait_s(2) == 0.0
 
 
 def test_a_trial_with_contingencies_and_its_cache_key(flip_plan_file, record):
@@ -53,7 +61,7 @@ def test_a_trial_with_contingencies_and_its_cache_key(flip_plan_file, record):
     key = trial_key(with_c)
     assert isinstance(key["contingencies"], str) and key != trial_key(job)
     out = run_trial(with_c)
-    assert out["replan"]["time_s"] >= record["wait_s"]
+    assert out["replan"]["time_s"] is not None and out["replan"]["failure"] is None
     assert set(out["ok"]) == {"scoop", "pickup", "flip"}
 
 
@@ -72,7 +80,7 @@ def test_validate_prepares_once_per_plan(flip_plan_file, monkeypatch):
     assert out["contingencies"] is True and len(calls) == 1
     assert out["summary"]["trials"] == 2
     rec = out["locations"][0]["contingencies"]
-    assert len(rec["places"]) == 4 and rec["wait_s"] >= 0 and rec["prepare_s"] > 0
+    assert len(rec["places"]) == len(rec["ready_s"]) == 4 and rec["prepare_s"] > 0
     off = validate([([0.69, -0.16, 0.072], {}, text)], 1, seed=3, replan=False,
                    contingencies=True, progress=False)
     assert off["contingencies"] is False and len(calls) == 1  # open loop: nothing prepared

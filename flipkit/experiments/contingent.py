@@ -4,12 +4,11 @@
 A cell prepares a plan's contingency flips once
 (:class:`~flipkit.planning.planners.contingency.Contingencies`). It starts when the plan
 starts: the arm goes to the burger and scoops, and the camera looks at the blade only when
-the scoop has ended. Here they are prepared once per plan, in this process, on the sweep's
-executor when one is given, and every trial of that plan hands them to its re-plan. The arm
-holds at the sense for the re-plan's own wall time (a check, or a solve where no contingency
-lands the place), plus whatever the preparation took beyond the time the plan spends
-before the sense (``wait_s``). So a preparation slower than the motion it overlaps shows in
-the executed run.
+the scoop has ended (:func:`sense_time`). Here they are prepared once per plan, in this
+process, on the sweep's executor when one is given, with the time each one was ready; every
+trial of that plan hands them to its re-plan. The arm holds at the sense for the re-plan's
+wall time: a check, a contingency (and, if it was not ready when the camera looked, the
+rest of its solve, waited for), or a solve where none lands the place.
 
 Each contingency is checked by :func:`~flipkit.planning.plans.verify.verify_plan` after the
 round trip through its file text, before any trial can receive it.
@@ -45,8 +44,9 @@ def sense_time(plan) -> float:
 
 def prepare(text: str, executor=None) -> dict:
     """The contingency record of the flip plan of file text ``text``, as trial jobs carry it:
-    ``{"places": [[x, y] ...], "texts": [plan text ...], "prepare_s": wall time (s),
-    "wait_s": max(0, prepare_s − the plan's sense time), "failed": [[x, y] ...]}``.
+    ``{"places": [[x, y] ...], "texts": [plan text ...], "ready_s": [s after the preparation
+    began, each], "prepare_s": wall time (s), "sense_s": the plan's sense time (s),
+    "failed": [[x, y] ...]}``.
 
     Raises:
         FlipkitError: A contingency that fails verification after its round trip.
@@ -60,9 +60,8 @@ def prepare(text: str, executor=None) -> dict:
         if not report.ok:
             raise FlipkitError(f"contingency at {place}: {report.summary()}")
     return {"places": [list(p) for p, _ in made.flips], "texts": texts,
-            "prepare_s": made.wall_time_s,
-            "wait_s": max(0.0, made.wall_time_s - sense_time(plan)),
-            "failed": [list(p) for p in made.failed]}
+            "ready_s": list(made.ready_s), "prepare_s": made.wall_time_s,
+            "sense_s": sense_time(plan), "failed": [list(p) for p in made.failed]}
 
 
 def attach(jobs: list, executor=None) -> tuple[list, dict]:
@@ -77,15 +76,16 @@ def attach(jobs: list, executor=None) -> tuple[list, dict]:
 
 def summary(record: dict) -> dict:
     """What a validate result records of a plan's contingencies: ``places``, ``failed``
-    (m), ``prepare_s`` and ``wait_s`` (s)."""
-    return {k: record[k] for k in ("places", "failed", "prepare_s", "wait_s")}
+    (m), ``ready_s``, ``prepare_s`` and ``sense_s`` (s)."""
+    return {k: record[k] for k in ("places", "failed", "ready_s", "prepare_s", "sense_s")}
 
 
 def replanner(plan, record: dict) -> Contingencies:
     """The re-plan of a trial of ``plan`` from its job's contingency record."""
     flips = [(tuple(p), plan_from_text(t)) for p, t in zip(record["places"], record["texts"])]
     return Contingencies(plan, flips, [tuple(p) for p in record["failed"]],
-                         float(record["prepare_s"]))
+                         float(record["prepare_s"]), [float(v) for v in record["ready_s"]],
+                         float(record["sense_s"]))
 
 
 __all__ = ["attach", "plan_text", "prepare", "replanner", "sense_time", "summary"]

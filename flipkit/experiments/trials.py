@@ -145,13 +145,13 @@ def run_trial(job: dict) -> dict:
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
-    replan, wait = (replan_flip if job.get("replan", False) else None), 0.0
+    replan = replan_flip if job.get("replan", False) else None
     if replan is not None and "contingencies" in job:
-        replan, wait = replanner(plan, job["contingencies"]), job["contingencies"]["wait_s"]
+        replan = replanner(plan, job["contingencies"])
     command = job.get("command", "compensated")
     servo = known_physics(plan.cell().physics, job.get("physics") or {})
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan, command=command, servo=servo, replan_wait_s=wait)
+                      replan=replan, command=command, servo=servo)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))

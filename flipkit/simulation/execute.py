@@ -75,9 +75,8 @@ class Execution:
             (``replan_failure`` says where it was).
         replan_failure: Why the replan failed (the original, verified plan then ran on), or
             ``None``.
-        replan_time_s: Wall time (s) of the replan, plus ``replan_wait_s``; the arm held at
-            rest that long (rounded up to a control step) before the replanned motion.
-            ``None`` open loop.
+        replan_time_s: Wall time (s) of the replan; the arm held at rest that long (rounded
+            up to a control step) before the replanned motion. ``None`` open loop.
     """
 
     run: BurgerRun
@@ -114,8 +113,7 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None,
-                 command: str = "compensated", servo=None,
-                 replan_wait_s: float = 0.0) -> Execution:
+                 command: str = "compensated", servo=None) -> Execution:
     """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
@@ -139,10 +137,6 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the modelled latency and half a servo period,
             ``"raw"`` the plan's (q, q̇) as they are. Commands use ``servo``; the servo itself
             follows ``cell.physics``.
-        replan_wait_s: Time (s) the arm also holds at the sense because the re-plan's
-            preparation (contingency flips made while the arm moved,
-            :mod:`flipkit.experiments.contingent`) was not done yet; ``replan_time_s`` counts
-            it with the re-plan's own wall time.
         servo: The cell's model of its servo for position commands (a
             :class:`~flipkit.config.PhysicsConfig`: rate, latency, gains); default the plan's
             nominal one. A cell that knows a parameter (its controller's servo rate) passes
@@ -164,8 +158,6 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         The :class:`Execution`; ``execution.plan`` is the plan finally executed.
     """
     d_ = _check(plan, mode, draw, hold, rate_hz)
-    if not (np.isfinite(replan_wait_s) and replan_wait_s >= 0):
-        raise ConfigError(f"need replan_wait_s >= 0 s, got {replan_wait_s!r}")
     if command not in COMMANDS:
         raise InvalidChoiceError("position command", command, COMMANDS)
     cell = cell or plan.cell()
@@ -215,7 +207,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                 new = replan(plan, sensed)
             except FlipkitError as exc:
                 new, sense["failure"] = None, str(exc)
-            sense["time"] = time.perf_counter() - started + replan_wait_s
+            sense["time"] = time.perf_counter() - started
         if new is not None and new.status != "solved":
             new, sense["failure"] = None, new.failure or "replanned plan not solved"
         if new is None:

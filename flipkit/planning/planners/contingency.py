@@ -14,12 +14,20 @@ solve.
 
 Every contingency is a re-plan as :func:`replan_flip` makes it (go to burger, scoop and
 pickup kept), solved and verified; a place that none of them lands is solved as before.
+
+A contingency may not be ready when the camera looks: the preparation starts with the plan,
+and its solves can outlast the 1.35 s of motion before the sense. The object records when
+each one became ready (``ready_s``, from the start of the preparation). Given ``sense_s``,
+the time of the sense on that clock, handing out a contingency that was not ready by then
+waits the rest of its solve, as a cell would wait for a solve under way. A plan that is
+kept, or a contingency that was ready, costs no wait.
 """
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,12 +80,17 @@ class Contingencies:
             solved, and that re-plan.
         failed: The places whose re-plan failed (never handed out).
         wall_time_s: Wall time (s) of :meth:`prepare`.
+        ready_s: For each of ``flips``, when it was ready (s after the preparation began).
+        sense_s: When the camera looks, on the same clock (s); ``None``: every contingency
+            counts as ready (module docstring).
     """
 
     plan: Plan
     flips: list
     failed: list
     wall_time_s: float
+    ready_s: list = field(default_factory=list)
+    sense_s: float | None = None
 
     @classmethod
     def prepare(cls, plan: Plan, places=None, *, solver: str = "auto",
@@ -92,11 +105,25 @@ class Contingencies:
         places = contingency_places(plan) if places is None else [
             tuple(float(v) for v in check_replan(plan, "flip", p)[1]) for p in places]
         jobs = [(plan, p, solver) for p in places]
-        made = (list(executor.map(solve_contingency, jobs)) if executor is not None
-                else [solve_contingency(j) for j in jobs])
-        return cls(plan, [(p, m) for p, m in zip(places, made) if m.status == "solved"],
-                   [p for p, m in zip(places, made) if m.status != "solved"],
-                   time.perf_counter() - t0)
+        made, ready = [None] * len(jobs), [0.0] * len(jobs)
+        if executor is None:
+            for i, job in enumerate(jobs):
+                made[i], ready[i] = solve_contingency(job), time.perf_counter() - t0
+        else:
+            futures = {executor.submit(solve_contingency, job): i for i, job in enumerate(jobs)}
+            for future in cf.as_completed(futures):
+                i = futures[future]
+                made[i], ready[i] = future.result(), time.perf_counter() - t0
+        ok = [i for i, m in enumerate(made) if m.status == "solved"]
+        return cls(plan, [(places[i], made[i]) for i in ok],
+                   [places[i] for i in range(len(made)) if i not in ok],
+                   time.perf_counter() - t0, [ready[i] for i in ok])
+
+    def wait_s(self, k: int) -> float:
+        """How long (s) handing out contingency ``k`` at the sense waits for its solve."""
+        if self.sense_s is None or not self.ready_s:
+            return 0.0
+        return max(0.0, self.ready_s[k] - self.sense_s)
 
     def lookup(self, on_blade) -> Plan | None:
         """The contingency, nearest place first, whose own release and flight land a burger
@@ -106,18 +133,23 @@ class Contingencies:
         Raises:
             ConfigError: ``on_blade`` is off the blade.
         """
+        k = self._lookup(on_blade)
+        return None if k is None else self.flips[k][1]
+
+    def _lookup(self, on_blade) -> int | None:
         cell, xy = check_replan(self.plan, "flip", on_blade)
         models, radius = Planner(cell).models, promise(self.plan)
-        for _, plan in sorted(self.flips, key=lambda f: float(np.hypot(*(np.subtract(f[0], xy))))):
-            if landing_miss(next(s for s in plan.segments if s.name == "flip"), xy,
-                            models) <= radius:
-                return plan
+        for k in sorted(range(len(self.flips)),
+                        key=lambda i: float(np.hypot(*np.subtract(self.flips[i][0], xy)))):
+            flip = next(s for s in self.flips[k][1].segments if s.name == "flip")
+            if landing_miss(flip, xy, models) <= radius:
+                return k
         return None
 
     def __call__(self, plan: Plan, on_blade) -> Plan:
         """Sense-plan-act's re-plan (``execute_plan(..., replan=contingencies)``): ``plan``
         itself where it keeps its promise, else the contingency that lands the measured
-        place, else :func:`replan_flip`'s solve.
+        place (after waiting :meth:`wait_s` for it), else :func:`replan_flip`'s solve.
 
         Raises:
             ConfigError: ``plan`` is not the plan these contingencies were made for, or
@@ -128,7 +160,11 @@ class Contingencies:
         cell, xy = check_replan(plan, "flip", on_blade)
         if keeps_promise(plan, xy, Planner(cell).models):
             return plan
-        return self.lookup(xy) or replan_flip(plan, xy, keep=False)
+        k = self._lookup(xy)
+        if k is None:
+            return replan_flip(plan, xy, keep=False)
+        time.sleep(self.wait_s(k))  # the solve still under way (module docstring)
+        return self.flips[k][1]
 
 
 __all__ = ["MARGIN", "Contingencies", "contingency_places", "solve_contingency"]
