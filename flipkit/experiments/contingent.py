@@ -16,20 +16,11 @@ round trip through its file text, before any trial can receive it.
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 from flipkit.errors import FlipkitError
-from flipkit.experiments.trial_jobs import plan_from_text
+from flipkit.experiments.trial_jobs import plan_from_text, plan_text
 from flipkit.planning.planners.contingency import Contingencies
 from flipkit.planning.plans.verify import verify_plan
 from flipkit.simulation.execute import SENSE_AFTER
-
-
-def plan_text(plan) -> str:
-    """The text of ``plan``'s file."""
-    with tempfile.TemporaryDirectory() as tmp:
-        return plan.to_json(Path(tmp) / "plan.json").read_text()
 
 
 def sense_time(plan) -> float:
@@ -88,4 +79,4 @@ def replanner(plan, record: dict) -> Contingencies:
                          float(record["sense_s"]))
 
 
-__all__ = ["attach", "plan_text", "prepare", "replanner", "sense_time", "summary"]
+__all__ = ["attach", "prepare", "replanner", "sense_time", "summary"]

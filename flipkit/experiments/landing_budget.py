@@ -90,7 +90,7 @@ def landing_budget(plan, mode: str = "feedforward") -> LandingBudget:
     if run.touch_grill[k]:
         raise ConfigError(f"the burger at {plan.burger['location']} still touches the grill "
                           "when the pickup ends: no flight to judge")
-    on_blade = ((run.burger_pos[k] - run.spatula_pos[k]) @ run.spatula_rot[k])[:2]
+    on_blade = run.in_blade_frame()[k, :2]
     touch = np.flatnonzero(run.touch_grill[k:])
     if not touch.size:
         raise ConfigError(f"the burger at {plan.burger['location']} never came down on the "

@@ -6,7 +6,9 @@ merged over trials."""
 from __future__ import annotations
 
 import json
+import tempfile
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 
@@ -25,6 +27,12 @@ def plan_from_text(text: str) -> Plan:
     """A plan from the text of a ``flipkit-plan`` file (already checked by Plan.load)."""
     doc = json.loads(text)
     return Plan(**{k: doc[k] for k in PLAN_KEYS})
+
+
+def plan_text(plan: Plan) -> str:
+    """The text of ``plan``'s ``flipkit-plan`` file (as :meth:`Plan.to_json` writes it)."""
+    with tempfile.TemporaryDirectory(prefix="flipkit-plan-") as tmp:
+        return plan.to_json(Path(tmp) / "plan.json").read_text()
 
 
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
@@ -62,4 +70,4 @@ def merge_tracking(errors: list) -> dict:
 
 
 __all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "merge_tracking", "plan_from_text",
-           "trial_jobs", "trial_key"]
+           "plan_text", "trial_jobs", "trial_key"]

@@ -38,7 +38,8 @@ from flipkit.experiments.bench import warm_up
 from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import make_executor, run_sweep
-from flipkit.experiments.trial_jobs import HOLD_S, TRACK_RATE_HZ, plan_from_text, trial_jobs
+from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, plan_from_text, plan_text,
+                                            trial_jobs)
 from flipkit.experiments.trials import landing_target, plan_location, run_trial
 from flipkit.experiments.trials import track_plan as track_execution
 from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
@@ -130,9 +131,7 @@ def nominal_trial(plan) -> dict:
     (``ok`` per stage, ``failure``, ``tracking``)."""
     none = Perturbations(position_sigma=0.0, grill_offset=0.0, mu_scale=(1.0, 1.0),
                          mass_scale=(1.0, 1.0))
-    with tempfile.TemporaryDirectory(prefix="flipkit-plan-") as tmp:
-        text = plan.to_json(Path(tmp) / "plan.json").read_text()
-    return run_trial(trial_jobs(text, 1, 0, none, TRACK_RATE_HZ)[0])
+    return run_trial(trial_jobs(plan_text(plan), 1, 0, none, TRACK_RATE_HZ)[0])
 
 
 # ------------------------------------------------------------------ solve times

@@ -133,12 +133,13 @@ class Contingencies:
         Raises:
             ConfigError: ``on_blade`` is off the blade.
         """
-        k = self._lookup(on_blade)
+        cell, xy = check_replan(self.plan, "flip", on_blade)
+        k = self._lookup(xy, Planner(cell).models)
         return None if k is None else self.flips[k][1]
 
-    def _lookup(self, on_blade) -> int | None:
-        cell, xy = check_replan(self.plan, "flip", on_blade)
-        models, radius = Planner(cell).models, promise(self.plan)
+    def _lookup(self, xy, models) -> int | None:
+        """The index in :attr:`flips` that :meth:`lookup` hands out for a checked place."""
+        radius = promise(self.plan)
         for k in sorted(range(len(self.flips)),
                         key=lambda i: float(np.hypot(*np.subtract(self.flips[i][0], xy)))):
             flip = next(s for s in self.flips[k][1].segments if s.name == "flip")
@@ -158,9 +159,10 @@ class Contingencies:
         if plan is not self.plan:
             raise ConfigError("these contingencies were made for another plan")
         cell, xy = check_replan(plan, "flip", on_blade)
-        if keeps_promise(plan, xy, Planner(cell).models):
+        models = Planner(cell).models
+        if keeps_promise(plan, xy, models):
             return plan
-        k = self._lookup(xy)
+        k = self._lookup(xy, models)
         if k is None:
             return replan_flip(plan, xy, keep=False)
         time.sleep(self.wait_s(k))  # the solve still under way (module docstring)
