@@ -95,3 +95,41 @@ def test_contingencies_need_replan(tmp_path, capsys, flip_plan_file, extra, mess
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and message in err[0]
     assert not (tmp_path / "v.json").exists()
+
+
+def test_validate_reports_the_pauses_of_its_replans(flip_plan_file):
+    text = flip_plan_file.read_text()
+    out = validate([([0.69, -0.16, 0.072], {}, text)], 2, seed=3, replan=True,
+                   contingencies=True, progress=False)
+    times = [land["replan"]["time_s"] for land in out["locations"][0]["landings"]]
+    pause = out["summary"]["pause"]
+    assert pause["trials"] == 2 and pause["worst_s"] == pytest.approx(max(times))
+    off = validate([([0.69, -0.16, 0.072], {}, text)], 1, seed=3, replan=False,
+                   progress=False)
+    assert off["summary"]["pause"] is None
+
+
+def test_the_cli_prints_the_pauses_of_its_replans(tmp_path, capsys, flip_plan_file):
+    code = main(["validate", "--plan", str(flip_plan_file), "--trials", "1", "--replan",
+                 "--contingencies", "--workers", "1", "--no-progress", "--json",
+                 str(tmp_path / "v.json")])
+    out = capsys.readouterr().out
+    assert code == 0 and "pause at the sense over 1 re-plans: median" in out
+
+
+def test_a_cache_shares_the_preparation_between_validations(flip_plan_file, tmp_path,
+                                                            monkeypatch):
+    calls = []
+    real = contingent.prepare
+
+    def counting(text, executor=None):
+        calls.append(text)
+        return real(text, executor)
+
+    monkeypatch.setattr(contingent, "prepare", counting)
+    text = flip_plan_file.read_text()
+    runs = [validate([([0.69, -0.16, 0.072], {}, text)], 1, seed=3, replan=True, mode=mode,
+                     contingencies=True, progress=False, cache_dir=tmp_path)
+            for mode in ("feedforward", "position")]
+    assert len(calls) == 1
+    assert runs[0]["locations"][0]["contingencies"] == runs[1]["locations"][0]["contingencies"]

@@ -16,7 +16,10 @@ round trip through its file text, before any trial can receive it.
 
 from __future__ import annotations
 
+from functools import partial
+
 from flipkit.errors import FlipkitError
+from flipkit.experiments.sweep import run_sweep, stable_hash
 from flipkit.experiments.trial_jobs import plan_from_text, plan_text
 from flipkit.planning.planners.contingency import Contingencies
 from flipkit.planning.plans.verify import verify_plan
@@ -55,13 +58,19 @@ def prepare(text: str, executor=None) -> dict:
             "sense_s": sense_time(plan), "failed": [list(p) for p in made.failed]}
 
 
-def attach(jobs: list, executor=None) -> tuple[list, dict]:
+def attach(jobs: list, executor=None, cache_dir=None) -> tuple[list, dict]:
     """``jobs`` (trial jobs with ``replan``) with each plan's contingency record under
-    ``"contingencies"``, prepared once per plan text; and ``{plan text: record}``."""
-    records = {}
-    for job in jobs:
-        if job["plan_text"] not in records:
-            records[job["plan_text"]] = prepare(job["plan_text"], executor)
+    ``"contingencies"``, prepared once per plan text; and ``{plan text: record}``.
+
+    With ``cache_dir`` (:func:`flipkit.experiments.sweep.run_sweep`'s cache) a record
+    prepared earlier for the same plan text is read back, so that the validations of one
+    figure run (both controller modes) share each plan's preparation, as one cell would.
+    """
+    texts = list(dict.fromkeys(job["plan_text"] for job in jobs))
+    made = run_sweep(partial(prepare, executor=executor), texts, None, cache_dir,
+                     key_fn=lambda text: {"plan": stable_hash(text)}, progress=False,
+                     name=f"{__name__}.prepare")
+    records = dict(zip(texts, made))
     return [{**job, "contingencies": records[job["plan_text"]]} for job in jobs], records
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from flipkit.config import known_physics, with_parameter
 from flipkit.errors import ConfigError
+from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
@@ -66,7 +67,8 @@ def run_serve_trial(job: dict) -> dict:
             "perturbation": draw, "tracking": ex.errors, "mode": mode,
             "rest": {"xy": [float(v) for v in run.burger_pos[-1, :2]],
                      "distance": serve.distance, "up_z": serve.up_z},
-            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure}
+            "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
+                       "time_s": ex.replan_time_s}
             if replan is not None else None}
 
 
@@ -129,7 +131,8 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
-                        "independent": entry["independent"]}}
+                        "independent": entry["independent"],
+                        "pause": pause_summary(entry["rests"]) if replan else None}}
 
 
 __all__ = ["SERVE_STAGES", "run_serve_trial", "validate_serve"]

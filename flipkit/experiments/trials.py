@@ -28,6 +28,7 @@ from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
+from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.sweep import run_sweep
@@ -239,13 +240,16 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             ``False`` runs the plans open loop.
         command: Position mode's command stream (:data:`flipkit.planning.plans.servo_command.COMMANDS`).
         contingencies: With ``replan``: each plan's contingency flips are prepared once (on
-            ``executor``) and the re-plans hand them out (:mod:`flipkit.experiments.contingent`).
+            ``executor``; read back from ``cache_dir`` when made there before) and the
+            re-plans hand them out (:mod:`flipkit.experiments.contingent`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
-        "trials", "success": {stage: count}, "independent": {stage: count}}}``.
+        "trials", "success": {stage: count}, "independent": {stage: count}, "pause": the
+        arm's pauses at the sense (:func:`flipkit.experiments.pauses.pause_summary`; ``None``
+        open loop)}}``.
     """
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
@@ -259,7 +263,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             jobs, owner = jobs + new, owner + [k] * len(new)
     records = {}
     if contingencies and replan:
-        jobs, records = attach(jobs, executor)
+        jobs, records = attach(jobs, executor, cache_dir)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
@@ -275,7 +279,9 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
                         "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},
                         "independent": {s: sum(e["independent"][s] for e in entries)
-                                        for s in STAGES}}}
+                                        for s in STAGES},
+                        "pause": pause_summary([land for e in entries for land in e["landings"]])
+                        if replan else None}}
 
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:

@@ -9,6 +9,7 @@ from flipkit.cli.common import write_json
 from flipkit.cli.validate import format_table
 from flipkit.errors import ConfigError
 from flipkit.experiments.compare_ik import LOCATION_SETS
+from flipkit.experiments.pauses import format_pauses
 from flipkit.experiments.sweep import make_executor
 from flipkit.experiments.trials import validate_locations, validate_plan_file
 from flipkit.planning.plans.verify import load_verified
@@ -38,4 +39,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
           f"{total['locations']} locations, "
           f"success {total['success']}; wrote {args.json}")
+    if out.get("replan") and "pause" in total:  # a flip validation's re-plans
+        print(format_pauses(total["pause"]))
     return 0
