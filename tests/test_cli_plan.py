@@ -122,6 +122,7 @@ def test_flip_plan_is_solved_continuous_and_verified(flip_file):
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
     flip = plan.segments[FLIP_NAMES.index("flip")]
     assert flip.cone_nodes == list(range(15))  # up to the release node
+    assert plan.segment("flip") is flip and plan.segment("carry") is None
 
 
 def test_batch_writes_plans_and_summary(tmp_path, capsys):

@@ -20,7 +20,7 @@ def side(flip_plan):
 
 
 def _flip(plan):
-    return next(s for s in plan.segments if s.name == "flip")
+    return plan.segment("flip")
 
 
 def test_places_lie_past_the_scenarios_by_the_margin(flip_plan):
@@ -46,8 +46,8 @@ def test_each_contingency_is_a_verified_replan_for_its_place(flip_plan, side):
     for place, plan in side.flips:
         assert plan.status == "solved" and verify_plan(plan).ok
         for name in ("go_to_burger", "scoop", "pickup"):  # kept from the plan
-            old = next(s for s in flip_plan.segments if s.name == name)
-            np.testing.assert_array_equal(next(s for s in plan.segments if s.name == name).q,
+            old = flip_plan.segment(name)
+            np.testing.assert_array_equal(plan.segment(name).q,
                                           old.q)
         assert _flip(plan).landing["burger_on_blade"][:2] == pytest.approx(place)
         assert landing_miss(_flip(plan), place, models) <= _flip(plan).landing["r_land"] + 1e-3

@@ -33,7 +33,7 @@ def test_the_replanner_hands_out_the_contingency_of_a_place(flip_plan_file, reco
     place = record["places"][2]
     got = replan(plan, place)
     assert got is replan.flips[2][1]
-    flip = next(s for s in got.segments if s.name == "flip")
+    flip = got.segment("flip")
     assert flip.landing["burger_on_blade"][:2] == pytest.approx(place)
 
 
@@ -47,7 +47,7 @@ def test_a_contingency_not_ready_at_the_sense_is_waited_for(flip_plan_file, reco
     t0 = time.perf_counter()
     assert replan(plan, record["places"][2]) is replan.flips[2][1]
     assert time.perf_counter() - t0 >= 0.3
-    x0, y0 = next(s for s in plan.segments if s.name == "flip").landing["burger_on_blade"][:2]
+    x0, y0 = plan.segment("flip").landing["burger_on_blade"][:2]
     t0 = time.perf_counter()
     assert replan(plan, (x0, y0)) is plan  # kept: nothing to wait for
     assert time.perf_counter() - t0 < 0.3

@@ -134,7 +134,7 @@ def test_pressed_blade_is_the_blades_spring_and_does_not_bounce(flip_plan):
     """The scoop's first configuration held (tip commanded 3 mm into the grill): the blade
     stays on the grill, and the steady force is the blade's stiffness times its flex (the
     penetration), at most k × 3 mm (the arm's PD yields the rest)."""
-    scoop = next(s for s in flip_plan.segments if s.name == "scoop")
+    scoop = flip_plan.segment("scoop")
     plan = held(flip_plan, scoop.q[0])
     ex = execute_plan(plan, "feedforward", draw={"dx_m": 0.2}, hold=0.0)  # burger out of the way
     late = ex.run.t > 0.5

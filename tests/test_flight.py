@@ -96,7 +96,7 @@ def test_landing_spot_off_the_grill_is_refused(flip_nlp):
 
 
 def test_solved_flip_records_a_landing_that_verify_recomputes(flip_plan):
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     land = flip.landing
     assert flip.release["node"] == 14 and land["r_land"] == R_LAND
     assert land["offset"] <= R_LAND + 1e-6 and land["tilt_deg"] >= 150.0 - 1e-6
@@ -113,7 +113,7 @@ def test_tampered_landing_record_fails_verify(flip_plan):
     import copy
 
     plan = copy.deepcopy(flip_plan)
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     flip.landing["point"][0] += 0.01  # claims a landing 1 cm off what the arrays give
     report = verify_plan(plan)
     assert not report.ok and report.worst()[0] == "landing"

@@ -165,7 +165,7 @@ def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
 
     plan = plan_flip((0.629686, -0.347136, 0.072))
     assert plan.status == "solved", plan.failure
-    scoop = next(s for s in plan.segments if s.name == "scoop")
+    scoop = plan.segment("scoop")
     assert SUBBEHAVIORS["scoop"].duration[1] < scoop.T <= T_STRETCH * SUBBEHAVIORS["scoop"].duration[1] + 1e-9
     # Stretched only where needed: the pickup and flip are not; the turn back from a robust
     # flip's end state near the singularity may be.

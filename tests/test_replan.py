@@ -30,7 +30,7 @@ def test_replanned_flip_is_verified_and_made_for_the_sensed_burger(flip_plan, re
     # the scoop drags the burger toward the blade's tip: measured ahead of the blade centre
     assert 0.005 < sensed[0] < flip_plan.spatula["length"] / 2
     assert ex.plan.status == "solved" and verify_plan(ex.plan).ok
-    flip = next(s for s in ex.plan.segments if s.name == "flip")
+    flip = ex.plan.segment("flip")
     np.testing.assert_allclose(flip.landing["burger_on_blade"], sensed, atol=1e-12)
     kept = [s.name for s in ex.plan.segments[:3]]
     assert kept == ["go_to_burger", "scoop", "pickup"]
@@ -49,7 +49,7 @@ def test_replanned_flip_lands_on_its_spot(replanned):
 def test_a_plan_without_the_landing_constraint_misses(flip_plan):
     loc = flip_plan.burger["location"]
     plan = plan_flip(loc, options=SegmentOptions(landing=False))
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     assert flip.landing is None and plan.status == "failed"  # verify: no landing
     assert "landing" in plan.failure
     plan.status = "solved"  # execute it anyway, as the paper's flip (26) alone

@@ -75,7 +75,7 @@ def test_scoop_model_predicts_the_simulated_scoop(flip_plan):
     within 1.5 cm along the blade (the model is not fitted to any trial)."""
     from flipkit.simulation.execute import execute_plan
 
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     predicted = flip.landing["burger_on_blade"]
     ex = execute_plan(flip_plan, "feedforward", None)
     k = np.searchsorted(ex.run.t, ex.bounds["scoop"][1])
@@ -94,7 +94,7 @@ def test_uncertainty_is_validated():
 
 # ------------------------------------------------------------------ robust landing
 def test_robust_plan_records_and_verifies_every_scenario(flip_plan, tmp_path):
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     rows = flip.landing["scenarios"]
     assert len(rows) == 4
     xs = [r["burger_on_blade"][0] for r in rows]
@@ -103,18 +103,18 @@ def test_robust_plan_records_and_verifies_every_scenario(flip_plan, tmp_path):
         assert r["offset"] <= r["r_land"] + LANDING_TOL["m"]  # the verification's tolerances
         assert r["tilt_deg"] >= 150.0 - LANDING_TOL["deg"]
     again = Plan.load(flip_plan.to_json(tmp_path / "p.json"))
-    assert next(s for s in again.segments if s.name == "flip").landing["scenarios"] == rows
+    assert again.segment("flip").landing["scenarios"] == rows
     assert verify_plan(again).ok
 
 
 def test_tampered_scenario_fails_verify(flip_plan):
     plan = copy.deepcopy(flip_plan)
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     flip.landing["scenarios"][0]["r_land"] = 1e-4  # claims a scenario lands within 0.1 mm
     report = verify_plan(plan)
     assert not report.ok and report.worst()[0] == "landing_scenarios"
     plan = copy.deepcopy(flip_plan)
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     flip.landing["scenarios"][1]["burger_on_blade"][0] += 0.02  # not where it was planned
     assert not verify_plan(plan).groups["landing_scenarios"].ok
 
@@ -147,7 +147,7 @@ def test_compensated_command_gives_the_plan_torque_at_the_plan_state(flip_plan):
     cell = flip_plan.cell()
     ph = cell.physics
     ctrl = Robot(cell, with_burger=False).model
-    seg = next(s for s in flip_plan.segments if s.name == "flip")
+    seg = flip_plan.segment("flip")
     q_c, qd_c = position_command(seg.q, seg.qd, seg.u, ctrl, ph)
     data = ctrl.createData()
     for k in range(len(seg.t)):
@@ -206,7 +206,7 @@ def test_the_arm_holds_while_the_replan_runs_and_the_camera_errs(flip_plan):
 def test_a_place_inside_the_scenarios_needs_no_replan(flip_plan):
     from flipkit.planning.planners.planner import covers, replan_flip
 
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     nominal = flip.landing["burger_on_blade"]
     assert covers(flip.landing, nominal)
     xs = [r["burger_on_blade"][0] for r in flip.landing["scenarios"]]
@@ -278,7 +278,7 @@ def test_a_place_the_plan_already_lands_needs_no_replan(flip_plan):
     from flipkit.planning.planners.planner import covers, landing_miss, replan_flip
 
     models = models_for(flip_plan.cell())
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     nominal = np.asarray(flip.landing["burger_on_blade"])
     recorded = np.hypot(*(np.asarray(flip.landing["point"][:2]) - flip.landing["target"]))
     assert landing_miss(flip, nominal, models) == pytest.approx(recorded, abs=1e-4)
@@ -324,7 +324,7 @@ def test_every_scenario_is_held_by_the_planned_cone_and_pressed_before_the_relea
     μ alone (no scenario cone, no press) fails this."""
     from flipkit.behaviors.options import MU_PLAN, RELEASE_PRESS
 
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     r = flip.release["node"]
     places = [flip.landing["burger_on_blade"]] + [
         row["burger_on_blade"] for row in flip.landing["scenarios"]]

@@ -297,6 +297,6 @@ def test_a_cook_serve_is_replanned_for_where_the_burger_is_seen(plan):
     assert np.allclose(new.segments[0].q[0], plan.segments[0].q[0])
     from flipkit.model.robot import Robot  # the scoop ends with the blade centre under it
     robot = Robot(new.cell())
-    scoop = next(s for s in new.segments if s.name == "scoop")
+    scoop = new.segment("scoop")
     assert np.allclose(robot.position(scoop.q[-1])[:2], seen, atol=2e-3)
     assert replan(motion, (2.0, 0.0)) is None

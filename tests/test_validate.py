@@ -126,7 +126,7 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
     from flipkit.behaviors import targets as tg
     from flipkit.experiments.trials import landing_target, plan_from_text
 
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     assert flip.landing is not None
     assert landing_target(flip_plan) == pytest.approx(flip.landing["target"])
     far = [0.30, 0.60]  # on the table, nowhere near where this flip lands

@@ -49,7 +49,7 @@ class Tags(HTMLParser):
 def test_the_motion_follows_the_plan(flip_plan):
     m = plan_motion(flip_plan, fps=50)
     ends = np.cumsum([s.T for s in flip_plan.segments])
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     assert m.t[0] == 0 and m.t[-1] >= ends[-1] and np.allclose(np.diff(m.t), 0.02)
     np.testing.assert_allclose(m.q[0], flip_plan.segments[0].q[0], atol=1e-12)
     h = flip_plan.burger["thickness"]

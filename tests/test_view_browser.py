@@ -57,7 +57,7 @@ ARM_ON_SCREEN = """() => {
 def test_the_page_shows_the_moving_arm_in_chromium(flip_plan, flip_plan_file, tmp_path):
     out = tmp_path / "view.html"
     assert main(["view", str(flip_plan_file), "--html", str(out)]) == 0
-    flip = next(s for s in flip_plan.segments if s.name == "flip")
+    flip = flip_plan.segment("flip")
     start = sum(s.T for s in flip_plan.segments[:3])
     mid_flight = start + flip.release["time"] + flip.landing["time_of_flight"] / 2
     with sync_playwright() as p:

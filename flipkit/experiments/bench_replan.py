@@ -75,7 +75,7 @@ def bench_replan(result: dict, contingencies: bool = False) -> dict:
         if plan.status != "solved":
             print(f"{str(loc):<24} plan failed: {plan.failure}")
             continue
-        landing = next(s for s in plan.segments if s.name == "flip").landing
+        landing = plan.segment("flip").landing
         extra = Contingencies.prepare(plan) if contingencies else None
         if extra is not None:
             prepared.append({"location": loc, "time_s": extra.wall_time_s,

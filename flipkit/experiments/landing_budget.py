@@ -83,7 +83,7 @@ def landing_budget(plan, mode: str = "feedforward") -> LandingBudget:
         raise ConfigError(f"landing_budget needs a solved flip plan, got a {plan.status} "
                           f"{plan.behavior} plan")
     cell = plan.cell()
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     ex = execute_plan(plan, mode)
     run = ex.run
     k = int(np.searchsorted(run.t, ex.bounds["pickup"][1] - 1e-9))

@@ -104,7 +104,7 @@ def landing_target(plan: Plan) -> np.ndarray:
     """Where the flip should land the burger (x, y) (m): the flip segment's planned
     ``landing["target"]`` when the plan has one (``flipkit plan flip --land X Y`` lands
     elsewhere than the default), else :func:`flipkit.behaviors.targets.landing_spot` of the burger."""
-    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    flip = plan.segment("flip")
     landing = getattr(flip, "landing", None)
     if landing is not None:
         return np.asarray(landing["target"], float)
@@ -171,7 +171,7 @@ def run_trial(job: dict) -> dict:
 
 def _predicted(plan) -> list | None:
     """The plan's predicted landing point (x, y) (m), or ``None`` without one."""
-    flip = next((s for s in plan.segments if s.name == "flip"), None)
+    flip = plan.segment("flip")
     return None if flip is None or not flip.landing else [float(v) for v in flip.landing["point"][:2]]
 
 

@@ -68,7 +68,7 @@ SPOT_RADIUS = 0.05  # m: the paper's landing tolerance (5 cm), drawn about the t
 def _landing_spot(execution):
     """(x, y, z) of the executed plan's landing target on the grill surface, or None."""
     plan = getattr(execution, "plan", None)
-    flip = next((s for s in plan.segments if s.name == "flip"), None) if plan else None
+    flip = plan.segment("flip") if plan else None
     if flip is None or not flip.landing:
         return None
     x, y = flip.landing["target"]

@@ -85,7 +85,7 @@ class BurgerResult:
 
 def landing_target(plan) -> np.ndarray:
     """Where a flip plan lands its burger (x, y) (m) (module docstring)."""
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     if getattr(flip, "landing", None):
         return np.asarray(flip.landing["target"], float)[:2]
     return landing_spot(plan.cell(), np.asarray(plan.burger["location"], float))[:2]

@@ -115,7 +115,7 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
     last = plan.segments[-1]
     landing, event = None, duration
     if ok and kind == "flip":
-        flip = next(s for s in plan.segments if s.name == "flip")
+        flip = plan.segment("flip")
         event = (_segment_start(plan, "flip") + flip.release["time"]
                  + flip.landing["time_of_flight"])
         landing = tuple(float(v) for v in flip.landing["point"][:2])

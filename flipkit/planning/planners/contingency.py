@@ -52,7 +52,7 @@ def contingency_places(plan: Plan, margin=MARGIN) -> list[tuple[float, float]]:
         ConfigError: ``plan`` is not a solved flip plan.
     """
     cell, _ = check_replan(plan, "flip", (0.0, 0.0))
-    landing = next(s for s in plan.segments if s.name == "flip").landing
+    landing = plan.segment("flip").landing
     x0, y0 = (float(v) for v in landing["burger_on_blade"][:2])
     pts = np.array([row["burger_on_blade"][:2] for row in landing.get("scenarios", ())]
                    or [(x0, y0)], float)
@@ -142,7 +142,7 @@ class Contingencies:
         radius = promise(self.plan)
         for k in sorted(range(len(self.flips)),
                         key=lambda i: float(np.hypot(*np.subtract(self.flips[i][0], xy)))):
-            flip = next(s for s in self.flips[k][1].segments if s.name == "flip")
+            flip = self.flips[k][1].segment("flip")
             if landing_miss(flip, xy, models) <= radius:
                 return k
         return None

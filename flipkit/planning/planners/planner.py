@@ -182,7 +182,7 @@ def promise(plan: Plan) -> float:
     """The radius (m) within which a solved flip plan promises to land a burger lying at any
     of its scenarios' places: the scenarios' ``r_land`` (``r_scenario``), or the nominal
     ``r_land`` of a plan without scenarios."""
-    landing = next(s for s in plan.segments if s.name == "flip").landing
+    landing = plan.segment("flip").landing
     return max((row["r_land"] for row in landing.get("scenarios", ())),
                default=landing["r_land"])
 
@@ -191,7 +191,7 @@ def keeps_promise(plan: Plan, on_blade, models) -> bool:
     """Whether a solved flip plan, as it is, lands a burger measured at ``on_blade`` (x, y)
     (m) within :func:`promise`: the place lies in its scenarios' hull (:func:`covers`), or
     its own release and flight land it so (:func:`landing_miss`)."""
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     return (covers(flip.landing, on_blade)
             or landing_miss(flip, on_blade, models) <= promise(plan))
 
@@ -228,7 +228,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     """
     t0 = time.perf_counter()
     cell, on_blade = check_replan(plan, "flip", on_blade)
-    flip = next(s for s in plan.segments if s.name == "flip")
+    flip = plan.segment("flip")
     planner = Planner(cell, solver=solver,
                       options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
     if keep and keeps_promise(plan, on_blade, planner.models):

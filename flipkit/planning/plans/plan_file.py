@@ -259,6 +259,10 @@ class Plan:
         except ConfigError as exc:
             raise PlanFileError(f"cannot rebuild the cell from the plan: {exc}") from None
 
+    def segment(self, name: str):
+        """The plan's first :class:`Segment` named ``name``, or ``None`` if it has none."""
+        return next((s for s in self.segments if s.name == name), None)
+
     def robot_for(self, segment, cell: CellConfig | None = None):
         """The dynamics model of ``segment`` (a :class:`Segment` of this plan, or a name: its
         first segment of that name, or a behaviour the plan lacks, which carries what that
@@ -270,7 +274,7 @@ class Plan:
                 differs from the file's.
         """
         if isinstance(segment, str):
-            seg = next((s for s in self.segments if s.name == segment), None)
+            seg = self.segment(segment)
             if seg is None and segment not in SUBBEHAVIORS:
                 raise PlanFileError(f"segments: no segment {segment!r} in this plan "
                                     f"({', '.join(s.name for s in self.segments)})")
