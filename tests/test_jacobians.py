@@ -162,16 +162,42 @@ def test_kinematic_block_over_nodes_jacobian(flip_nlp, cell, quantity):
 def test_node_by_node_quantity_matches_its_batch(flip_nlp, cell):
     """A quantity without broadcasting is applied node by node: the same rows as the built-in
     one it wraps."""
-    from flipkit.transcription.constraints.kinematic import BladeEdgeHeights, KinematicBlock
+    from flipkit.transcription.constraints.kinematic import BladeCornerHeights, KinematicBlock
     from flipkit.transcription.layout import Evaluation
 
-    class PerNode(BladeEdgeHeights):
+    class PerNode(BladeCornerHeights):
         broadcasts = False
 
     ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
     L, x = flip_nlp.layout, flip_nlp.x0
     ev = Evaluation(L, flip_nlp.robot, x)
-    a = KinematicBlock("a", L, BladeEdgeHeights(), [1, 2, 7], 0, np.inf, ctx=ctx).evaluate(ev)
+    a = KinematicBlock("a", L, BladeCornerHeights(), [1, 2, 7], 0, np.inf, ctx=ctx).evaluate(ev)
     b = KinematicBlock("b", L, PerNode(), [1, 2, 7], 0, np.inf, ctx=ctx).evaluate(ev)
     for u, v in zip(a, b):
         np.testing.assert_array_equal(u, v)
+
+
+def test_the_corner_heights_are_the_lowest_points_of_the_rolled_blade(flip_nlp, cell):
+    """The grill_clearance rows hold the whole blade: at random joint states their smallest
+    value is the lowest point of a dense grid over the blade rectangle, which an edge's
+    midpoint misses once the blade rolls."""
+    from flipkit.transcription.constraints.kinematic import BladeCornerHeights
+    from flipkit.transcription.layout import Evaluation
+
+    ctx = {"length": cell.spatula.length, "width": cell.spatula.width}
+    L, robot = flip_nlp.layout, flip_nlp.robot
+    rng = np.random.default_rng(7)
+    u, v = np.meshgrid(np.linspace(-0.5, 0.5, 21), np.linspace(-0.5, 0.5, 21))
+    grid = np.stack([u.ravel() * ctx["length"], v.ravel() * ctx["width"],
+                     np.zeros(u.size)])  # (3, 441) blade frame
+    below_midpoints = 0
+    for _ in range(5):
+        x = flip_nlp.x0 + rng.normal(scale=0.3, size=flip_nlp.n) * (L.n_nodes > 0)
+        st = Evaluation(L, robot, x).state(3)
+        corners = BladeCornerHeights()(st, ctx)[0]
+        lowest = st.p[2] + (st.R @ grid)[2].min()
+        assert corners.min() == pytest.approx(lowest, abs=1e-12)
+        mids = st.p[2] + (st.R @ np.array([[0.5, -0.5, 0, 0], [0, 0, 0.5, -0.5], [0, 0, 0, 0]])
+                          * np.array([[ctx["length"]], [ctx["width"]], [0]]))[2]
+        below_midpoints += corners.min() < mids.min() - 1e-6
+    assert below_midpoints >= 1  # a rolled blade's corner is lower than every midpoint

@@ -90,7 +90,7 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
 
 
 def blade_floor(spec: Subbehavior | str, cell, N: int, task=None) -> np.ndarray:
-    """Lowest height (m) of the blade's tip, heel and side edges at nodes 0..N: the spec's
+    """Lowest height (m) of the blade's four corners at nodes 0..N: the spec's
     floor, the grill's surface by default; on an approach (``spec.approach``) at least
     ``task.approach_height`` above the grill on nodes 0..N−2 when the task sets one."""
     spec = subbehavior(spec) if isinstance(spec, str) else spec

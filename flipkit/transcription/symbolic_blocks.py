@@ -30,7 +30,8 @@ from flipkit.transcription.constraints.base import Block, FixedValues
 from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.dynamics import BezierOutput, Dynamics, HermiteSimpson
 from flipkit.transcription.constraints.interpolant import InterpolantLimits, interval_terms
-from flipkit.transcription.constraints.kinematic import (Acceleration, BladeEdgeHeights, Cone,
+from flipkit.transcription.constraints.kinematic import (BLADE_CORNERS, Acceleration,
+                                                         BladeCornerHeights, Cone,
                                                          Height, KinematicBlock, Normal, Pitch,
                                                          Position, Rpy, TipHeight, Velocity,
                                                          XAxis)
@@ -71,10 +72,9 @@ def quantity(q, k: Kinematics, ctx: dict) -> ca.SX:
         return k.R[:, 0]
     if isinstance(q, TipHeight):
         return _blade_height(k, (ctx["length"] / 2, 0.0, 0.0))
-    if isinstance(q, BladeEdgeHeights):
+    if isinstance(q, BladeCornerHeights):
         l, w = ctx["length"] / 2, ctx["width"] / 2
-        return ca.vertcat(*[_blade_height(k, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0),
-                                                          (0, -w, 0))])
+        return ca.vertcat(*[_blade_height(k, (a * l, b * w, 0.0)) for a, b in BLADE_CORNERS])
     if isinstance(q, Velocity):
         return k.v
     if isinstance(q, Acceleration):

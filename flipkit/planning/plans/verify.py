@@ -32,7 +32,7 @@ continuity         (q, q̇) of segment k's last node = segment k+1's first      
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
                    (flip: nodes ≤ max(0.6 N, release node); carry: all;
                    place: nodes ≤ 0.7 N)
-grill_clearance    tip, heel and side-edge heights ≥ the segment's floor (m):  tol
+grill_clearance    the blade's four corners' heights ≥ the segment's floor (m):  tol
                    h_g, pressed SCOOP_PRESS into it on scoop and pickup,
                    a burger's thickness above it on turn back (blade_floor)
 placing            serve: the table spot on the table, and the rest point        1 mm
@@ -86,6 +86,7 @@ from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
 from flipkit.planning.plans.verify_flight import check_flight
 # the report's types, importable from here as before
+from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
 from flipkit.planning.plans.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
 from flipkit.errors import VerificationError
 from scipy.interpolate import CubicHermiteSpline
@@ -189,7 +190,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     l, w = cell.spatula.length / 2, cell.spatula.width / 2
     floor = blade_floor(seg.name, cell, N)
     for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
-        heights = [_point_height(st, r) for r in ((l, 0, 0), (-l, 0, 0), (0, w, 0), (0, -w, 0))]
+        heights = [_point_height(st, (a * l, b * w, 0)) for a, b in BLADE_CORNERS]
         add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
     cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
     release = seg.release["node"] if seg.release else 0

@@ -104,15 +104,21 @@ class TipHeight(Quantity):
         return _point_height(st, (ctx["length"] / 2, 0.0, 0.0))
 
 
-class BladeEdgeHeights(Quantity):
-    """Heights of the blade's tip, heel and two side edges (the spatula stays above the grill)."""
+BLADE_CORNERS = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # (±l/2, ±w/2): tip left, tip right, ...
+
+
+class BladeCornerHeights(Quantity):
+    """Heights of the blade's four corners (±l/2, ±w/2): the lowest point of the flat blade
+    is always one of them, so the whole blade stays above a floor that they do (its edges'
+    midpoints do not suffice once the blade rolls: a corner then reaches lower)."""
 
     size = 4
     broadcasts = True
 
     def __call__(self, st, ctx):
         l, w = ctx["length"] / 2, ctx["width"] / 2
-        r = st.R @ np.array([[l, -l, 0.0, 0.0], [0.0, 0.0, w, -w], [0.0, 0.0, 0.0, 0.0]])
+        r = st.R @ np.array([[a * l for a, _ in BLADE_CORNERS], [b * w for _, b in BLADE_CORNERS],
+                             [0.0] * 4])
         # height p_z + r_z; ∂/∂q: ∂p_z/∂q − (r × J_ω)_z = ∂p_z/∂q + r_y J_ωx − r_x J_ωy
         Jw = st.Jw
         return (st.p[..., 2, None] + r[..., 2, :],
@@ -152,7 +158,7 @@ class Cone(Quantity):
 
 
 QUANTITIES = {"position": Position, "height": Height, "rpy": Rpy, "pitch": Pitch, "normal": Normal,
-              "xaxis": XAxis, "tip_height": TipHeight, "blade_heights": BladeEdgeHeights,
+              "xaxis": XAxis, "tip_height": TipHeight, "blade_heights": BladeCornerHeights,
               "velocity": Velocity, "acceleration": Acceleration}
 
 
