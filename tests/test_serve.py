@@ -282,7 +282,8 @@ def test_return_home_guess_makes_the_withdrawal():
 
 def test_a_cook_serve_is_replanned_for_where_the_burger_is_seen(plan):
     """motions.serve_replanner: the same start and table spot, the scoop at the seen place;
-    a place off the grill gives None (the scheduled serve then runs), never an exception."""
+    a place off the grill is refused with its one-line reason (the scheduled serve then
+    runs, and the cook's record says why)."""
     from types import SimpleNamespace
 
     from flipkit.planning.kitchen.motions import serve_replanner
@@ -299,4 +300,13 @@ def test_a_cook_serve_is_replanned_for_where_the_burger_is_seen(plan):
     robot = Robot(new.cell())
     scoop = new.segment("scoop")
     assert np.allclose(robot.position(scoop.q[-1])[:2], seen, atol=2e-3)
-    assert replan(motion, (2.0, 0.0)) is None
+    with pytest.raises(FlipkitError, match="outside the grill area"):
+        replan(motion, (2.0, 0.0))
+    from flipkit.simulation.cook import sensed_serve
+
+    sensed = []
+    scene = SimpleNamespace(data=SimpleNamespace(qpos=np.array([2.0, 0.0, 0.1])),
+                            qpos_of=lambda k: slice(0, 3))
+    assert sensed_serve(motion, scene, 0, replan, (0.0, 0.0), sensed) is plan
+    assert sensed[0]["replanned"] is False
+    assert sensed[0]["why"].startswith("the re-plan was refused: burger location (2.000, 0.000)")

@@ -29,9 +29,10 @@ def place_cone(ctx) -> list[int]:
 
 _to_table = partial(task_path_guess, joint_fallback=True)  # a straight carry may pass the base
 
-# The carry covers up to ~1 m under the cone (planned μ 0.4: ≤ 3.9 m/s² sideways).
+# The carry covers up to ~1 m under the cone (planned μ 0.4: ≤ 3.9 m/s² sideways; 1 m takes
+# ≥ 1.01 s bang-bang), so its bound is 1.2 s; a farther spot gets the stretched bound.
 CARRY = Subbehavior(
-    "carry", duration=(0.6, 1.6), carries_burger=True, end="rest", needs=("spot",),
+    "carry", duration=(0.6, 1.2), carries_burger=True, end="rest", needs=("spot",),
     floor=sv.table_floor, exempt=tool_leaves_grill,
     end_pose=lambda ctx: sv.carry_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), cone_on_blade=True, guess=_to_table,
@@ -45,9 +46,10 @@ PLACE = Subbehavior(
     end_pose=lambda ctx: sv.place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=place_cone, cone_on_blade=True, guess=_to_table, record=record_placing,
     doc="tilt-off about the tip, just above the table")
-# The return unrolls the heading back to q_home's.
+# The return unrolls the heading back to q_home's: within 0.8 s it had no solution at the
+# three serves tried (docs/benchmarks/2026-11-27-cook-ten.md), within 1.2 s it had at all.
 RETURN_HOME = Subbehavior(
-    "return_home", duration=(0.5, 1.5), carries_burger=False, end="home",
+    "return_home", duration=(0.5, 1.2), carries_burger=False, end="home",
     floor=sv.withdrawn_floor, exempt=tool_at_table, path=sv.withdrawal,
     guess=return_home_guess, doc="withdraw the blade in its plane, then home")
 SERVE = Behavior("serve", (GO_TO_BURGER, SCOOP, PICKUP, CARRY, PLACE, RETURN_HOME))

@@ -48,7 +48,7 @@ import mujoco
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, InvalidChoiceError
+from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.servo_command import COMMANDS
 from flipkit.simulation.control import ArmController, plan_references, step_references
@@ -152,8 +152,9 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         rate_hz: Joint controller rate (Hz).
         film_fps: Keep a frame every 1/film_fps s of stepped cook time (0: none).
         step_idle: Step the idle intervals instead of skipping them.
-        sense_serve: ``sense_serve(motion, xy) -> plan | None``: the serve of ``motion``
-            re-planned for its burger seen at ``xy`` (m) on the grill (module docstring);
+        sense_serve: ``sense_serve(motion, xy) -> plan``: the serve of ``motion``
+            re-planned for its burger seen at ``xy`` (m) on the grill (module docstring;
+            :class:`~flipkit.errors.FlipkitError` for a place it refuses);
             ``None`` (default): every serve runs open loop as planned.
         sensing_sigma: The camera's error (m, per axis). seed: Seed of its draws.
 
@@ -249,19 +250,26 @@ def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
     true_xy = np.array(scene.data.qpos[scene.qpos_of(k)][:2], float)
     xy = true_xy + np.asarray(error, float)
     t0 = time.perf_counter()
-    new = sense_serve(mo, xy)
+    try:
+        new = sense_serve(mo, xy)
+        why = _unusable(new, float(sum(s.T for s in mo.plan.segments)))
+    except FlipkitError as exc:  # a place the planner refuses, with its reason
+        new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0
-    T_old = float(sum(s.T for s in mo.plan.segments))
-    why = None
-    if new is None or new.status != "solved":
-        why = "the re-plan failed"
-    elif float(sum(s.T for s in new.segments)) > T_old + 1e-9:
-        why = "the re-plan is longer than the scheduled serve"
     sensed.append({"burger": mo.burger, "true_xy": [round(float(v), 5) for v in true_xy],
                    "sensed_xy": [round(float(v), 5) for v in xy],
                    "planned_xy": [round(float(v), 5) for v in mo.plan.burger["location"][:2]],
                    "replanned": why is None, "why": why, "wall_s": round(wall, 3)})
     return mo.plan if why is not None else new
+
+
+def _unusable(new, T_old: float) -> str | None:
+    """Why the re-planned serve ``new`` cannot replace one of ``T_old`` s, or ``None``."""
+    if new is None or new.status != "solved":
+        return "the re-plan failed" + (f": {new.failure}" if new is not None else "")
+    if float(sum(s.T for s in new.segments)) > T_old + 1e-9:
+        return "the re-plan is longer than the scheduled serve"
+    return None
 
 
 def _at_rest(scene: Scene, active: np.ndarray) -> bool:

@@ -2,8 +2,8 @@
 from a few representative plans, instead of planning every motion of a long stream.
 
 Every flip and serve starts and ends at rest at q_home, and their planned times vary little
-over the grill (a flip 3.38–3.40 s, its landing 2.32 s in; a serve 5.90 s, its lift-off
-1.35 s in, on the cooks of ``flipkit/data``). :func:`plan_model` plans a flip at each of
+over the grill: each segment runs to its upper duration bound, which only a far spot or an
+awkward place stretches (``docs/scheduling.md`` gives them). :func:`plan_model` plans a flip at each of
 :data:`REPRESENTATIVE` (Table I locations 1, 6 and 10: the grill's near corner, middle and
 far corner) and a serve from each landing to the nearest, a middle and the farthest table
 spot, and keeps per kind the longest plan (conservative for the arm's load) with its own

@@ -182,20 +182,18 @@ def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=
     """Sense, plan, act for a cook's serves: ``replan(motion, xy) -> Plan | None`` plans the
     serve of ``motion`` (a scheduled serve with its ``plan``) again, from the same start
     configuration to the same table spot, for its burger seen at ``xy`` (m) on the grill,
-    coming in above the other burgers as :func:`serve_planner` does; ``None`` when the
-    place is off the grill or the plan fails (the caller then runs the scheduled serve)."""
+    coming in above the other burgers as :func:`serve_planner` does. The plan returned may
+    have failed (its ``failure`` says why); a place the planner refuses (off the grill area,
+    say) raises :class:`~flipkit.errors.FlipkitError` with its one-line reason. Either way
+    the caller runs the scheduled serve."""
     cell = cell or CellConfig()
 
     def replan(motion, xy):
         old = motion.plan
         location = (float(xy[0]), float(xy[1]), float(old.burger["location"][2]))
-        try:
-            plan = plan_serve(location, table_spot(old), q_start=old.segments[0].q[0],
-                              cell=cell, solver=solver, atlas=atlas,
-                              approach_height=approach_height(cell))
-        except FlipkitError:
-            return None
-        return plan if plan.status == "solved" else None
+        return plan_serve(location, table_spot(old), q_start=old.segments[0].q[0],
+                          cell=cell, solver=solver, atlas=atlas,
+                          approach_height=approach_height(cell))
 
     return replan
 
