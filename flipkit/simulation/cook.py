@@ -266,7 +266,8 @@ def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
 def _unusable(new, T_old: float) -> str | None:
     """Why the re-planned serve ``new`` cannot replace one of ``T_old`` s, or ``None``."""
     if new is None or new.status != "solved":
-        return "the re-plan failed" + (f": {new.failure}" if new is not None else "")
+        reason = getattr(new, "failure", None)
+        return "the re-plan failed" + (f": {reason}" if reason else "")
     if float(sum(s.T for s in new.segments)) > T_old + 1e-9:
         return "the re-plan is longer than the scheduled serve"
     return None

@@ -17,7 +17,7 @@ from typing import Callable, Mapping, Protocol
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.errors import FlipkitError, InvalidChoiceError
+from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
 from flipkit.planning.planners.serve import plan_serve, table_spot
@@ -127,6 +127,16 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
                          failure=None if ok else getattr(plan, "failure", "plan failed"))
 
 
+def refused(job: MotionJob, q_start, exc: UnreachableError, t0: float) -> PlannedMotion:
+    """The motion of ``job`` that the planner refused (a place off the grill area, say): not
+    ``ok``, nothing to execute, its failure the planner's one-line reason naming the place."""
+    return PlannedMotion(ok=False, duration_s=0.0, event_s=0.0,
+                         q_end=np.asarray(q_start, float),
+                         planning_time_s=time.perf_counter() - t0,
+                         failure=f"refused at ({job.location[0]:.3f}, {job.location[1]:.3f}): "
+                                 f"{exc}")
+
+
 def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                  ) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planners.planner.plan_flip` from ``q_start``, landing
@@ -135,8 +145,11 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
     warm-started from ``atlas`` if given."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_flip(job.location, q_start, cell=cell, solver=solver, land=job.land,
-                      atlas=atlas, approach_height=approach_height(cell or CellConfig()))
+        try:
+            p = plan_flip(job.location, q_start, cell=cell, solver=solver, land=job.land,
+                          atlas=atlas, approach_height=approach_height(cell or CellConfig()))
+        except UnreachableError as exc:
+            return refused(job, q_start, exc, t0)
         return from_plan(p, "flip", time.perf_counter() - t0)
 
     return plan
@@ -152,9 +165,12 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
     burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
-        p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell, solver=solver,
-                       atlas=atlas,
-                       approach_height=approach_height(cell or CellConfig()))
+        try:
+            p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell,
+                           solver=solver, atlas=atlas,
+                           approach_height=approach_height(cell or CellConfig()))
+        except UnreachableError as exc:  # e.g. a flip's predicted landing off the grill area
+            return refused(job, q_start, exc, t0)
         return from_plan(p, "serve", time.perf_counter() - t0)
 
     return plan
@@ -216,4 +232,5 @@ def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPl
 
 
 __all__ = ["KINDS", "MissingPlannerError", "MotionJob", "MotionPlanner", "PlannedMotion",
-           "cached_planners", "default_planners", "flip_planner", "from_plan", "serve_planner"]
+           "cached_planners", "default_planners", "flip_planner", "from_plan", "refused",
+           "serve_planner"]
