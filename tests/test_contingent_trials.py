@@ -16,6 +16,20 @@ def record(flip_plan_file):
     return contingent.prepare(flip_plan_file.read_text())
 
 
+@pytest.fixture
+def prepared(monkeypatch):
+    """The plan texts contingent.prepare is called with, in order (it still prepares)."""
+    calls = []
+    real = contingent.prepare
+
+    def counting(text, executor=None):
+        calls.append(text)
+        return real(text, executor)
+
+    monkeypatch.setattr(contingent, "prepare", counting)
+    return calls
+
+
 def test_the_record_holds_every_contingency_verified_and_the_wait_beyond_the_scoop(
         flip_plan, record):
     assert record["places"] == [list(p) for p in contingency_places(flip_plan)]
@@ -65,15 +79,8 @@ def test_a_trial_with_contingencies_and_its_cache_key(flip_plan_file, record):
     assert set(out["ok"]) == {"scoop", "pickup", "flip"}
 
 
-def test_validate_prepares_once_per_plan(flip_plan_file, monkeypatch):
-    calls = []
-    real = contingent.prepare
-
-    def counting(text, executor=None):
-        calls.append(text)
-        return real(text, executor)
-
-    monkeypatch.setattr(contingent, "prepare", counting)
+def test_validate_prepares_once_per_plan(flip_plan_file, prepared):
+    calls = prepared
     text = flip_plan_file.read_text()
     out = validate([([0.69, -0.16, 0.072], {}, text)], 2, seed=3, replan=True,
                    contingencies=True, progress=False)
@@ -118,15 +125,8 @@ def test_the_cli_prints_the_pauses_of_its_replans(tmp_path, capsys, flip_plan_fi
 
 
 def test_a_cache_shares_the_preparation_between_validations(flip_plan_file, tmp_path,
-                                                            monkeypatch):
-    calls = []
-    real = contingent.prepare
-
-    def counting(text, executor=None):
-        calls.append(text)
-        return real(text, executor)
-
-    monkeypatch.setattr(contingent, "prepare", counting)
+                                                            prepared):
+    calls = prepared
     text = flip_plan_file.read_text()
     runs = [validate([([0.69, -0.16, 0.072], {}, text)], 1, seed=3, replan=True, mode=mode,
                      contingencies=True, progress=False, cache_dir=tmp_path)
