@@ -3,12 +3,12 @@ from a few representative plans, instead of planning every motion of a long stre
 
 Every flip and serve starts and ends at rest at q_home, and their planned times vary little
 over the grill: each segment runs to its upper duration bound, which only a far spot or an
-awkward place stretches (``docs/scheduling.md`` gives them). :func:`plan_model` plans a flip at each of
-:data:`REPRESENTATIVE` (Table I locations 1, 6 and 10: the grill's near corner, middle and
-far corner) and a serve from each landing to the nearest, a middle and the farthest table
-spot, and keeps per kind the longest plan (conservative for the arm's load) with its own
-event time. :meth:`MotionModel.planners` then stands in for the real planners: every motion
-takes the model's times, lands where it was picked up and ends at rest.
+awkward place stretches (``docs/scheduling.md`` gives them). :func:`plan_model` plans a flip
+at each of :data:`REPRESENTATIVE` (Table I locations 1, 6 and 10: the grill's near corner,
+middle and far corner) and a serve from each landing to the nearest, a middle and the
+farthest table spot, and keeps per kind the longest plan (conservative for the arm's load)
+with its own event time. :meth:`MotionModel.planners` then stands in for the real planners:
+every motion takes the model's times, lands where it was picked up and ends at rest.
 """
 
 from __future__ import annotations
