@@ -148,11 +148,21 @@ def test_cli_serves_the_page_until_stopped(flip_plan_file, monkeypatch, capsys):
 
 
 def test_a_stopped_server_is_an_error_not_a_hang(flip_plan):
+    import socket
+    from urllib.parse import urlparse
+
     vis = server.open_visualizer()
     vis.window.zmq_socket.setsockopt(zmq.RCVTIMEO, 500)
     server.close_visualizer(vis)
-    with pytest.raises(server.ViewerError, match="did not answer"):
-        server.page(vis)
+    # Hold the stopped server's port: ZMQ reconnects by itself, and a MeshCat server that
+    # another test worker starts would otherwise take the freed port and answer.
+    url = urlparse(vis.window.zmq_url)
+    with socket.socket() as holder:
+        holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        holder.bind((url.hostname, url.port))
+        holder.listen()
+        with pytest.raises(server.ViewerError, match="did not answer"):
+            server.page(vis)
 
 
 def test_inline_puts_the_page_in_an_iframe(flip_plan, monkeypatch):
