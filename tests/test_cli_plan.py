@@ -123,6 +123,10 @@ def test_flip_plan_is_solved_continuous_and_verified(flip_file):
     flip = plan.segments[FLIP_NAMES.index("flip")]
     assert flip.cone_nodes == list(range(15))  # up to the release node
     assert plan.segment("flip") is flip and plan.segment("carry") is None
+    k = FLIP_NAMES.index("flip")
+    start = sum(float(s.T) for s in plan.segments[:k])
+    assert plan.segment_span("flip") == pytest.approx((start, start + float(flip.T)))
+    assert plan.segment_span("go_to_burger")[0] == 0.0 and plan.segment_span("carry") is None
 
 
 def test_batch_writes_plans_and_summary(tmp_path, capsys):

@@ -28,11 +28,9 @@ from flipkit.simulation.execute import SENSE_AFTER
 
 def sense_time(plan) -> float:
     """Time (s) from a flip plan's start to its sense: the end of its scoop."""
-    total = 0.0
-    for seg in plan.segments:
-        total += float(seg.T)
-        if seg.name == SENSE_AFTER[plan.behavior]:
-            return total
+    span = plan.segment_span(SENSE_AFTER[plan.behavior])
+    if span is not None:
+        return span[1]
     raise FlipkitError(f"a {plan.behavior} plan without a {SENSE_AFTER[plan.behavior]}")
 
 

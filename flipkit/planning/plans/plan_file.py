@@ -263,6 +263,16 @@ class Plan:
         """The plan's first :class:`Segment` named ``name``, or ``None`` if it has none."""
         return next((s for s in self.segments if s.name == name), None)
 
+    def segment_span(self, name: str) -> tuple[float, float] | None:
+        """(start, end) (s, from the plan's start) of its first segment named ``name``, or
+        ``None`` if it has none."""
+        t = 0.0
+        for seg in self.segments:
+            if seg.name == name:
+                return t, t + float(seg.T)
+            t += float(seg.T)
+        return None
+
     def robot_for(self, segment, cell: CellConfig | None = None):
         """The dynamics model of ``segment`` (a :class:`Segment` of this plan, or a name: its
         first segment of that name, or a behaviour the plan lacks, which carries what that
