@@ -9,7 +9,8 @@ import pytest
 
 from flipkit.simulation.judges import SCOOP_OVERLAP, judge_scoop
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.simulation.execute import MODES, execute_plan
+from flipkit.simulation import execute
+from flipkit.simulation.execute import HOLD_S, MODES, SETTLED_WINDOW, execute_plan
 
 
 def held(plan, q, burger_dx=0.0):
@@ -84,13 +85,30 @@ def test_run_layout_and_determinism(flip_plan, feedforward):
     ex = feedforward
     run = ex.run
     T = sum(s.T for s in flip_plan.segments)
-    assert run.t[0] == 0.0 and run.t[-1] == pytest.approx(T + 1.0, abs=2e-3)
+    # the flipped burger settles within the hold, and the run ends a window after it did
+    assert run.t[0] == 0.0 and T + SETTLED_WINDOW - 2e-3 <= run.t[-1] < T + HOLD_S - 0.1
     assert list(ex.bounds) == [s.name for s in flip_plan.segments]
     assert ex.bounds["turn_back"][1] == pytest.approx(T)
     assert run.spatula_pos.shape == (run.t.size, 3) and ex.qpos.shape[0] == run.t.size
     assert np.all(np.abs(ex.u) <= ex.scene.robot.u_max + 1e-9)
     again = execute_plan(flip_plan, "feedforward")
     np.testing.assert_array_equal(again.run.burger_pos, run.burger_pos)
+
+
+def test_run_ends_once_the_burger_has_settled(flip_plan, feedforward, monkeypatch):
+    """Held for the whole hold (a burger never counted as settled), the burger ends where the
+    early end left it: within the settled motion, and judged the same."""
+    settled_motion = execute.SETTLED_MOTION
+    monkeypatch.setattr(execute, "SETTLED_MOTION", 0.0)
+    full = execute_plan(flip_plan, "feedforward")
+    T = sum(s.T for s in flip_plan.segments)
+    assert full.run.t[-1] == pytest.approx(T + HOLD_S, abs=2e-3)
+    early = feedforward.run
+    assert early.t.size < full.run.t.size
+    np.testing.assert_array_equal(full.run.burger_pos[:early.t.size], early.burger_pos)
+    moved = np.abs(full.run.burger_pos[-1] - early.burger_pos[-1]).max()
+    assert moved < settled_motion
+    assert abs(full.run.up_z[-1] - early.up_z[-1]) < 1e-3
 
 
 def test_perturbation_draw_reaches_the_plant(flip_plan):
