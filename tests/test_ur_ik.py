@@ -32,6 +32,27 @@ def test_dh_inverse_inverts_dh_forward_on_all_eight_branches():
     assert counts.count(BRANCHES) >= 35 and min(counts) >= 2 and all(c % 2 == 0 for c in counts)
 
 
+def test_many_poses_at_once_are_the_poses_one_by_one(robot, ik):
+    """The batch over poses (the tracker's path) gives each pose's branches, NaN where one
+    does not exist: random poses, a wrist singularity (θ5 = 0) and poses out of reach."""
+    rng = np.random.default_rng(5)
+    poses = [robot.placement(q).homogeneous for q in rng.uniform(-np.pi, np.pi, (40, 6))]
+    q = rng.uniform(-1.0, 1.0, 6)
+    q[4] = 0.0
+    poses.append(robot.placement(q).homogeneous)
+    for p in ([3.0, 0.0, 0.5], [0.0, 0.0, 3.0]):
+        far = np.eye(4)
+        far[:3, 3] = p
+        poses.append(far)
+    many = ik.solve_many(np.array(poses))
+    assert many.shape == (len(poses), BRANCHES, 6)
+    for T, sols in zip(poses, many):
+        np.testing.assert_array_equal(sols, ik.solve(T))
+    assert np.isnan(many[-2:]).all() and not np.isnan(many[-3]).all()
+    for s in many[-3][~np.isnan(many[-3][:, 0])]:  # the singular pose's branches reproduce it
+        np.testing.assert_allclose(robot.placement(s).homogeneous, poses[-3], atol=1e-9)
+
+
 def test_spatula_poses_of_the_urdf_model(robot, ik):
     rng = np.random.default_rng(2)
     lo, hi = robot.q_min, robot.q_max

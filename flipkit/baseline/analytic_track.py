@@ -19,7 +19,7 @@ from flipkit.baseline.ee_opt import EETrajectory
 from flipkit.baseline.ik_track import IKTrack
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
-from flipkit.model.ur_ik import URAnalyticIK
+from flipkit.model.ur_ik import URAnalyticIK, nearest_branch
 
 
 class AnalyticTracker:
@@ -41,10 +41,11 @@ class AnalyticTracker:
         tic = time.perf_counter()
         n = len(traj.t)
         q, branch = np.empty((n, self.robot.nq)), np.full(n, -1)
-        T = np.eye(4)
+        T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        T[:, :3, :3], T[:, :3, 3] = traj.R, traj.p
+        sols = self.ik.solve_many(T)  # every branch of every sample at once
         for k in range(n):
-            T[:3, :3], T[:3, 3] = traj.R[k], traj.p[k]
-            found = self.ik.nearest(T, q_prev)
+            found = nearest_branch(sols[k], q_prev)
             if found is not None:
                 branch[k], q_prev = found[0], found[1]
             q[k] = q_prev

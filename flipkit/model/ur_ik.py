@@ -37,11 +37,15 @@ BRANCHES = 8  # shoulder (2) × wrist (2) × elbow (2)
 SINGULAR = 1e-9  # |sin θ5| below this: wrist singularity (θ6 is set to 0 there)
 
 
-def dh_transform(i: int, theta: float) -> np.ndarray:
-    """T_{i−1,i} (4×4) of joint i (0-based) at angle ``theta`` (rad)."""
+def dh_transform(i: int, theta) -> np.ndarray:
+    """T_{i−1,i} (…, 4, 4) of joint i (0-based) at angle(s) ``theta`` (rad, any shape)."""
+    theta = np.asarray(theta, float)
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(ALPHA[i]), np.sin(ALPHA[i])
-    return np.array([[ct, -st * ca, st * sa, A[i] * ct], [st, ct * ca, -ct * sa, A[i] * st],
-                     [0.0, sa, ca, D[i]], [0.0, 0.0, 0.0, 1.0]])
+    T = np.zeros(theta.shape + (4, 4))
+    T[..., 0, 0], T[..., 0, 1], T[..., 0, 2], T[..., 0, 3] = ct, -st * ca, st * sa, A[i] * ct
+    T[..., 1, 0], T[..., 1, 1], T[..., 1, 2], T[..., 1, 3] = st, ct * ca, -ct * sa, A[i] * st
+    T[..., 2, 1], T[..., 2, 2], T[..., 2, 3], T[..., 3, 3] = sa, ca, D[i], 1.0
+    return T
 
 
 def dh_forward(q) -> np.ndarray:
@@ -59,36 +63,50 @@ def _wrap(a):
 def dh_inverse(T06: np.ndarray) -> np.ndarray:
     """The eight DH joint solutions of T_06, (8, 6) rad in [−π, π); rows of an unreachable
     branch are NaN. Row k: shoulder = k // 4, wrist = (k // 2) % 2, elbow = k % 2."""
-    out = np.full((BRANCHES, 6), np.nan)
-    R, p = T06[:3, :3], T06[:3, 3]
-    o5 = p - D[5] * R[:, 2]
-    r = np.hypot(o5[0], o5[1])
-    if r < abs(D[3]):
-        return out  # the wrist centre is inside the cylinder of radius d4: no θ1
-    psi, delta = np.arctan2(o5[1], o5[0]), np.arcsin(D[3] / r)
-    for s, th1 in enumerate((psi + delta, psi + np.pi - delta)):
-        T01 = dh_transform(0, th1)
-        T16 = np.linalg.solve(T01, T06)
-        R16 = T16[:3, :3]
-        c5 = np.clip(R16[2, 2], -1.0, 1.0)
-        for w, th5 in enumerate((np.arccos(c5), -np.arccos(c5))):
-            s5 = np.sin(th5)
-            if abs(s5) < SINGULAR:
-                th6, phi = 0.0, np.arctan2(R16[1, 0], R16[0, 0])  # Rz(φ ± θ6): pick θ6 = 0
-            else:
-                th6 = np.arctan2(-R16[2, 1] / s5, R16[2, 0] / s5)
-                phi = np.arctan2(-R16[1, 2] / s5, -R16[0, 2] / s5)
-            T14 = T16 @ np.linalg.inv(dh_transform(4, th5) @ dh_transform(5, th6))
-            x, y = T14[0, 3], T14[1, 3]
-            c3 = (x * x + y * y - A[1] ** 2 - A[2] ** 2) / (2 * A[1] * A[2])
-            if abs(c3) > 1.0 + 1e-12:
-                continue  # out of the arm's reach on this shoulder/wrist branch
-            for e, th3 in enumerate((np.arccos(np.clip(c3, -1, 1)),
-                                     -np.arccos(np.clip(c3, -1, 1)))):
-                th2 = np.arctan2(y, x) - np.arctan2(A[2] * np.sin(th3), A[1] + A[2] * np.cos(th3))
-                th4 = phi - th2 - th3
-                out[4 * s + 2 * w + e] = _wrap([th1, th2, th3, th4, th5, th6])
-    return out
+    return dh_inverse_many(np.asarray(T06, float)[None])[0]
+
+
+def dh_inverse_many(T06: np.ndarray) -> np.ndarray:
+    """:func:`dh_inverse` of n poses at once: T06 (n, 4, 4) → (n, 8, 6) rad.
+
+    The same steps on arrays, axes (pose, shoulder, wrist, elbow): two θ1 from the wrist
+    centre, two θ5 per θ1, then θ6 and φ (θ6 = 0 at the wrist singularity), and two θ3 per
+    (θ1, θ5) from the planar triangle.
+    """
+    T06 = np.asarray(T06, float)
+    n = T06.shape[0]
+    R, p = T06[:, :3, :3], T06[:, :3, 3]
+    o5 = p - D[5] * R[:, :, 2]
+    r = np.hypot(o5[:, 0], o5[:, 1])
+    reach = r >= abs(D[3])  # else the wrist centre is inside the cylinder of radius d4
+    psi = np.arctan2(o5[:, 1], o5[:, 0])
+    delta = np.arcsin(np.where(reach, D[3] / np.where(reach, r, 1.0), 0.0))
+    th1 = np.stack([psi + delta, psi + np.pi - delta], axis=1)  # (n, 2)
+    T16 = np.linalg.solve(dh_transform(0, th1), T06[:, None])  # (n, 2, 4, 4)
+    R16 = T16[..., :3, :3]
+    c5 = np.clip(R16[..., 2, 2], -1.0, 1.0)
+    th5 = np.stack([np.arccos(c5), -np.arccos(c5)], axis=2)  # (n, 2, 2)
+    s5 = np.sin(th5)
+    singular = np.abs(s5) < SINGULAR
+    safe = np.where(singular, 1.0, s5)
+    R16w = R16[:, :, None]  # broadcast over the wrist axis
+    th6 = np.where(singular, 0.0, np.arctan2(-R16w[..., 2, 1] / safe, R16w[..., 2, 0] / safe))
+    phi = np.where(singular, np.arctan2(R16w[..., 1, 0], R16w[..., 0, 0]),
+                   np.arctan2(-R16w[..., 1, 2] / safe, -R16w[..., 0, 2] / safe))
+    T14 = T16[:, :, None] @ np.linalg.inv(dh_transform(4, th5) @ dh_transform(5, th6))
+    x, y = T14[..., 0, 3], T14[..., 1, 3]
+    c3 = (x * x + y * y - A[1] ** 2 - A[2] ** 2) / (2 * A[1] * A[2])
+    ok = (np.abs(c3) <= 1.0 + 1e-12) & reach[:, None, None]  # else out of reach
+    a3 = np.arccos(np.clip(c3, -1.0, 1.0))
+    th3 = np.stack([a3, -a3], axis=3)  # (n, 2, 2, 2)
+    th2 = (np.arctan2(y, x)[..., None]
+           - np.arctan2(A[2] * np.sin(th3), A[1] + A[2] * np.cos(th3)))
+    th4 = phi[..., None] - th2 - th3
+    full = lambda a: np.broadcast_to(a, th3.shape)  # noqa: E731
+    out = _wrap(np.stack([full(th1[:, :, None, None]), th2, th3, th4,
+                          full(th5[..., None]), full(th6[..., None])], axis=-1))
+    out[~np.broadcast_to(ok[..., None], th3.shape)] = np.nan
+    return out.reshape(n, BRANCHES, 6)
 
 
 class URAnalyticIK:
@@ -126,30 +144,34 @@ class URAnalyticIK:
         """The eight branches (8, 6) rad for a spatula pose (4×4, world frame), each
         wrapped into the joint limits where a 2π shift allows; NaN rows where a branch does
         not exist or leaves the limits."""
+        return self.solve_many(np.asarray(T_spatula, float)[None])[0]
+
+    def solve_many(self, T_spatula: np.ndarray) -> np.ndarray:
+        """:meth:`solve` of n poses (n, 4, 4) at once: (n, 8, 6) rad. Each joint takes the
+        first of the shifts 0, +2π, −2π that puts it inside its limits."""
         T06 = np.linalg.solve(self.base, T_spatula @ np.linalg.inv(self.spatula)) @ np.linalg.inv(
             self.tool)
-        sols = dh_inverse(T06)
+        sols = dh_inverse_many(T06)
         lo, hi = self.robot.q_min, self.robot.q_max
-        for k in range(BRANCHES):
-            if np.isnan(sols[k, 0]):
-                continue
-            for j in range(6):
-                for shift in (0.0, 2 * np.pi, -2 * np.pi):
-                    if lo[j] <= sols[k, j] + shift <= hi[j]:
-                        sols[k, j] += shift
-                        break
-                else:
-                    sols[k] = np.nan
-                    break
+        shifted = sols[..., None] + np.array([0.0, 2 * np.pi, -2 * np.pi])  # (n, 8, 6, 3)
+        inside = (shifted >= lo[:, None]) & (shifted <= hi[:, None])
+        first = np.argmax(inside, axis=-1)[..., None]
+        sols = np.take_along_axis(shifted, first, axis=-1)[..., 0]
+        sols[~inside.any(axis=-1).all(axis=-1)] = np.nan
         return sols
 
     def nearest(self, T_spatula: np.ndarray, q_ref) -> tuple[int, np.ndarray] | None:
         """(branch, q) of the solution nearest to ``q_ref`` (max joint distance, with 2π
         shifts inside the limits), or None if no branch exists."""
-        sols = self.solve(T_spatula)
-        ok = ~np.isnan(sols[:, 0])
-        if not ok.any():
-            return None
-        dist = np.where(ok, np.abs(np.nan_to_num(sols) - np.asarray(q_ref)).max(axis=1), np.inf)
-        k = int(np.argmin(dist))
-        return k, sols[k]
+        return nearest_branch(self.solve(T_spatula), q_ref)
+
+
+def nearest_branch(sols: np.ndarray, q_ref) -> tuple[int, np.ndarray] | None:
+    """(branch, q) of the row of ``sols`` (8, 6) nearest to ``q_ref`` (max joint distance;
+    NaN rows do not exist), or None if every row is NaN."""
+    ok = ~np.isnan(sols[:, 0])
+    if not ok.any():
+        return None
+    dist = np.where(ok, np.abs(np.nan_to_num(sols) - np.asarray(q_ref)).max(axis=1), np.inf)
+    k = int(np.argmin(dist))
+    return k, sols[k]
