@@ -245,7 +245,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             end = plan_end[id(refs.bounds)] = max(b[1] for b in refs.bounds.values())
         if k <= w or refs.t[k] < end + SETTLED_WINDOW:
             return False
-        bp, br = trace.bp[k - w:k], trace._br[k - w:k]
+        bp, br = trace.bp[k - w:k], trace.br[k - w:k]
         return bool(np.abs(bp - bp[-1]).max() < SETTLED_MOTION
                     and np.abs(br - br[-1]).max() < SETTLED_TURN)
 
