@@ -236,14 +236,13 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         trace(k)
 
     w = max(1, int(round(SETTLED_WINDOW / dt)))
-    plan_end = {}  # id of a references' bounds -> the end of its plan (s)
+    plan_end = [None, 0.0]  # the references' bounds it was computed for, the plan's end (s)
 
     def settled(k: int, refs: References) -> bool:
         """After the plan's last segment and a window more: the burger has settled."""
-        end = plan_end.get(id(refs.bounds))
-        if end is None:
-            end = plan_end[id(refs.bounds)] = max(b[1] for b in refs.bounds.values())
-        if k <= w or refs.t[k] < end + SETTLED_WINDOW:
+        if plan_end[0] is not refs.bounds:  # a replan brings new references
+            plan_end[:] = refs.bounds, max(b[1] for b in refs.bounds.values())
+        if k <= w or refs.t[k] < plan_end[1] + SETTLED_WINDOW:
             return False
         bp, br = trace.bp[k - w:k], trace.br[k - w:k]
         return bool(np.abs(bp - bp[-1]).max() < SETTLED_MOTION
