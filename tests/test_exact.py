@@ -1,5 +1,7 @@
 """FATROP and exact-Hessian IPOPT (flipkit.solvers.exact) against the SQP, on the same NLP."""
 
+import os
+
 import pytest
 
 from flipkit.behaviors.models import Models
@@ -8,7 +10,8 @@ from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
-from flipkit.solvers.exact import ExactSolver, solve_exact
+from flipkit.solvers.exact import ExactOptions, ExactSolver, solve_exact
+from flipkit.solvers.step_profile import StepProfile, captured_stdout, fatrop_profile
 from flipkit.solvers.sqp import solve_sqp
 from flipkit.transcription.ocp_graph import OcpGraph
 
@@ -61,3 +64,35 @@ def test_other_graph_refused(cell, translate, graph):
                                     options=SegmentOptions(arm_clearance=False)))
     with pytest.raises(ConfigError, match="differs"):
         ExactSolver(translate, "ipopt", graph=graph).solve(graph=pickup)
+
+
+@pytest.mark.parametrize("solver", ["fatrop", "ipopt"])
+def test_step_profile_counts_the_solves_iterations(translate, graph, solver):
+    """With ``step_profile`` each solve records how many of its iterations regularised the
+    Hessian and cut the primal step: FATROP from its captured table (nothing of it shown),
+    IPOPT from its statistics; over as many iterations as the solver reports."""
+    exact = ExactSolver(translate, solver, ExactOptions(step_profile=True), graph=graph)
+    result = exact.solve()
+    p = exact.last_profile
+    assert result.success and p is not None
+    assert p.iterations == result.iterations
+    assert 0 <= p.regularised <= p.iterations and 0 < p.short_steps + p.regularised
+
+
+def test_fatrop_table_is_read_row_by_row():
+    text = """iter    objective   inf_pr   inf_du lg(mu)    ||d||   lg(rg)   alpha_du   alpha_pr ls
+   0  3.15e-01 1.40e-02 1.87e-01   -1.0 0.00e+00      -  0.00e+00   0.00e+00x  1
+   1  3.17e-01 1.56e-02 2.08e-01   -1.0 0.00e+00      -  9.83e-01   1.00e+00f  1
+   2  3.18e-01 1.42e-02 7.55e-02   -1.7 1.85e-01   -2.0  1.00e+00   3.81e-01h  1
+   3  2.96e-01 1.39e-02 1.41e-02   -2.5 1.65e-01    0.2  9.90e-01   1.00e+00h  1
+EXIT: Optimal solution found.
+"""
+    assert fatrop_profile(text) == StepProfile(iterations=3, regularised=2, short_steps=1)
+    assert fatrop_profile("no table here") is None
+
+
+def test_captured_stdout_takes_c_level_writes():
+    with captured_stdout() as out:
+        os.write(1, b"from C's fd 1\n")
+        print("from Python")
+    assert out == ["from C's fd 1\nfrom Python\n"]

@@ -39,6 +39,7 @@ import statistics
 import sys
 import time
 import warnings
+from dataclasses import asdict
 
 import numpy as np
 
@@ -123,10 +124,44 @@ def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
         for g in graphs:
             key = (plugin, g.key, jit)
             if key not in cache:
-                cache[key] = ExactSolver(g.nlp, plugin, ExactOptions(jit=jit), graph=g)
+                cache[key] = ExactSolver(g.nlp, plugin, ExactOptions(jit=jit, step_profile=True),
+                                         graph=g)
                 build[name] = build.get(name, 0.0) + cache[key].build_time_s
             solvers[(name, id(g))] = cache[key]
     return solvers, build
+
+
+ITERATION_RATIO = 1.5  # a peer's median iterations within this × exact IPOPT's (issue 31)
+
+
+def iteration_notes(rows, names, med) -> list[str]:
+    """One line per peer whose median iterations exceed :data:`ITERATION_RATIO` × exact
+    IPOPT's, with why where its solves were profiled: over all segments, how many of its
+    iterations regularised the Hessian and how many cut the primal step below half, beside
+    exact IPOPT's (:mod:`flipkit.solvers.step_profile`)."""
+    ref = "ipopt_exact"
+    if ref not in names or not med[ref]["iterations"]:
+        return []
+
+    def total(name):
+        profiles = [r[name]["profile"] for r in rows if r[name].get("profile")]
+        return None if not profiles else {k: sum(p[k] for p in profiles) for k in profiles[0]}
+
+    lines, base = [], total(ref)
+    for name in names:
+        ratio = med[name]["iterations"] / med[ref]["iterations"]
+        if name in ("sqp", ref) or ratio <= ITERATION_RATIO:
+            continue
+        p = total(name)
+        why = ("not profiled" if p is None or base is None else
+               f"it regularised its Hessian on {p['regularised']} of its {p['iterations']} "
+               f"iterations over the segments (exact IPOPT: {base['regularised']} of "
+               f"{base['iterations']}) and cut its primal step below half on "
+               f"{p['short_steps']} ({base['short_steps']})")
+        lines.append(f"{TRANSLATE_SOLVERS[name]}: median {med[name]['iterations']:.0f} "
+                     f"iterations, {ratio:.1f} × exact IPOPT's {med[ref]['iterations']:.0f} "
+                     f"(over {ITERATION_RATIO:g} ×): {why}")
+    return lines
 
 
 def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
@@ -178,13 +213,16 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
     for k, nlp in enumerate(nlps):
         r = {"segment": f"{k + 1}->{(k + 1) % len(nlps) + 1}"}
         for name in names:
+            profile = None
             if name in EXACT_RESULT_NAMES.values():
-                res = exact[(name, id(graphs[k]))].solve(graph=graphs[k])
+                solver = exact[(name, id(graphs[k]))]
+                res, profile = solver.solve(graph=graphs[k]), solver.last_profile
             else:
                 res = solve_segment(nlp, name)
             r[name] = {"time_s": res.wall_time_s, "iterations": res.iterations,
                        "objective": res.objective, "status": str(res.status),
-                       "T_s": float(res.x[nlp.layout.T_index])}
+                       "T_s": float(res.x[nlp.layout.T_index]),
+                       "profile": None if profile is None else asdict(profile)}
         for name in names:
             d, s = r[name], r["sqp"]
             both = d["status"] == s["status"] == "solved"
@@ -216,6 +254,8 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
           "over the segments both solved, ms/it = median time per iteration, "
           "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
           "solver calls alone (FATROP's and exact IPOPT's without building their graphs)")
+    for line in iteration_notes(rows, names, med):
+        print(line)
     return {"machine": machine(), "key_points": TRANSLATE_KEY_POINTS, "full": full, "jit": jit,
             "build_s": build, "rows": rows, "median": med}
 

@@ -23,6 +23,7 @@ by :meth:`NLP.evaluate` at the returned point (clipped to the bounds) is at most
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import dataclass
 
@@ -34,6 +35,8 @@ from flipkit.solvers.names import EXACT_RESULT_NAMES, EXACT_SOLVERS
 from flipkit.transcription.nlp import NLP
 from flipkit.transcription.ocp_graph import OcpGraph
 from flipkit.solvers.result import SolveResult, Status
+from flipkit.solvers.step_profile import (StepProfile, captured_stdout, fatrop_profile,
+                                          ipopt_profile)
 
 
 @dataclass(frozen=True)
@@ -51,6 +54,9 @@ class ExactOptions:
         jit: Compile the graph's functions to C before solving (CasADi JIT, ``-O0``: the
             graph's C is ~40 MB; gcc -O1 on it ran for over 3 min and 3 GB, not finished).
         print_level: Solver verbosity (0 silent).
+        step_profile: Record each solve's :class:`~flipkit.solvers.step_profile.StepProfile`
+            (``ExactSolver.last_profile``): FATROP then prints its iteration table, which is
+            captured and read instead of shown.
     """
 
     tol: float = 1e-8
@@ -59,6 +65,7 @@ class ExactOptions:
     max_iter: int = 1000
     jit: bool = False
     print_level: int = 0
+    step_profile: bool = False
 
     def plugin_options(self, solver: str, graph: OcpGraph) -> dict:
         """The :func:`casadi.nlpsol` options of ``solver`` for ``graph``."""
@@ -68,7 +75,8 @@ class ExactOptions:
                            "jit_options": {"flags": ["-O0"], "verbose": False}})
         if solver == "fatrop":
             return {**common, **graph.structure, "structure_detection": "manual",
-                    "fatrop": {"print_level": self.print_level, "max_iter": self.max_iter,
+                    "fatrop": {"print_level": 5 if self.step_profile else self.print_level,
+                               "max_iter": self.max_iter,
                                "tol": self.fatrop_tol, "constr_viol_tol": self.constr_viol_tol}}
         return {**common, "ipopt": {"print_level": self.print_level, "sb": "yes",
                                     "linear_solver": "mumps", "tol": self.tol,
@@ -89,6 +97,8 @@ class ExactSolver:
 
     Attributes:
         build_time_s: Wall time (s) of building the graph (when not given) and the solver.
+        last_profile: The last solve's :class:`~flipkit.solvers.step_profile.StepProfile`
+            (IPOPT always; FATROP with ``options.step_profile``), else ``None``.
 
     Raises:
         InvalidChoiceError: ``solver`` is not one of :data:`EXACT_SOLVERS`.
@@ -105,6 +115,7 @@ class ExactSolver:
         self.function = ca.nlpsol(f"{solver}_{nlp.name}", solver, self.graph.problem,
                                   options.plugin_options(solver, self.graph))
         self.build_time_s = time.perf_counter() - t0
+        self.last_profile: StepProfile | None = None
 
     def solve(self, x0=None, graph: OcpGraph | None = None) -> SolveResult:
         """Solve from ``x0`` (unscaled; default ``nlp.x0``, clipped to the bounds).
@@ -130,11 +141,15 @@ class ExactSolver:
                               f"{self.name} solver was built for")
         nlp = g.nlp
         x_start = np.clip(np.array(nlp.x0 if x0 is None else x0, float), nlp.x_lb, nlp.x_ub)
-        t0 = time.perf_counter()
-        sol = self.function(x0=g.from_nlp_point(x_start), lbx=g.lbx, ubx=g.ubx, lbg=g.lbg,
-                            ubg=g.ubg)
-        wall = time.perf_counter() - t0
+        capture = self.options.step_profile and self.name == "fatrop"
+        with captured_stdout() if capture else contextlib.nullcontext([]) as printed:
+            t0 = time.perf_counter()
+            sol = self.function(x0=g.from_nlp_point(x_start), lbx=g.lbx, ubx=g.ubx,
+                                lbg=g.lbg, ubg=g.ubg)
+            wall = time.perf_counter() - t0
         stats = self.function.stats()
+        self.last_profile = (fatrop_profile("".join(printed)) if capture
+                             else ipopt_profile(stats) if self.name == "ipopt" else None)
         x = np.clip(g.to_nlp_point(sol["x"]), nlp.x_lb, nlp.x_ub)
         violation = float(nlp.scaled_violation(nlp.constraints(x)).max(initial=0.0))
         if stats.get("success", False):
