@@ -1,6 +1,7 @@
 """The translate bench says why a peer's iterations exceed 1.5 × exact IPOPT's."""
 
-from flipkit.experiments.bench import ITERATION_RATIO, iteration_notes
+from flipkit.experiments.bench import TRANSLATE_SOLVERS
+from flipkit.experiments.iteration_notes import ITERATION_RATIO, iteration_notes
 
 
 def _row(iterations, profile):
@@ -17,16 +18,16 @@ def test_a_peer_over_the_ratio_gets_its_profile_beside_ipopts():
              "ipopt_exact": _row(27, prof(27, 0, 6)), "ipopt": _row(36, None)}]
     med = {"sqp": {"iterations": 8.5}, "fatrop": {"iterations": 85.0},
            "ipopt_exact": {"iterations": 26.0}, "ipopt": {"iterations": 33.0}}
-    lines = iteration_notes(rows, names, med)
+    lines = iteration_notes(rows, names, med, TRANSLATE_SOLVERS)
     assert len(lines) == 1 and lines[0].startswith("FATROP: median 85 iterations, 3.3 ×")
     assert "110 of its 170" in lines[0] and "exact IPOPT: 1 of 52" in lines[0]
     assert "below half on 50 (11)" in lines[0]
     med["fatrop"]["iterations"] = ITERATION_RATIO * 26.0  # at the ratio: no note
-    assert iteration_notes(rows, names, med) == []
+    assert iteration_notes(rows, names, med, TRANSLATE_SOLVERS) == []
 
 
 def test_a_peer_without_a_profile_is_said_to_be_so():
     names = ("ipopt_exact", "ipopt")
     rows = [{"ipopt_exact": _row(20, None), "ipopt": _row(50, None)}]
     med = {"ipopt_exact": {"iterations": 20.0}, "ipopt": {"iterations": 50.0}}
-    assert iteration_notes(rows, names, med)[0].endswith("not profiled")
+    assert iteration_notes(rows, names, med, TRANSLATE_SOLVERS)[0].endswith("not profiled")

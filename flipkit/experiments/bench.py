@@ -58,6 +58,7 @@ from flipkit.planning.planners.planner import plan_batch, plan_flip
 from flipkit.experiments.bench_replan import bench_replan, load_result, run_validation
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 from flipkit.planning.kitchen.schedule import schedule_cook
+from flipkit.experiments.iteration_notes import iteration_notes
 from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
@@ -129,39 +130,6 @@ def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
                 build[name] = build.get(name, 0.0) + cache[key].build_time_s
             solvers[(name, id(g))] = cache[key]
     return solvers, build
-
-
-ITERATION_RATIO = 1.5  # a peer's median iterations within this × exact IPOPT's (issue 31)
-
-
-def iteration_notes(rows, names, med) -> list[str]:
-    """One line per peer whose median iterations exceed :data:`ITERATION_RATIO` × exact
-    IPOPT's, with why where its solves were profiled: over all segments, how many of its
-    iterations regularised the Hessian and how many cut the primal step below half, beside
-    exact IPOPT's (:mod:`flipkit.solvers.step_profile`)."""
-    ref = "ipopt_exact"
-    if ref not in names or not med[ref]["iterations"]:
-        return []
-
-    def total(name):
-        profiles = [r[name]["profile"] for r in rows if r[name].get("profile")]
-        return None if not profiles else {k: sum(p[k] for p in profiles) for k in profiles[0]}
-
-    lines, base = [], total(ref)
-    for name in names:
-        ratio = med[name]["iterations"] / med[ref]["iterations"]
-        if name in ("sqp", ref) or ratio <= ITERATION_RATIO:
-            continue
-        p = total(name)
-        why = ("not profiled" if p is None or base is None else
-               f"it regularised its Hessian on {p['regularised']} of its {p['iterations']} "
-               f"iterations over the segments (exact IPOPT: {base['regularised']} of "
-               f"{base['iterations']}) and cut its primal step below half on "
-               f"{p['short_steps']} ({base['short_steps']})")
-        lines.append(f"{TRANSLATE_SOLVERS[name]}: median {med[name]['iterations']:.0f} "
-                     f"iterations, {ratio:.1f} × exact IPOPT's {med[ref]['iterations']:.0f} "
-                     f"(over {ITERATION_RATIO:g} ×): {why}")
-    return lines
 
 
 def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
@@ -254,7 +222,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
           "over the segments both solved, ms/it = median time per iteration, "
           "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
           "solver calls alone (FATROP's and exact IPOPT's without building their graphs)")
-    for line in iteration_notes(rows, names, med):
+    for line in iteration_notes(rows, names, med, TRANSLATE_SOLVERS):
         print(line)
     return {"machine": machine(), "key_points": TRANSLATE_KEY_POINTS, "full": full, "jit": jit,
             "build_s": build, "rows": rows, "median": med}
