@@ -11,7 +11,8 @@ from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.exact import ExactOptions, ExactSolver, solve_exact
-from flipkit.solvers.step_profile import StepProfile, captured_stdout, fatrop_profile
+from flipkit.solvers.step_profile import StepProfile, fatrop_profile
+from flipkit.solvers.stdout_redirect import captured_stdout
 from flipkit.solvers.sqp import solve_sqp
 from flipkit.transcription.ocp_graph import OcpGraph
 

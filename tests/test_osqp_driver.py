@@ -4,7 +4,7 @@ import numpy as np
 import osqp
 import scipy.sparse as sp
 
-from flipkit.solvers.osqp_driver import _LIBC, c_stdout_silenced
+from flipkit.solvers.stdout_redirect import _LIBC, c_stdout_silenced
 
 MESSAGE = "Polishing not needed"
 

@@ -35,8 +35,8 @@ from flipkit.solvers.names import EXACT_RESULT_NAMES, EXACT_SOLVERS
 from flipkit.transcription.nlp import NLP
 from flipkit.transcription.ocp_graph import OcpGraph
 from flipkit.solvers.result import SolveResult, Status
-from flipkit.solvers.step_profile import (StepProfile, captured_stdout, fatrop_profile,
-                                          ipopt_profile)
+from flipkit.solvers.step_profile import StepProfile, fatrop_profile, ipopt_profile
+from flipkit.solvers.stdout_redirect import captured_stdout
 
 
 @dataclass(frozen=True)

@@ -30,10 +30,6 @@ fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import os
-import sys
 import warnings
 
 import cvxpy as cp
@@ -42,50 +38,13 @@ import scipy.sparse as sp
 
 from flipkit.errors import SolverError
 from flipkit.solvers.param_map import ParameterMap, osqp_form
+from flipkit.solvers.stdout_redirect import c_stdout_silenced
 import osqp
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 ADD_PER_ROUND = 10  # compact mode: most violated dropped rows added per round
 INITIAL_SLACK = 1e-2  # first working set: inequality rows this close to a bound at d = 0
 INITIAL_ROWS = 2  # working set carried between solves: at most this many rows per variable
-try:
-    _LIBC = ctypes.CDLL(None)  # this process's C library, for fflush
-except OSError:  # pragma: no cover - not a POSIX process
-    _LIBC = None
-
-
-@contextlib.contextmanager
-def c_stdout_silenced():
-    """Discard what the solver writes to stdout meanwhile, from C or through Python.
-
-    OSQP 1.1's polish step prints "Polishing not needed - no active set detected at optimal
-    point" whatever its ``verbose`` setting — with C's printf, whose buffer is flushed at exit
-    when stdout is a pipe (the line then lands in the middle of a command's output), or through
-    ``sys.stdout`` when the extension is set to print through Python. Both are sent to
-    /dev/null: fd 1 (C's buffer flushed before fd 1 is restored) and ``sys.stdout``. Nothing
-    of flipkit prints inside a solve. fd 1 is process-wide: not for threads that print while
-    OSQP runs (flipkit's sweeps use processes).
-    """
-    try:
-        sys.stdout.flush()
-        saved = os.dup(1)
-    except (OSError, ValueError, AttributeError):  # no fd 1 (e.g. closed)
-        saved = None
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        if saved is not None:
-            os.dup2(devnull, 1)
-        with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):
-            yield
-    finally:
-        if _LIBC is not None:
-            _LIBC.fflush(None)
-        if saved is not None:
-            os.dup2(saved, 1)
-            os.close(saved)
-        os.close(devnull)
-
-
 def _capped(rows: np.ndarray, first: np.ndarray, then: np.ndarray, cap: int) -> np.ndarray:
     """The mask ``rows`` keeping at most ``cap`` of them: smallest ``first``, ties by ``then``.
 

@@ -6,28 +6,19 @@ matrix has the wrong inertia, i.e. when the problem is not convex along its cons
 there. Its line search then often takes short primal steps. Both cost iterations. IPOPT
 reports them per iteration in its statistics (``regularization_size``, ``alpha_pr``).
 FATROP does not: it prints them in its iteration table (columns ``lg(rg)``, "-" when it did
-not regularise, and ``alpha_pr``, with a one-letter suffix). :func:`captured_stdout` collects
-that table, and :func:`fatrop_profile` reads it.
+not regularise, and ``alpha_pr``, with a one-letter suffix).
+:func:`~flipkit.solvers.stdout_redirect.captured_stdout` collects that table, and
+:func:`fatrop_profile` reads it.
 """
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import io
-import os
 import re
-import sys
-import tempfile
 from dataclasses import dataclass
 
 SHORT_STEP = 0.5  # a primal step length below this counts as cut short
 _ROW = re.compile(r"^\s*\d+\s+[-+0-9.eE]+\s")  # a row of FATROP's iteration table
 _NUMBER = re.compile(r"[-+0-9.eE]+")
-try:
-    _LIBC = ctypes.CDLL(None)  # this process's C library, to flush the solver's printf
-except OSError:  # pragma: no cover - not a POSIX process
-    _LIBC = None
 
 
 @dataclass(frozen=True)
@@ -64,29 +55,4 @@ def fatrop_profile(text: str) -> StepProfile | None:
                        sum(a < SHORT_STEP for a in alpha))
 
 
-@contextlib.contextmanager
-def captured_stdout():
-    """Collect what is written meanwhile instead of showing it: to fd 1 (C's printf) and
-    through ``sys.stdout`` (where CasADi sends its solvers' output in Python, and a
-    notebook's or pytest's stream when it is not fd 1). Yields a list that holds the text,
-    fd 1's then Python's, once the block ends. fd 1 is process-wide: not for threads that
-    print meanwhile."""
-    out: list[str] = []
-    sys.stdout.flush()
-    saved = os.dup(1)
-    python = io.StringIO()
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        os.dup2(sink.fileno(), 1)
-        try:
-            with contextlib.redirect_stdout(python):
-                yield out
-        finally:
-            if _LIBC is not None:
-                _LIBC.fflush(None)
-            os.dup2(saved, 1)
-            os.close(saved)
-            sink.seek(0)
-            out.append(sink.read().decode(errors="replace") + python.getvalue())
-
-
-__all__ = ["SHORT_STEP", "StepProfile", "captured_stdout", "fatrop_profile", "ipopt_profile"]
+__all__ = ["SHORT_STEP", "StepProfile", "fatrop_profile", "ipopt_profile"]
