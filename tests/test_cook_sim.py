@@ -205,7 +205,7 @@ def test_a_sensed_serve_runs_only_a_solved_re_plan_no_longer_than_the_scheduled_
     from types import SimpleNamespace as NS
 
     def plan(T, status="solved", xy=(0.70, -0.20)):
-        return NS(status=status, segments=[NS(T=T / 2), NS(T=T / 2)],
+        return NS(status=status, segments=[NS(T=T / 2), NS(T=T / 2)], duration=T,
                   burger={"location": [xy[0], xy[1], 0.072]})
 
     scene = build_scene(burgers=2)

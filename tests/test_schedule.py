@@ -205,7 +205,8 @@ def test_serve_planner_calls_plan_serve_from_the_start_configuration(monkeypatch
         seg = [SimpleNamespace(name=n, T=t, q=np.full((21, 6), k))
                for k, (n, t) in enumerate([("go_to_burger", 0.7), ("scoop", 0.6),
                                            ("pickup", 0.3), ("carry", 1.0)])]
-        return SimpleNamespace(status="solved", segments=seg, behavior="serve")
+        return SimpleNamespace(status="solved", segments=seg, behavior="serve",
+                               duration=sum(g.T for g in seg))
 
     monkeypatch.setattr(motions, "plan_serve", fake_plan_serve)
     serve = motions.default_planners(("flip", "serve"), CELL, "sqp")["serve"]

@@ -209,7 +209,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         if sense_serve is not None and mo.kind == "serve":
             plan = plans[i] = sensed_serve(mo, scene, index[mo.burger], sense_serve,
                                             rng.normal(0.0, sensing_sigma, 2), sensed)
-        T = float(sum(s.T for s in plan.segments))
+        T = plan.duration
         gap = nxt - mo.end
         hold = gap if step_idle and np.isfinite(gap) else min(max(gap, 0.0), MAX_SETTLE_S)
         refs = plan_references(plan, robot, cell.physics, mode, command, dt, hold)
@@ -252,7 +252,7 @@ def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
     t0 = time.perf_counter()
     try:
         new = sense_serve(mo, xy)
-        why = _unusable(new, float(sum(s.T for s in mo.plan.segments)))
+        why = _unusable(new, mo.plan.duration)
     except FlipkitError as exc:  # a place the planner refuses, with its reason
         new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0
@@ -268,7 +268,7 @@ def _unusable(new, T_old: float) -> str | None:
     if new is None or new.status != "solved":
         reason = getattr(new, "failure", None)
         return "the re-plan failed" + (f": {reason}" if reason else "")
-    if float(sum(s.T for s in new.segments)) > T_old + 1e-9:
+    if new.duration > T_old + 1e-9:
         return "the re-plan is longer than the scheduled serve"
     return None
 

@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> int:
         count, what = write_ros2(plan, args.out, args.rate, **common), "trajectory points"
     else:
         count, what = write_csv(plan, args.out, args.rate, **common), "rows"
-    total = sum(s.T for s in plan.segments)
+    total = plan.duration
     print(f"flipkit export: wrote {count} {what} ({total:.3f} s at {args.rate:g} Hz) to "
           f"{args.out}")
     return 0

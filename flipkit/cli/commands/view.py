@@ -29,7 +29,7 @@ def _stop(signum, frame):
 def run(args: argparse.Namespace) -> int:
     """Write the page (``--html``), or serve the view and wait for Ctrl-C."""
     plan = Plan.load(args.plan)
-    total = sum(s.T for s in plan.segments)
+    total = plan.duration
     if args.html:
         write_html(plan, args.html, where=args.plan, meshes=args.meshes)
         print(f"flipkit view: wrote {args.html} ({plan.behavior} plan, {total:.2f} s; "

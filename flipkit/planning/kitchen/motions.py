@@ -21,6 +21,7 @@ from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
 from flipkit.planning.planners.serve import plan_serve, table_spot
+from flipkit.planning.plans.plan_file import segment_span
 
 KINDS = ("flip", "serve")
 
@@ -94,13 +95,11 @@ class MotionPlanner(Protocol):
 
 def _segment_start(plan, name: str) -> float:
     """Start time (s) of the first segment called ``name``, from the start of the plan."""
-    t = 0.0
-    for seg in plan.segments:
-        if seg.name == name:
-            return t
-        t += float(seg.T)
-    raise FlipkitError(f"{plan.behavior} plan has no {name!r} segment "
-                       f"(segments: {', '.join(s.name for s in plan.segments)})")
+    span = segment_span(plan.segments, name)
+    if span is None:
+        raise FlipkitError(f"{plan.behavior} plan has no {name!r} segment "
+                           f"(segments: {', '.join(s.name for s in plan.segments)})")
+    return span[0]
 
 
 def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
@@ -111,7 +110,7 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
     slid the blade under the burger and the lift begins.
     """
     ok = plan.status == "solved"
-    duration = float(sum(s.T for s in plan.segments))
+    duration = plan.duration
     last = plan.segments[-1]
     landing, event = None, duration
     if ok and kind == "flip":

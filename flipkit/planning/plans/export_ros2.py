@@ -60,7 +60,7 @@ def trajectory(plan: Plan, rate: float, *, force: bool = False) -> dict:
                           f"URDF has {', '.join(names)}")
     stamps = [round(x * 1e9) for x in t]
     last = plan.segments[-1]
-    end = round(sum(s.T for s in plan.segments) * 1e9)
+    end = round(plan.duration * 1e9)
     samples = list(zip(stamps, q, qd))
     if end > stamps[-1]:
         samples.append((end, last.q[-1], last.qd[-1]))
@@ -74,7 +74,7 @@ def ros2_text(plan: Plan, message: dict, rate: float, where: str) -> str:
     """The YAML document, after comment lines that say what it is."""
     made = plan.created_by
     head = [f"# {MESSAGE} from flipkit export --format ros2: {where}, a {plan.behavior} plan "
-            f"of {len(plan.segments)} segments, {sum(s.T for s in plan.segments):.3f} s",
+            f"of {len(plan.segments)} segments, {plan.duration:.3f} s",
             f"# planned by flipkit {made['flipkit']} (git {made['git']}); passed flipkit "
             "verify before this was written",
             f"# {len(message['points'])} points: samples at {rate:g} Hz and the plan's end; "

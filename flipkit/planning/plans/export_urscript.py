@@ -117,7 +117,7 @@ def urscript_text(plan: Plan, t, q_cmd, rate: float, options: ServoOptions, wher
     tail = f"{options.lookahead:g}, {options.gain:g})"
     lines = [
         f"# flipkit export --format urscript: {where}, a {plan.behavior} plan of "
-        f"{len(plan.segments)} segments, {sum(s.T for s in plan.segments):.3f} s",
+        f"{len(plan.segments)} segments, {plan.duration:.3f} s",
         f"# planned by flipkit {made['flipkit']} (git {made['git']}); passed flipkit verify "
         "before this was written",
         f"# {t.size} servoj samples at {rate:g} Hz (t = {period} s), lookahead_time "

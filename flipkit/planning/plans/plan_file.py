@@ -79,6 +79,17 @@ _ROBOT_KEYS = ("urdf", "base_in_world", "tool_parent_frame", "spatula_in_parent"
 _BURGER_KEYS = ("location", "diameter", "thickness", "mass", "mu")
 
 
+def segment_span(segments, name: str) -> tuple[float, float] | None:
+    """(start, end) (s, from the first segment's start) of the first of ``segments`` named
+    ``name``, chained end to start, or ``None`` if none is."""
+    t = 0.0
+    for seg in segments:
+        if seg.name == name:
+            return t, t + float(seg.T)
+        t += float(seg.T)
+    return None
+
+
 @dataclass
 class Plan:
     """A plan file in memory; attribute names and nesting are the file's (``docs/plan-format.md``).
@@ -263,15 +274,15 @@ class Plan:
         """The plan's first :class:`Segment` named ``name``, or ``None`` if it has none."""
         return next((s for s in self.segments if s.name == name), None)
 
+    @property
+    def duration(self) -> float:
+        """Its executed duration (s): the sum of its segments'."""
+        return float(sum(seg.T for seg in self.segments))
+
     def segment_span(self, name: str) -> tuple[float, float] | None:
         """(start, end) (s, from the plan's start) of its first segment named ``name``, or
-        ``None`` if it has none."""
-        t = 0.0
-        for seg in self.segments:
-            if seg.name == name:
-                return t, t + float(seg.T)
-            t += float(seg.T)
-        return None
+        ``None`` if it has none (:func:`segment_span`)."""
+        return segment_span(self.segments, name)
 
     def robot_for(self, segment, cell: CellConfig | None = None):
         """The dynamics model of ``segment`` (a :class:`Segment` of this plan, or a name: its
