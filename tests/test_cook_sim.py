@@ -20,7 +20,8 @@ from flipkit.planning.kitchen.motions import PlannedMotion, cached_planners, def
 from flipkit.planning.kitchen.schedule import schedule_cook
 from flipkit.planning.kitchen.windows import Windows
 from flipkit.simulation.cook import CookNotSimulatedError, sensed_serve, simulate_cook
-from flipkit.simulation.scene import PARK_ORIGIN, build_scene, park_burger, place_burger
+from flipkit.simulation.scene import (BURGER_BIT, PARK_ORIGIN, build_scene, park_burger,
+                                     place_burger)
 
 CELL = CellConfig()
 # Two burgers whose approach lines from the arm do not cross (issue: a scoop runs over a
@@ -37,7 +38,11 @@ def test_several_burgers_have_their_own_pairs_and_stay_parked_until_placed():
     names = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_PAIR, i) for i in range(m.npair)}
     for k in range(3):
         assert {f"burger_{k}_blade", f"burger_{k}_grill", f"burger_{k}_table"} <= names
-    assert {"burger_0_burger_1", "burger_0_burger_2", "burger_1_burger_2"} <= names
+    # burgers meet each other through their collision bit (every strip), nothing else does
+    bit = [g for k in range(3) for g in scene.burger_geoms[k]]
+    assert np.all(m.geom_contype[bit] == BURGER_BIT) and np.all(m.geom_conaffinity[bit] == BURGER_BIT)
+    others = np.setdiff1d(np.arange(m.ngeom), bit)
+    assert np.all(m.geom_contype[others] == 0) and np.all(m.geom_conaffinity[others] == 0)
     place_burger(scene, (0.7, -0.2), burger=1)
     mujoco.mj_step(m, d, nstep=400)  # 0.2 s
     parked = d.qpos[scene.qpos_of(0)][:3]
@@ -47,6 +52,16 @@ def test_several_burgers_have_their_own_pairs_and_stay_parked_until_placed():
     assert on[2] == pytest.approx(scene.grill_height + CELL.burger.thickness / 2, abs=1e-3)
     park_burger(scene, 1)
     assert np.allclose(d.qpos[scene.qpos_of(1)][:3], np.add(PARK_ORIGIN, (0.2, 0, 0)))
+
+
+def test_burgers_placed_overlapping_push_each_other_apart():
+    scene = build_scene(burgers=2)
+    m, d = scene.model, scene.data
+    place_burger(scene, (0.70, -0.2), burger=0)
+    place_burger(scene, (0.70 + 0.095, -0.2), burger=1)  # 5 mm into each other
+    mujoco.mj_step(m, d, nstep=400)
+    gap = d.qpos[scene.qpos_of(1)][:2] - d.qpos[scene.qpos_of(0)][:2]
+    assert np.linalg.norm(gap) > CELL.burger.diameter - 1e-3
 
 
 def test_one_burger_scene_is_unchanged():
@@ -82,7 +97,11 @@ def test_two_burgers_are_flipped_and_served_in_one_simulation(simulated, timelin
         assert b.flip.upside_down and max(map(abs, b.flip.offset)) <= 0.05
         # the simulated landing lies within a control step or two of the planned one
         assert abs(b.deviation_s["flip"] - b.planned_deviation_s["flip"]) < 0.05
-        assert b.knocked_m < 0.01  # (b2 placed beside b1 on the table touches it: reported)
+    # b2 lies untouched after it landed and after its serve. b1 lies where its serve put it, a
+    # few cm off its table spot (the bending patty passes the place the serve planned for,
+    # docs/benchmarks/2026-11-27-bending-patty.md), and b2's serve brushes it: reported.
+    b1, b2 = simulated.burgers
+    assert b2.knocked_m < 0.01 and b1.knocked_m < 0.03
     # the idle intervals (the 90 s and 60 s waits) are skipped, at rest
     assert simulated.skipped_s > 100 and simulated.stepped_s < 40
     assert simulated.skip_speed["burger_m_s"] < 1e-3 and simulated.skip_speed["arm_rad_s"] < 1e-3

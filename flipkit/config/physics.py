@@ -40,8 +40,14 @@ class PhysicsConfig:
             was found: 50 kPa, range 28-147 kPa.
         burger_edge_radius: Radius (m) of the patty's rounded rim (a hand-formed or pressed
             patty has no sharp edge). No source: 5 mm, range 1 mm to half the thickness.
-        burger_dampratio: Damping ratio of the burger contacts (MuJoCo solref[1]); a patty
-            does not bounce (no source: 1 = critically damped, range 0.7-2).
+        burger_dampratio: Damping ratio of the burger contacts (MuJoCo solref[1]) and of the
+            patty's bending (its hinges, :mod:`flipkit.simulation.patty`); a patty does not
+            bounce (no source: 1 = critically damped, range 0.7-2).
+        burger_strips: How many hinged strips the simulated patty is made of (odd; 1 is a
+            rigid disc). The patty bends under its own weight (:mod:`flipkit.simulation.patty`:
+            Hencky's bar chain with the bending stiffness of ``burger_modulus``). A numerical
+            setting, not a physical one: 5, where the Table I outcomes agree with 7 and 9
+            strips (docs/benchmarks/2026-11-27-bending-patty.md).
         blade_thickness: Blade thickness (m). A stiff one-piece stainless turner is 0.04 in
             = 1 mm, 18 gauge (J. Kenji Lopez-Alt, "The Food Lab", equipment chapter); a thin
             plated-steel turner 0.45 mm (softsolder.com, "Kitchen Spatula Search", 2016);
@@ -91,6 +97,7 @@ class PhysicsConfig:
     burger_modulus: float = 50e3
     burger_edge_radius: float = 0.005
     burger_dampratio: float = 1.0
+    burger_strips: int = 5
     blade_thickness: float = 0.001
     bevel_length: float = 0.005
     edge_thickness: float = 0.0002
@@ -111,6 +118,10 @@ class PhysicsConfig:
                      "blade_dampratio", "blade_tip_mass",
                      "timestep", "servo_rate_hz", "servo_gain_scale"):
             positive(f"physics {name}", getattr(self, name))
+        n = self.burger_strips
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1 or n % 2 == 0:
+            raise ConfigError(f"physics burger_strips must be an odd integer >= 1 (1: a rigid "
+                              f"disc), got {n!r}")
         if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
             raise ConfigError(f"physics latency_s must be >= 0 s, got {self.latency_s!r}")
         if self.edge_thickness >= self.blade_thickness:
@@ -156,6 +167,10 @@ class PhysicsConfig:
         tau = math.sqrt(m * burger.thickness / (self.burger_modulus * area))
         return max(tau, 2 * self.timestep)
 
+
+# PhysicsConfig fields that are numerical settings of the simulation: no plan depends on them
+# (the atlas's staleness hash leaves them out)
+SIMULATION_ONLY = ("burger_strips",)
 
 _NO_SOURCE = "no source found; range ours"
 PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from flipkit.config import PhysicsConfig
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
@@ -48,10 +49,13 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
 
 
 def trial_key(job: dict) -> dict:
-    """Cache key of a trial job: the plan's digest instead of its text, and the contingency
-    record's (:mod:`flipkit.experiments.contingent`) instead of it."""
+    """Cache key of a trial job: the plan's digest instead of its text, the contingency
+    record's (:mod:`flipkit.experiments.contingent`) instead of it, and the digest of the
+    simulated cell's default physics (a changed model, such as the patty's strips, is not
+    served from the cache)."""
     key = {**{k: v for k, v in job.items() if k != "plan_text"},
-           "plan": stable_hash(job["plan_text"])}
+           "plan": stable_hash(job["plan_text"]),
+           "simulated_physics": stable_hash(asdict(PhysicsConfig()))}
     if "contingencies" in job:
         key["contingencies"] = stable_hash(job["contingencies"])
     return key

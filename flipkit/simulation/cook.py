@@ -56,6 +56,7 @@ from flipkit.simulation.cook_judges import BurgerResult, judge_burger
 from flipkit.simulation.cook_record import CookRecorder, Watch
 from flipkit.simulation.execute import HOLD_S
 from flipkit.simulation.modes import MODES, POSITION
+from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger, place_burger
 
 REST_SPEED = 1e-3  # m/s (burger centres) and rad/s (arm joints): "at rest" before a skip
@@ -175,6 +176,9 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
     dt = control.substeps * m.opt.timestep
     watches = [Watch(index[mo.burger], mo.kind, mo.start, mo.end + HOLD_S) for mo in motions]
     rec = CookRecorder(scene, watches, dt, film_fps)
+    # each patty's strips lie along its flip's scoop (its serve's scoop meets them at an angle)
+    heading = {index[mo.burger]: scoop_heading(mo.plan, robot) for mo in motions
+               if mo.kind == "flip"}
     events = sorted([(b.burger.t_drop, 0, k) for k, b in enumerate(records)]
                     + [(max(mo.end + timeline.dwell_s, mo.end + HOLD_S), 1, index[mo.burger])
                        for mo in motions if mo.kind == "serve"])
@@ -187,7 +191,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
                 rec.removed(k)
             elif not away:
                 b = records[k].burger
-                place_burger(scene, (b.x, b.y), burger=k)
+                place_burger(scene, (b.x, b.y), burger=k, heading=heading.get(k, 0.0))
                 rec.placed(k)
 
     d.qpos[:ARM_JOINTS] = motions[0].plan.segments[0].q[0]

@@ -58,8 +58,8 @@ class CookRecorder:
         n = len(scene.burger_bodies)
         m = scene.model
         self.owner = np.full(m.ngeom, -1)
-        for k, body in enumerate(scene.burger_bodies):
-            self.owner[m.body_geomadr[body]:m.body_geomadr[body] + m.body_geomnum[body]] = k
+        for k, geoms in enumerate(scene.burger_geoms):
+            self.owner[list(geoms)] = k
         self.active = np.zeros(n, bool)
         self.rest_pos = np.zeros((n, 3))
         self.knocked_m = np.zeros(n)

@@ -40,6 +40,7 @@ from flipkit.model.robot import Robot
 from flipkit.simulation.control import (ArmController, References, plan_references,
                                         step_references)
 from flipkit.simulation.modes import FEEDFORWARD, MODES
+from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
 from flipkit.simulation.trace import BurgerTrace
 
@@ -184,7 +185,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     t_sense = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
 
     pb = np.asarray(plan.burger["location"], float)
-    place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=refs.q_des[0])
+    place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=refs.q_des[0],
+                 heading=scoop_heading(plan, robot))
     d.qvel[:ARM_JOINTS] = refs.qd_des[0]
     mujoco.mj_forward(m, d)
     N = len(refs.t) if replan is None else 3 * len(refs.t)  # room for the pause and a longer tail

@@ -60,6 +60,7 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
+from flipkit.simulation import patty
 
 NOSLIP_ITERATIONS = 10  # post-solve iterations: static friction holds without creep
 ARM_JOINTS = 6
@@ -72,6 +73,9 @@ BLADE_IMPEDANCE = 0.01
 # edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
 # spring-damper, so that the pressed edge meets k and b in all.
 BLADE_EDGE_CONTACTS = 2
+# Collision bit of the burgers' geoms in a several-burger scene: burger-burger contacts come from
+# MuJoCo's broad phase (a pair per strip pair would be thousands); every other geom has none.
+BURGER_BIT = 2
 # Parked burgers (several-burger scenes): a row below the visual floor (z = -0.6 m), hidden from
 # the cameras above it, 0.2 m apart (more than a diameter: no burger-burger contact).
 PARK_ORIGIN = (-1.0, 0.0, -1.5)  # m
@@ -124,11 +128,15 @@ class Scene:
         robot: The pinocchio arm it mirrors (no burger payload).
         blade_site: Site id of the spatula frame (top-face centre). grill_height: Actual
             surface height (m). geoms: ``{"blade", "grill", "burger", "table"}`` geom ids.
-        burger_qpos, burger_qvel: Slices of the burger's free joint in qpos / qvel.
+        burger_qpos, burger_qvel: Slices of the (first) burger's free joint in qpos / qvel.
         blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
             (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
-        burger_bodies: Body id of each burger (one, or ``burgers`` of :func:`build_scene`);
-            with several, ``geoms`` holds ``burger_k`` for each instead of ``burger``.
+        burger_bodies: Root body id of each burger (one, or ``burgers`` of :func:`build_scene`);
+            with several, ``geoms`` holds ``burger_k`` for each instead of ``burger``. A
+            root is the patty's middle strip (:mod:`flipkit.simulation.patty`): its pose
+            is the burger's.
+        burger_geoms: Per burger, the geom ids of all its strips, in order along the patty's
+            x; ``geoms`` names them too (``burger_s0`` …).
     """
 
     model: mujoco.MjModel
@@ -140,9 +148,15 @@ class Scene:
     geoms: dict
     blade_contact: dict
     burger_bodies: tuple = ()
+    burger_geoms: tuple = ()
 
-    burger_qpos = slice(ARM_JOINTS, ARM_JOINTS + 7)  # class constants, not fields
-    burger_qvel = slice(ARM_JOINTS, ARM_JOINTS + 6)
+    @property
+    def burger_qpos(self) -> slice:
+        return self.qpos_of(0)
+
+    @property
+    def burger_qvel(self) -> slice:
+        return self.qvel_of(0)
 
     def contacts(self) -> list[tuple[int, int, float]]:
         """(geom, geom, normal force N) of each contact of the last step, in contact order.
@@ -165,11 +179,24 @@ class Scene:
 
     def qpos_of(self, k: int) -> slice:
         """Slice of burger k's free joint (position, quaternion) in qpos."""
-        return slice(ARM_JOINTS + 7 * k, ARM_JOINTS + 7 * k + 7)
+        a = int(self.model.jnt_qposadr[self.model.body_jntadr[self.burger_bodies[k]]])
+        return slice(a, a + 7)
 
     def qvel_of(self, k: int) -> slice:
         """Slice of burger k's free joint (linear, angular velocity) in qvel."""
-        return slice(ARM_JOINTS + 6 * k, ARM_JOINTS + 6 * k + 6)
+        a = int(self.model.jnt_dofadr[self.model.body_jntadr[self.burger_bodies[k]]])
+        return slice(a, a + 6)
+
+    def patty_bodies(self, k: int) -> np.ndarray:
+        """Body ids of burger k's strips (its root and the strips hinged to it)."""
+        return np.flatnonzero(self.model.body_rootid == self.burger_bodies[k])
+
+    def hinges_of(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """qpos and qvel indices of burger k's strip hinges (empty for a rigid patty)."""
+        m = self.model
+        joints = [j for b in self.patty_bodies(k)[1:]
+                  for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b])]
+        return (np.asarray(m.jnt_qposadr[joints], int), np.asarray(m.jnt_dofadr[joints], int))
 
 
 def _joint_axis(joint) -> np.ndarray:
@@ -266,13 +293,20 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     names = ["burger"] if burgers == 1 else [f"burger_{k}" for k in range(burgers)]
     soft = (tau_b, ph.burger_dampratio)
 
+    strips = ph.burger_strips
+    collide = ('contype="0" conaffinity="0"' if burgers == 1 else
+               f'contype="{BURGER_BIT}" conaffinity="{BURGER_BIT}" condim="3" '
+               f'friction="{ph.mu_grill} 0.001 0.0001" solref="{soft[0]:.6g} {soft[1]:.6g}"')
+
     def body(name, pos, gravcomp):
+        if strips > 1:
+            return patty.body_xml(name, pos, gravcomp, cell, mass, collide)
         return (f'<body name="{name}" pos="{pos}"{gravcomp}>\n'
                 f'      <freejoint name="{name}"/>\n'
                 f'      <inertial pos="0 0 0" mass="{mass:.9g}" '
                 f'diaginertia="{_vec(_disc_inertia(mass, r, 2 * h2))}"/>\n'
-                f'      <geom name="{name}" type="mesh" mesh="burger" contype="0" '
-                f'conaffinity="0"\n            rgba="0.45 0.25 0.15 1"/>\n'
+                f'      <geom name="{name}" type="mesh" mesh="burger" {collide}\n'
+                f'            rgba="0.45 0.25 0.15 1"/>\n'
                 f'      <geom type="cylinder" size="{r * 0.8:.4g} 0.0005" pos="0 0 {h2}" '
                 f'contype="0"\n            conaffinity="0" rgba="0.3 0.15 0.08 1" mass="0"/>\n'
                 f'    </body>')
@@ -282,11 +316,19 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     else:
         bodies = "\n    ".join(body(n, _vec(_park_position(k)), ' gravcomp="1"')
                                for k, n in enumerate(names))
+    disc_mesh = (f'<mesh name="burger" vertex="'
+                 f'{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>')
+    parts = {n: [patty.strip_geom_name(n, st, strips) for st in patty.strips(cell, mass)]
+             if strips > 1 else [n] for n in names}
     pairs = "\n    ".join(
-        [line for n in names for line in (pair(n, "blade", mu, soft),
-                                          pair(n, "grill", ph.mu_grill, soft),
-                                          pair(n, "table", ph.mu_grill, soft))]
-        + [pair(a, b, ph.mu_grill, soft) for i, a in enumerate(names) for b in names[i + 1:]])
+        line for n in names for g in parts[n]
+        for line in (pair(g, "blade", mu, soft), pair(g, "grill", ph.mu_grill, soft),
+                     pair(g, "table", ph.mu_grill, soft)))
+    # burger-burger contacts: collision bits (BURGER_BIT), not pairs; a patty's strips meet
+    # their neighbours through the hinges only
+    excludes = "\n    ".join(
+        f'<exclude body1="{a}" body2="{b}"/>' for n in names if burgers > 1
+        for i, a in enumerate(parts[n]) for b in parts[n][i + 2:])
     xml = f"""<mujoco model="flipkit_cell">
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
@@ -298,7 +340,7 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.9 0.95" rgb2="0.4 0.5 0.6"
              width="32" height="32"/>
     <mesh name="blade" vertex="{_vec(verts)}"/>
-    <mesh name="burger" vertex="{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>
+    {disc_mesh if strips == 1 else patty.mesh_assets(cell)}
   </asset>
   <worldbody>
     <light pos="0.6 -0.2 2.0" dir="0 0 -1" diffuse="0.8 0.8 0.8"/>
@@ -318,6 +360,7 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
     {pairs}
     {pair("blade", "table", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
+    {excludes}
   </contact>
 </mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
@@ -328,10 +371,12 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
     data = mujoco.MjData(model)
     gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
+    every = [g for n in names for g in parts[n]]
     scene = Scene(model, data, xml, robot,
                   mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
-                  {n: gid(n) for n in ("blade", "grill", *names, "table")}, contact,
-                  tuple(int(model.geom_bodyid[gid(n)]) for n in names))
+                  {n: gid(n) for n in ("blade", "grill", *every, "table")}, contact,
+                  tuple(int(model.geom_bodyid[gid(n)]) for n in names),
+                  tuple(tuple(gid(g) for g in parts[n]) for n in names))
     mujoco.mj_forward(model, data)
     return scene
 
@@ -361,25 +406,40 @@ def _park_position(k: int) -> np.ndarray:
     return np.asarray(PARK_ORIGIN, float) + [PARK_SPACING * k, 0.0, 0.0]
 
 
-def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | None = None
-                 ) -> None:
-    """Put a burger upright at ``xy`` (m) on the grill, at rest; the arm at ``q`` (rad).
+def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | None = None,
+                 heading: float = 0.0) -> None:
+    """Put a burger upright and flat at ``xy`` (m) on the grill, at rest; the arm at ``q`` (rad).
 
     Args:
         scene: The cell. xy: Where the burger's centre lies (m).
         q: Arm configuration (rad) to set too, or ``None``.
         burger: Which burger (index into ``scene.burger_bodies``); it gets its weight back.
         height: Surface it rests on (m); default the grill's.
+        heading: Yaw (rad) of the patty's x axis, along which its strips bend
+            (:func:`flipkit.simulation.patty.scoop_heading`). A rigid patty (one strip) keeps
+            yaw 0 whatever it is: the disc is symmetric, and turning its 32-gon mesh would
+            only move its contact points.
     """
     d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
     if q is not None:
         d.qpos[:ARM_JOINTS] = q
     surface = scene.grill_height if height is None else float(height)
-    d.qpos[scene.qpos_of(burger)] = [*np.asarray(xy, float)[:2], surface + h2, 1, 0, 0, 0]
+    if len(scene.burger_geoms[burger]) == 1:
+        heading = 0.0
+    c, s_ = np.cos(heading / 2), np.sin(heading / 2)
+    d.qpos[scene.qpos_of(burger)] = [*np.asarray(xy, float)[:2], surface + h2, c, 0, 0, s_]
     d.qvel[scene.qvel_of(burger)] = 0.0
-    if scene.model.body_gravcomp[scene.burger_bodies[burger]] != 0.0:
-        scene.model.body_gravcomp[scene.burger_bodies[burger]] = 0.0
+    _rest_hinges(scene, burger, gravcomp=0.0)
     mujoco.mj_forward(scene.model, d)
+
+
+def _rest_hinges(scene: Scene, burger: int, gravcomp: float) -> None:
+    """Burger ``burger``'s strips flat and at rest, each body's gravity compensation set."""
+    qa, va = scene.hinges_of(burger)
+    scene.data.qpos[qa], scene.data.qvel[va] = 0.0, 0.0
+    bodies = scene.patty_bodies(burger)
+    if np.any(scene.model.body_gravcomp[bodies] != gravcomp):
+        scene.model.body_gravcomp[bodies] = gravcomp
 
 
 def park_burger(scene: Scene, burger: int) -> None:
@@ -394,5 +454,5 @@ def park_burger(scene: Scene, burger: int) -> None:
     d = scene.data
     d.qpos[scene.qpos_of(burger)] = [*_park_position(burger), 1, 0, 0, 0]
     d.qvel[scene.qvel_of(burger)] = 0.0
-    scene.model.body_gravcomp[scene.burger_bodies[burger]] = 1.0
+    _rest_hinges(scene, burger, gravcomp=1.0)
     mujoco.mj_forward(scene.model, d)

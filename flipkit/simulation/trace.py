@@ -39,9 +39,10 @@ class BurgerTrace:
         self.ts, self.tg = np.zeros(n, bool), np.zeros(n, bool)
         self.fs, self.fg, self.fbg = np.zeros(n), np.zeros(n), np.zeros(n)
         g = scene.geoms  # recorded geom pair (sorted) -> (touch flags or None, forces)
-        self._slots = {tuple(sorted((g["burger"], g["blade"]))): (self.ts, self.fs),
-                       tuple(sorted((g["burger"], g["grill"]))): (self.tg, self.fg),
-                       tuple(sorted((g["blade"], g["grill"]))): (None, self.fbg)}
+        self._slots = {tuple(sorted((g["blade"], g["grill"]))): (None, self.fbg)}
+        for part in scene.burger_geoms[0]:  # every strip of the patty is the burger
+            self._slots[tuple(sorted((part, g["blade"])))] = (self.ts, self.fs)
+            self._slots[tuple(sorted((part, g["grill"])))] = (self.tg, self.fg)
 
     @property
     def br(self) -> np.ndarray:

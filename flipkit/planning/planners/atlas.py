@@ -31,6 +31,7 @@ import numpy as np
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
+from flipkit.config.physics import SIMULATION_ONLY
 from flipkit.errors import AtlasError
 from flipkit.fileio import InputFileError, check_input
 from flipkit.fileio import replace_with
@@ -59,8 +60,13 @@ def default_path() -> Path:
 
 
 def options_hash(cell: CellConfig, options: SegmentOptions) -> str:
-    """SHA-256 of the cell and transcription options (canonical JSON): equal hashes, same NLPs."""
-    text = json.dumps({"format": FORMAT, "cell": dataclasses.asdict(cell),
+    """SHA-256 of the cell and transcription options (canonical JSON): equal hashes, same NLPs.
+    The simulation's numerical settings (:data:`flipkit.config.physics.SIMULATION_ONLY`) are
+    left out: no NLP depends on them."""
+    record = dataclasses.asdict(cell)
+    for name in SIMULATION_ONLY:
+        record["physics"].pop(name)
+    text = json.dumps({"format": FORMAT, "cell": record,
                        "options": dataclasses.asdict(options)}, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()
 
