@@ -251,3 +251,65 @@ def test_a_sensed_serve_runs_only_a_solved_re_plan_no_longer_than_the_scheduled_
         assert np.allclose(seen[-1], (0.713, -0.184), atol=1e-9)  # true place + the error
         assert r["true_xy"] == pytest.approx([0.71, -0.18], abs=1e-9)
         assert r["planned_xy"] == [0.7, -0.2]
+
+
+def test_a_serve_re_planned_on_the_blade_runs_only_if_it_ends_before_the_next_motion():
+    """blade_replan reads the burger's place in the blade frame (true + the camera's error),
+    and hands back references only for a solved re-plan that, paused for its wall time,
+    still ends before the next motion."""
+    from types import SimpleNamespace as NS
+
+    from flipkit.errors import FlipkitError
+    from flipkit.simulation.cook_blade import blade_replan
+
+    scene = build_scene(burgers=2)
+    scene.data.qpos[:6] = CELL.robot.q_home
+    mujoco.mj_forward(scene.model, scene.data)
+    p_b, R_b = scene.blade_pose()  # the arm at q_home: the blade flat and level
+    place_burger(scene, p_b[:2] + (0.03, 0.01), burger=1, height=p_b[2])  # on the blade
+    true = ((scene.data.xpos[scene.burger_bodies[1]] - p_b) @ R_b)[:2]
+    assert np.hypot(*true) == pytest.approx(np.hypot(0.03, 0.01), abs=1e-6)  # level blade
+    seen = []
+
+    def replan_with(new):
+        def replan(plan, xy):
+            seen.append(np.array(xy))
+            if new is None:
+                raise FlipkitError("off the blade")
+            return new
+        return replan
+
+    refs_kw = {"robot": scene.robot, "physics": CELL.physics, "mode": "position",
+               "command": "compensated", "hold_max": 1.0}
+    cases = ((NS(status="solved", duration=6.0, failure=None), 5.0, "into the next motion"),
+             (NS(status="failed", duration=6.0, failure="infeasible"), np.inf, "failed"),
+             (None, np.inf, "refused"))
+    for new, next_start, why in cases:
+        refs, plan, r = blade_replan(scene, 1, NS(), replan_with(new), (0.002, -0.003),
+                                     t_now=3.0, start=0.0, next_start=next_start, dt=0.001,
+                                     references=refs_kw)
+        assert refs is None and plan is None and not r["replanned"] and why in r["why"]
+        assert np.allclose(seen[-1], true + (0.002, -0.003), atol=1e-9)
+        assert r["on_blade_true"] == pytest.approx(true, abs=1e-5) and r["pause_s"] == 0.0
+    # a burger the scoop left behind is not re-planned for: no call, and the record says so
+    calls = len(seen)
+    refs, plan, r = blade_replan(scene, 1, NS(), replan_with(None), (0.3, 0.0), t_now=3.0,
+                                 start=0.0, next_start=np.inf, dt=0.001, references=refs_kw)
+    assert refs is None and len(seen) == calls and "not on the blade" in r["why"]
+
+
+@pytest.mark.slow
+def test_serves_re_planned_on_the_blade(timeline):
+    """The two-burger cook with sense-plan-act on the grill and on the blade: each serve is
+    re-planned at the end of its carry (its drops leave time for the pause), the arm pauses
+    for the re-plan, and both burgers end upright on the table near their spots."""
+    from flipkit.planning.kitchen.motions import blade_replanner, serve_replanner
+
+    sim = simulate_cook(timeline, sense_serve=serve_replanner(CELL),
+                        sense_blade=blade_replanner())
+    assert [r["serve"] for r in sim.sensed_blade] == ["b1", "b2"]
+    for r in sim.sensed_blade:
+        assert r["replanned"], r["why"]
+        assert r["pause_s"] >= r["wall_s"] - 1e-9 and 0.0 < r["on_blade_true"][0] < 0.08
+    for b in sim.burgers:
+        assert b.flipped and b.serve.upright and b.serve.on_table and b.serve.distance < 0.05

@@ -56,6 +56,7 @@ from flipkit.simulation.cook_judges import BurgerResult, judge_burger
 from flipkit.simulation.cook_record import CookRecorder, Watch
 from flipkit.simulation.execute import HOLD_S
 from flipkit.simulation.modes import MODES, POSITION
+from flipkit.simulation.cook_blade import blade_replan
 from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger, place_burger
 
@@ -91,6 +92,9 @@ class CookSimulation:
         sensed: One record per sensed serve (``sense_serve``): ``burger``, ``true_xy``,
             ``sensed_xy``, ``planned_xy`` (m), ``replanned`` and ``why`` (the planned serve
             ran), ``wall_s`` of the re-plan.
+        sensed_blade: One record per serve sensed on the blade (``sense_blade``):
+            ``serve`` (burger id) and :func:`~flipkit.simulation.cook_blade.blade_replan`'s
+            record.
     """
 
     burgers: list[BurgerResult]
@@ -105,6 +109,7 @@ class CookSimulation:
     scene: Scene
     runs: dict
     sensed: list = field(default_factory=list)
+    sensed_blade: list = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -119,7 +124,8 @@ class CookSimulation:
                                    else round(self.min_distance_m, 6)),
                 "stepped_s": round(self.stepped_s, 3), "skipped_s": round(self.skipped_s, 3),
                 "skip_speed": {k: float(f"{v:.3g}") for k, v in self.skip_speed.items()},
-                "wall_s": round(self.wall_s, 2), "sensed_serves": self.sensed}
+                "wall_s": round(self.wall_s, 2), "sensed_serves": self.sensed,
+                "sensed_on_blade": self.sensed_blade}
 
 
 def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) -> list:
@@ -141,7 +147,8 @@ def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) ->
 def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated",
                   cell: CellConfig | None = None, rate_hz: float = 1000.0,
                   film_fps: float = 0.0, step_idle: bool = False, sense_serve=None,
-                  sensing_sigma: float = SENSING_SIGMA, seed: int = 0) -> CookSimulation:
+                  sense_blade=None, sensing_sigma: float = SENSING_SIGMA,
+                  seed: int = 0) -> CookSimulation:
     """Simulate the whole cook of ``timeline`` (module docstring).
 
     Args:
@@ -157,6 +164,10 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             re-planned for its burger seen at ``xy`` (m) on the grill (module docstring;
             :class:`~flipkit.errors.FlipkitError` for a place it refuses);
             ``None`` (default): every serve runs open loop as planned.
+        sense_blade: ``sense_blade(plan, on_blade) -> plan``: at the end of each serve's
+            carry, place and return home re-planned for where the camera sees the burger on
+            the blade (:func:`~flipkit.planning.planners.serve.replan_serve`;
+            :mod:`flipkit.simulation.cook_blade`); ``None`` (default): none.
         sensing_sigma: The camera's error (m, per axis). seed: Seed of its draws.
 
     Raises:
@@ -200,8 +211,9 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
     now = min(b.burger.t_drop for b in records)
     stepped = skipped = 0.0
     speed = {"burger_m_s": 0.0, "arm_rad_s": 0.0}
-    refs_of, plans, sensed = {}, {}, []
+    refs_of, plans, sensed, sensed_blade = {}, {}, [], []
     rng = np.random.default_rng(seed)
+    rng_blade = np.random.default_rng([seed, 1])  # its own draws: the grill's stay as they are
     for i, mo in enumerate(motions):
         if mo.start > now + 1e-9:  # idle: skipped (module docstring)
             _note_speed(scene, rec, speed)
@@ -213,24 +225,43 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         if sense_serve is not None and mo.kind == "serve":
             plan = plans[i] = sensed_serve(mo, scene, index[mo.burger], sense_serve,
                                             rng.normal(0.0, sensing_sigma, 2), sensed)
-        T = plan.duration
         gap = nxt - mo.end
         hold = gap if step_idle and np.isfinite(gap) else min(max(gap, 0.0), MAX_SETTLE_S)
         refs = plan_references(plan, robot, cell.physics, mode, command, dt, hold)
         refs_of[i] = refs
         d.time = mo.start
+        # the serve's end (s into it) and references as they are now: a re-plan on the blade
+        # moves the one and replaces the other
+        now_run = {"end": plan.duration, "refs": refs, "sensed": mo.kind != "serve"
+                   or sense_blade is None}
 
-        def hook(k, refs, mo=mo):
+        def hook(k, refs, mo=mo, i=i, nxt=nxt, run=now_run):
             apply_events(mo.start + refs.t[k])
+            if run["sensed"] or refs.t[k] < refs.bounds["carry"][1] - 1e-9:
+                return None
+            run["sensed"] = True
+            new_refs, new, note = blade_replan(
+                scene, index[mo.burger], plans[i], sense_blade,
+                rng_blade.normal(0.0, sensing_sigma, 2),
+                t_now=refs.t[k], start=mo.start, next_start=nxt, dt=dt,
+                references={"robot": robot, "physics": cell.physics, "mode": mode,
+                            "command": command, "hold_max": MAX_SETTLE_S})
+            sensed_blade.append({"serve": mo.burger, **note})
+            if new_refs is None:
+                return None
+            plans[i], refs_of[i], run["refs"] = new, new_refs, new_refs
+            run["end"] = max(b[1] for b in new_refs.bounds.values())
+            watches[i].t1 = max(watches[i].t1, mo.start + run["end"] + HOLD_S)
+            return new_refs
 
-        def stop(k, refs, mo=mo, nxt=nxt, T=T):
+        def stop(k, refs, mo=mo, nxt=nxt, run=now_run):
             if mo.start + (k + 1) * dt > nxt + 1e-9:  # the next motion starts
                 return True
-            return (not step_idle and refs.t[k] >= T + HOLD_S - 1e-9
+            return (not step_idle and refs.t[k] >= run["end"] + HOLD_S - 1e-9
                     and _at_rest(scene, rec.active))
 
-        def record(k, q, u, mo=mo, refs=refs):
-            rec.sample(mo.start + refs.t[k], mo.key)
+        def record(k, q, u, mo=mo, run=now_run):
+            rec.sample(mo.start + run["refs"].t[k], mo.key)
 
         _, steps = step_references(scene, control, refs, record, hook, stop)
         stepped += steps * dt
@@ -245,7 +276,8 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         results.append(judge_burger(b, runs.get("flip"), runs.get("serve"), cell.table,
                                     rec.knocked_m[k], rec.contact_s[k]))
     return CookSimulation(results, mode, command, rec.min_distance_m, stepped, skipped, speed,
-                          time.perf_counter() - started, rec.frames, scene, all_runs, sensed)
+                          time.perf_counter() - started, rec.frames, scene, all_runs, sensed,
+                          sensed_blade)
 
 
 def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):

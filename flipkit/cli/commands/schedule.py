@@ -124,8 +124,9 @@ def run(args: argparse.Namespace) -> int:
     sim = None
     if getattr(args, "simulate", False) and timeline.ok:  # a failed schedule is not simulated
         sense = (motions.serve_replanner(cell, args.solver, atlas) if args.sense else None)
+        blade = motions.blade_replanner(args.solver) if args.sense else None
         sim = simulate_cook(timeline, mode=args.mode, film_fps=FILM_FPS if args.film else 0.0,
-                            sense_serve=sense, seed=args.seed)
+                            sense_serve=sense, sense_blade=blade, seed=args.seed)
         doc["simulation"] = sim.to_dict()
     write_json(timeline_path, doc)
     if args.figure:

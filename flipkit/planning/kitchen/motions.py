@@ -20,7 +20,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
-from flipkit.planning.planners.serve import plan_serve, table_spot
+from flipkit.planning.planners.serve import plan_serve, replan_serve, table_spot
 from flipkit.planning.plans.plan_file import segment_span
 
 KINDS = ("flip", "serve")
@@ -213,6 +213,17 @@ def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=
     return replan
 
 
+def blade_replanner(solver: str = "auto") -> Callable:
+    """Sense, plan, act on the blade for a cook's serves: ``replan(plan, on_blade) -> Plan``
+    plans place and return home of the serve ``plan`` again for its burger seen at
+    ``on_blade`` (x, y) (m, blade frame) at the end of the carry
+    (:func:`~flipkit.planning.planners.serve.replan_serve`)."""
+    def replan(plan, on_blade):
+        return replan_serve(plan, on_blade, solver=solver)
+
+    return replan
+
+
 def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPlanner]:
     """``planners`` that plan each distinct motion once: a request with the same kind, burger,
     location, table spot, landing spot and start configuration (to 1e-9) returns the first plan (the same
@@ -231,5 +242,5 @@ def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPl
 
 
 __all__ = ["KINDS", "MissingPlannerError", "MotionJob", "MotionPlanner", "PlannedMotion",
-           "cached_planners", "default_planners", "flip_planner", "from_plan", "refused",
+           "blade_replanner", "cached_planners", "default_planners", "flip_planner", "from_plan", "refused",
            "serve_planner"]

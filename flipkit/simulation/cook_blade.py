@@ -1,0 +1,81 @@
+"""Sense, plan, act on the blade during a cook's serve: at the end of the carry the camera sees
+where the burger lies on the blade, and place and return home are planned again for it.
+
+The carry ends at rest with the blade flat above the table (as
+:func:`~flipkit.planning.planners.serve.replan_serve` expects), so the cell measures the
+burger there, holds the arm at rest while the re-plan runs (the pause is whole control steps
+of its measured wall time), then runs the re-planned rest of the serve. A cook cannot stretch
+a serve into the next motion: the re-plan is used only if it is solved and the serve, paused
+and re-planned, still ends before the next motion starts; otherwise the scheduled serve runs
+on and the record says why.
+"""
+
+from __future__ import annotations
+
+import time
+
+import mujoco
+import numpy as np
+
+from flipkit.errors import FlipkitError
+from flipkit.simulation.control import plan_references
+from flipkit.simulation.scene import Scene
+
+
+def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float,
+                 start: float, next_start: float, dt: float, references: dict) -> tuple:
+    """At cook time ``start + t_now`` (the carry's end): the re-planned serve's references, or
+    ``None``, and the record of the sense.
+
+    Args:
+        scene: The cook's scene. burger: Index of the carried burger. plan: The serve running.
+        replan: ``replan(plan, on_blade) -> Plan`` (e.g. ``replan_serve``); a
+            :class:`~flipkit.errors.FlipkitError` is a refusal.
+        error: The camera's error (m, (2,)) added to the true place on the blade.
+        t_now: Time (s) into the serve. start, next_start: The serve's and the next
+            motion's start (s, cook clock; ``inf`` for none). dt: Control period (s).
+        references: ``plan_references``'s other arguments: ``robot``, ``physics``, ``mode``,
+            ``command``, ``hold_max`` (the longest hold after the serve, s).
+
+    Returns:
+        ``(refs or None, new plan or None, record)``; ``record`` holds ``burger`` (index),
+        ``on_blade_true``, ``on_blade_sensed`` (m), ``replanned``, ``why``, ``wall_s`` and
+        ``pause_s``.
+    """
+    m, d = scene.model, scene.data
+    mujoco.mj_kinematics(m, d)
+    p_b, R_b = scene.blade_pose()
+    true = ((d.xpos[scene.burger_bodies[burger]] - p_b) @ R_b)[:2]
+    sensed = true + np.asarray(error, float)
+    sp = scene.robot.cell.spatula
+    t0 = time.perf_counter()
+    if np.any(np.abs(sensed) > (sp.length / 2, sp.width / 2)):  # the scoop missed it
+        new, why = None, (f"the burger is not on the blade after the carry: seen at "
+                          f"({sensed[0]:+.3f}, {sensed[1]:+.3f}) m in the blade frame")
+    else:
+        try:
+            new = replan(plan, sensed)
+            why = None if new.status == "solved" else ("the re-plan failed: "
+                                                         + (new.failure or new.status))
+        except FlipkitError as exc:
+            new, why = None, f"the re-plan was refused: {exc}"
+    wall = time.perf_counter() - t0
+    pause = dt * np.ceil(wall / dt - 1e-9)
+    refs = None
+    if why is None:
+        end = start + pause + new.duration
+        if end > next_start + 1e-9:
+            why = f"the re-planned serve would end {end - next_start:.2f} s into the next motion"
+        else:
+            r = references
+            hold = min(max(next_start - end, 0.0), r["hold_max"])
+            refs = plan_references(new, r["robot"], r["physics"], r["mode"], r["command"], dt,
+                                   hold, t_now, pause)
+    record = {"burger": int(burger), "on_blade_true": [round(float(v), 5) for v in true],
+              "on_blade_sensed": [round(float(v), 5) for v in sensed],
+              "replanned": why is None, "why": why, "wall_s": round(wall, 3),
+              "pause_s": round(float(pause), 3) if why is None else 0.0}
+    return refs, (new if why is None else None), record
+
+
+__all__ = ["blade_replan"]
