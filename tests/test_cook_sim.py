@@ -230,7 +230,7 @@ def test_a_sensed_serve_runs_only_a_solved_re_plan_no_longer_than_the_scheduled_
     scene = build_scene(burgers=2)
     place_burger(scene, (0.71, -0.18), burger=1)
     scheduled = plan(6.0)
-    mo = NS(burger="b2", plan=scheduled)
+    mo = NS(burger="b2", plan=scheduled, start=10.0, end=16.0)  # its slot: its plan
     seen = []
 
     def replan_with(new):
@@ -251,6 +251,10 @@ def test_a_sensed_serve_runs_only_a_solved_re_plan_no_longer_than_the_scheduled_
         assert np.allclose(seen[-1], (0.713, -0.184), atol=1e-9)  # true place + the error
         assert r["true_xy"] == pytest.approx([0.71, -0.18], abs=1e-9)
         assert r["planned_xy"] == [0.7, -0.2]
+    # a slot longer than the plan (a sense pause scheduled beyond it) takes a longer re-plan
+    longer, records = plan(6.4), []
+    roomy = NS(burger="b2", plan=scheduled, start=10.0, end=16.5)
+    assert sensed_serve(roomy, scene, 1, replan_with(longer), (0.0, 0.0), records) is longer
 
 
 def test_a_serve_re_planned_on_the_blade_runs_only_if_it_ends_before_the_next_motion():

@@ -282,13 +282,15 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
 
 def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
     """The serve plan to run for motion ``mo``: re-planned for burger ``k`` where the camera
-    sees it (true place + ``error``), if verified and no longer than the planned one."""
+    sees it (true place + ``error``), if verified and no longer than the serve's slot in the
+    schedule (its plan's duration, and any time the schedule gave it beyond, such as
+    :data:`~flipkit.planning.kitchen.motions.SENSE_PAUSE_S`)."""
     true_xy = np.array(scene.data.qpos[scene.qpos_of(k)][:2], float)
     xy = true_xy + np.asarray(error, float)
     t0 = time.perf_counter()
     try:
         new = sense_serve(mo, xy)
-        why = _unusable(new, mo.plan.duration)
+        why = _unusable(new, mo.end - mo.start)
     except FlipkitError as exc:  # a place the planner refuses, with its reason
         new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0

@@ -72,6 +72,8 @@ def run(args: argparse.Namespace) -> int:
         order = check_cook(burgers, cell)
         spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
         planners = _planners(order, kinds, cell, args, atlas, spots, executor)
+        if getattr(args, "simulate", False) and args.sense:  # time for the blade re-plans
+            planners = motions.with_sense_pause(planners)
         if executor is None:
             planners = motions.cached_planners(planners)
         common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
