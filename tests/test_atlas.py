@@ -125,6 +125,18 @@ def test_the_shipped_atlas_serves_the_default_options():
     assert plan.status == "solved"
 
 
+def test_the_atlas_hash_leaves_out_the_simulations_numerical_settings():
+    """No NLP depends on how many strips the simulated patty has; it does on the grill's
+    friction (the scoop model)."""
+    from dataclasses import replace
+
+    cell, opts = CellConfig(), SegmentOptions()
+    strips = replace(cell, physics=replace(cell.physics, burger_strips=1))
+    grill = replace(cell, physics=replace(cell.physics, mu_grill=0.4))
+    assert options_hash(strips, opts) == options_hash(cell, opts)
+    assert options_hash(grill, opts) != options_hash(cell, opts)
+
+
 def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch):
     """The serve shares go to burger, scoop and pickup with the flip: the atlas seeds those
     (at the entry itself, the stored solution exactly) and no other segment; the serve is

@@ -67,6 +67,19 @@ def test_the_sensitivity_nominal_is_the_table1_position_open_loop_run():
     assert trial_key(table1[0])["perturbations"] == asdict(Perturbations())
 
 
+def test_a_changed_simulated_physics_is_not_served_from_the_cache(tmp_path, monkeypatch):
+    """Trial keys carry the digest of the simulated cell's default physics: a new patty model
+    (another default strip count) recomputes every trial."""
+    import flipkit.experiments.trial_jobs as tj
+    from flipkit.config import PhysicsConfig
+
+    jobs = trial_jobs(PLAN, 2, 0, Perturbations(), mode="position")
+    assert run_trials(jobs, tmp_path)[1] == 2
+    assert run_trials(jobs, tmp_path)[1] == 0
+    monkeypatch.setattr(tj, "PhysicsConfig", lambda: PhysicsConfig(burger_strips=1))
+    assert run_trials(jobs, tmp_path)[1] == 2
+
+
 def test_plans_are_cached_by_location_and_solver(tmp_path, monkeypatch):
     planned = []
 
