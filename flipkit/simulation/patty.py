@@ -6,9 +6,9 @@ q L⁴ / (8 E I) ≈ 5 mm over 5 cm (q its weight per length), five times the bl
 thickness. So when the blade's tip lifts the rim, a rigid disc would pivot on its far rim
 and put half its weight on the blade, and the blade's friction would drag it along whenever
 the burger–blade friction exceeds the grill's. A real patty lifts only a strip near the rim
-(a heavy beam lifted by δ at its end leaves the floor over (72 E I δ / q)^¼ ≈ 5 cm and
-carries a third of that length's weight at the end), and the blade's share grows as the
-blade slides under it.
+(a heavy beam lifted by δ = 1 mm at its end, its curvature continuous where it meets the
+floor, leaves the floor over (24 E I δ / q)^¼ ≈ 4 cm and carries half that length's weight
+at the end), and the blade's share grows as the blade slides under it.
 
 The model is Hencky's bar chain: the patty is cut into ``burger_strips`` equal strips
 along its x axis (the simulation lays x along the scoop, :func:`scoop_heading`); each strip
@@ -136,14 +136,14 @@ def _origin(s: Strip) -> float:
     return 0.0 if s.hinge_x is None else s.hinge_x
 
 
-def mesh_assets(cell: CellConfig) -> str:
-    """The MJCF ``<mesh>`` assets of the strips (``burger_strip_j``), each in its body's frame;
-    empty for a rigid patty (the scene's own disc mesh)."""
+def mesh_assets(cell: CellConfig, ss: list[Strip]) -> str:
+    """The MJCF ``<mesh>`` assets of the strips ``ss`` (``burger_strip_j``, of :func:`strips`),
+    each in its body's frame; empty for a rigid patty (the scene's own disc mesh)."""
     bg, ph = cell.burger, cell.physics
     if ph.burger_strips == 1:
         return ""
     out = []
-    for s in strips(cell):
+    for s in ss:
         v = strip_vertices(bg.diameter / 2, bg.thickness, ph.burger_edge_radius, s.x0, s.x1)
         out.append(f'<mesh name="burger_strip_{s.index}" vertex="{_vec(v - [_origin(s), 0, 0])}"/>')
     return "\n    ".join(out)
@@ -155,12 +155,11 @@ def strip_geom_name(burger: str, s: Strip, n: int) -> str:
     return burger if s.index == n // 2 else f"{burger}_s{s.index}"
 
 
-def body_xml(name: str, pos: str, gravcomp: str, cell: CellConfig, mass: float,
+def body_xml(name: str, pos: str, gravcomp: str, cell: CellConfig, ss: list[Strip],
              contact: str) -> str:
-    """The MJCF body tree of a hinged-strip patty named ``name`` at ``pos`` (its free joint on
-    the middle strip, two chains of hinged strips), each strip geom with the attributes
-    ``contact`` (collision bits, friction, softness)."""
-    ss = strips(cell, mass)
+    """The MJCF body tree of a hinged-strip patty named ``name`` at ``pos`` with the strips
+    ``ss`` (:func:`strips`; its free joint on the middle strip, two chains of hinged strips),
+    each strip geom with the attributes ``contact`` (collision bits, friction, softness)."""
     n, mid, h2 = len(ss), len(ss) // 2, cell.burger.thickness / 2
 
     def part(s: Strip) -> str:

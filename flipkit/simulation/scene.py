@@ -108,13 +108,7 @@ def burger_vertices(diameter: float, thickness: float, edge_radius: float,
                     n_around: int = 32, n_arc: int = 4) -> np.ndarray:
     """Vertices (m, burger frame, axis z) of a disc with rounded rims: flat faces at
     z = ±thickness/2, rims of radius ``edge_radius`` (clipped to half the thickness)."""
-    r, h2 = diameter / 2, thickness / 2
-    rho = min(edge_radius, h2)
-    prof = []  # (radius, z) around the rim, top to bottom
-    for zc, sgn in ((h2 - rho, 1.0), (-h2 + rho, -1.0)):
-        for a in np.linspace(0.0, np.pi / 2, n_arc + 1):
-            prof.append((r - rho + rho * np.sin(a), zc + sgn * rho * np.cos(a)))
-    prof = np.unique(np.round(prof, 12), axis=0)
+    prof = patty.disc_profile(diameter / 2, thickness, edge_radius, n_arc)
     phi = 2 * np.pi * np.arange(n_around) / n_around
     return np.array([(rr * np.cos(f), rr * np.sin(f), z) for rr, z in prof for f in phi])
 
@@ -294,13 +288,14 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     soft = (tau_b, ph.burger_dampratio)
 
     strips = ph.burger_strips
+    parts_of = patty.strips(cell, mass) if strips > 1 else []  # computed once per scene
     collide = ('contype="0" conaffinity="0"' if burgers == 1 else
                f'contype="{BURGER_BIT}" conaffinity="{BURGER_BIT}" condim="3" '
                f'friction="{ph.mu_grill} 0.001 0.0001" solref="{soft[0]:.6g} {soft[1]:.6g}"')
 
     def body(name, pos, gravcomp):
         if strips > 1:
-            return patty.body_xml(name, pos, gravcomp, cell, mass, collide)
+            return patty.body_xml(name, pos, gravcomp, cell, parts_of, collide)
         return (f'<body name="{name}" pos="{pos}"{gravcomp}>\n'
                 f'      <freejoint name="{name}"/>\n'
                 f'      <inertial pos="0 0 0" mass="{mass:.9g}" '
@@ -318,8 +313,8 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                                for k, n in enumerate(names))
     disc_mesh = (f'<mesh name="burger" vertex="'
                  f'{_vec(burger_vertices(bg.diameter, bg.thickness, ph.burger_edge_radius))}"/>')
-    parts = {n: [patty.strip_geom_name(n, st, strips) for st in patty.strips(cell, mass)]
-             if strips > 1 else [n] for n in names}
+    parts = {n: [patty.strip_geom_name(n, st, strips) for st in parts_of] if strips > 1
+             else [n] for n in names}
     pairs = "\n    ".join(
         line for n in names for g in parts[n]
         for line in (pair(g, "blade", mu, soft), pair(g, "grill", ph.mu_grill, soft),
@@ -340,7 +335,7 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     <texture name="sky" type="skybox" builtin="gradient" rgb1="0.85 0.9 0.95" rgb2="0.4 0.5 0.6"
              width="32" height="32"/>
     <mesh name="blade" vertex="{_vec(verts)}"/>
-    {disc_mesh if strips == 1 else patty.mesh_assets(cell)}
+    {disc_mesh if strips == 1 else patty.mesh_assets(cell, parts_of)}
   </asset>
   <worldbody>
     <light pos="0.6 -0.2 2.0" dir="0 0 -1" diffuse="0.8 0.8 0.8"/>
