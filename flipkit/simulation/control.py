@@ -30,6 +30,11 @@ def paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
     return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
 
 
+def pause_steps(wall_s: float, dt: float) -> float:
+    """The arm's pause (s) for a re-plan of ``wall_s`` s: whole control steps of ``dt``."""
+    return dt * np.ceil(wall_s / dt - 1e-9)
+
+
 def desired(plan, t: np.ndarray):
     """Plan's desired q, q̇ (per-segment cubic Hermite) and u (per-segment linear) at times t
     (s, from 0); after the last segment the final q with q̇ = 0 and the final u."""
@@ -170,5 +175,5 @@ def step_references(scene: Scene, control: ArmController, refs: References,
     return refs, len(refs.t)
 
 
-__all__ = ["ArmController", "References", "desired", "paused", "plan_references",
+__all__ = ["ArmController", "References", "desired", "pause_steps", "paused", "plan_references",
            "step_references"]

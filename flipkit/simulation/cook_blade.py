@@ -14,11 +14,10 @@ from __future__ import annotations
 
 import time
 
-import mujoco
 import numpy as np
 
 from flipkit.errors import FlipkitError
-from flipkit.simulation.control import plan_references
+from flipkit.simulation.control import pause_steps, plan_references
 from flipkit.simulation.scene import Scene
 
 
@@ -42,10 +41,7 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
         ``on_blade_true``, ``on_blade_sensed`` (m), ``replanned``, ``why``, ``wall_s`` and
         ``pause_s``.
     """
-    m, d = scene.model, scene.data
-    mujoco.mj_kinematics(m, d)
-    p_b, R_b = scene.blade_pose()
-    true = ((d.xpos[scene.burger_bodies[burger]] - p_b) @ R_b)[:2]
+    true = scene.in_blade_frame(scene.burger_bodies[burger])[:2]
     sensed = true + np.asarray(error, float)
     sp = scene.robot.cell.spatula
     t0 = time.perf_counter()
@@ -60,7 +56,7 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
         except FlipkitError as exc:
             new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0
-    pause = dt * np.ceil(wall / dt - 1e-9)
+    pause = pause_steps(wall, dt)
     refs = None
     if why is None:
         end = start + pause + new.duration

@@ -37,8 +37,8 @@ from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
-from flipkit.simulation.control import (ArmController, References, plan_references,
-                                        step_references)
+from flipkit.simulation.control import (ArmController, References, pause_steps,
+                                        plan_references, step_references)
 from flipkit.simulation.modes import FEEDFORWARD, MODES
 from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
@@ -202,9 +202,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         t = refs.t
         if not (t[k] >= t_sense - 1e-9 and sense["sensed"] is None):
             return None
-        mujoco.mj_kinematics(m, d)
-        p_b, R_b = scene.blade_pose()
-        rel = (d.xpos[burger_body] - p_b) @ R_b
+        rel = scene.in_blade_frame(burger_body)
         sensed = sense["sensed"] = rel[:2] + [d_["sense_dx_m"], d_["sense_dy_m"]]  # camera error
         if np.any(np.abs(sensed) > half) or not 0.0 < rel[2] < bg.thickness + thick:
             # not on the blade (the scoop missed or pushed it off): nothing to re-plan for;
@@ -226,7 +224,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         sense["plan"] = new
         # The arm held at rest while the replan ran: the rest of the run starts after that
         # pause, a whole number of control steps long.
-        pause = dt * np.ceil(sense["time"] / dt - 1e-9)
+        pause = pause_steps(sense["time"], dt)
         new_refs = plan_references(new, robot, ph, mode, command, dt, hold, t[k], pause,
                                    servo=servo)
         if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):

@@ -171,6 +171,13 @@ class Scene:
         return (self.data.site_xpos[self.blade_site].copy(),
                 self.data.site_xmat[self.blade_site].reshape(3, 3).copy())
 
+    def in_blade_frame(self, body: int) -> np.ndarray:
+        """Position (m) of ``body`` (a burger's root) in the spatula frame, from the current
+        qpos (runs mj_kinematics): what a camera measures of the burger on the blade."""
+        mujoco.mj_kinematics(self.model, self.data)
+        p_b, R_b = self.blade_pose()
+        return (self.data.xpos[body] - p_b) @ R_b
+
     def qpos_of(self, k: int) -> slice:
         """Slice of burger k's free joint (position, quaternion) in qpos."""
         a = int(self.model.jnt_qposadr[self.model.body_jntadr[self.burger_bodies[k]]])
