@@ -17,6 +17,7 @@ from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.simulation.modes import FEEDFORWARD
+from flipkit.simulation.scene import NOSLIP_ITERATIONS, SLEEP_TOLERANCE
 
 TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
 HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
@@ -51,11 +52,13 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
 def trial_key(job: dict) -> dict:
     """Cache key of a trial job: the plan's digest instead of its text, the contingency
     record's (:mod:`flipkit.experiments.contingent`) instead of it, and the digest of the
-    simulated cell's default physics (a changed model, such as the patty's strips, is not
-    served from the cache)."""
+    simulated cell's default physics and of the scene's numerical settings (a changed model,
+    such as the patty's strips or a burger that sleeps at rest, is not served from the
+    cache)."""
     key = {**{k: v for k, v in job.items() if k != "plan_text"},
            "plan": stable_hash(job["plan_text"]),
-           "simulated_physics": stable_hash(asdict(PhysicsConfig()))}
+           "simulated_physics": stable_hash(asdict(PhysicsConfig())),
+           "scene": {"noslip_iterations": NOSLIP_ITERATIONS, "sleep_tolerance": SLEEP_TOLERANCE}}
     if "contingencies" in job:
         key["contingencies"] = stable_hash(job["contingencies"])
     return key

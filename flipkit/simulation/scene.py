@@ -48,6 +48,17 @@ the cook simulation, not relied on. All n start *parked* (:func:`park_burger`): 
 (``gravcomp`` 1), so a parked burger stays exactly where it is; :func:`place_burger` with
 ``burger=k`` puts one at rest on the grill (or table) and gives it back its weight. With one
 burger (the default) the scene is unchanged: body and geom ``burger``, on the grill.
+
+Sleeping (one burger). A burger lying still on the grill costs a step as much as one being
+scooped: its five strips keep about twenty contacts. A single-burger scene therefore lets
+MuJoCo put a burger at rest to sleep (``<flag sleep="enable"/>``): a tree whose speed stays
+below :data:`SLEEP_TOLERANCE` for MuJoCo's ``mjMINAWAKE`` steps is frozen and skipped until an
+awake body touches it (the blade arriving), when it is simulated again. The arm never sleeps
+(``sleep="never"``). A frozen burger keeps the contacts it fell asleep with: the record of a
+run (:class:`~flipkit.simulation.trace.BurgerTrace`) carries them on, so the judges still see
+it lying on the grill. A step costs about half as much (27 µs against 52 µs over a Table I
+flip). Scenes of several burgers do not sleep: the cook moves burgers by writing their state (:func:`place_burger`,
+:func:`park_burger`), which does not wake a sleeping tree.
 """
 
 from __future__ import annotations
@@ -63,6 +74,9 @@ from flipkit.model.robot import Robot
 from flipkit.simulation import patty
 
 NOSLIP_ITERATIONS = 10  # post-solve iterations: static friction holds without creep
+# m/s (MuJoCo's default, speeds weighted by each dof's length): a tree slower than this for
+# mjMINAWAKE steps sleeps, in a scene that sleeps (module docstring)
+SLEEP_TOLERANCE = 1e-3
 ARM_JOINTS = 6
 LINK_RADIUS = 0.045  # m, capsule visuals
 # Constant impedance of the blade-grill contact (module docstring): small, so that the contact
@@ -131,6 +145,7 @@ class Scene:
             is the burger's.
         burger_geoms: Per burger, the geom ids of all its strips, in order along the patty's
             x; ``geoms`` names them too (``burger_s0`` …).
+        sleeps: Whether MuJoCo puts a burger at rest to sleep (module docstring).
     """
 
     model: mujoco.MjModel
@@ -143,6 +158,7 @@ class Scene:
     blade_contact: dict
     burger_bodies: tuple = ()
     burger_geoms: tuple = ()
+    sleeps: bool = False
 
     @property
     def burger_qpos(self) -> slice:
@@ -157,7 +173,8 @@ class Scene:
 
         The normal force is the contact's first ``efc_force`` row: with the scene's elliptic
         cones that is what ``mj_contactForce`` returns, read without a call per contact; a
-        contact without constraint rows (``efc_address`` −1) has none.
+        contact without constraint rows (``efc_address`` −1) has none. A sleeping burger (a
+        scene that sleeps) has none: MuJoCo skips it, and it lies as it fell asleep.
         """
         d = self.data
         if d.ncon == 0:
@@ -225,8 +242,10 @@ def _arm_bodies(robot: Robot, sp_xml: str) -> str:
         link = "" if np.linalg.norm(child) < 1e-6 else (
             f'<geom type="capsule" fromto="0 0 0 {_vec(child)}" size="{LINK_RADIUS}" '
             f'contype="0" conaffinity="0" rgba="0.55 0.6 0.65 1" mass="0"/>')
+        never = ' sleep="never"' if j == 1 else ""  # the arm is driven: it never sleeps
         opened.append(
-            f'<body name="{m.names[j]}" pos="{_vec(M.translation)}" quat="{_quat(M.rotation)}">'
+            f'<body name="{m.names[j]}" pos="{_vec(M.translation)}" quat="{_quat(M.rotation)}"'
+            f'{never}>'
             f'<joint name="{m.names[j]}" type="hinge" axis="{_vec(axis)}" '
             f'limited="false"/>'
             f'<inertial pos="{_vec(I.lever)}" mass="{I.mass:.12g}" fullinertia="{fi}"/>{link}')
@@ -236,7 +255,7 @@ def _arm_bodies(robot: Robot, sp_xml: str) -> str:
 
 def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                 grill_offset: float = 0.0, burger_xy=None, mu: float | None = None,
-                mass: float | None = None, burgers: int = 1) -> Scene:
+                mass: float | None = None, burgers: int = 1, sleep: bool | None = None) -> Scene:
     """Compile the cell.
 
     Args:
@@ -250,14 +269,21 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
         mass: Burger mass (kg); default ``cell.burger.mass``.
         burgers: Number of burgers, ≥ 1. One: the burger lies at ``burger_xy``. Several:
             all start parked (module docstring); ``burger_xy`` must be ``None``.
+        sleep: Let a burger at rest sleep (module docstring); default with one burger only.
 
     Raises:
-        ConfigError: ``burgers`` not a positive integer, or ``burger_xy`` with several.
+        ConfigError: ``burgers`` not a positive integer, ``burger_xy`` with several, or
+            ``sleep`` with several.
     """
     if isinstance(burgers, bool) or not isinstance(burgers, (int, np.integer)) or burgers < 1:
         raise ConfigError(f"burgers must be a positive integer, got {burgers!r}")
     if burgers > 1 and burger_xy is not None:
         raise ConfigError("burger_xy places the single burger; several start parked")
+    if sleep is None:
+        sleep = burgers == 1
+    if sleep and burgers > 1:
+        raise ConfigError("a scene of several burgers cannot sleep: the cook moves burgers by "
+                          "writing their state, which does not wake them")
     robot = robot or Robot(cell, with_burger=False)
     cell = cell or robot.cell
     ph, sp, bg, gr, tb = cell.physics, cell.spatula, cell.burger, cell.grill, cell.table
@@ -334,7 +360,8 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     xml = f"""<mujoco model="flipkit_cell">
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{ph.timestep}" gravity="{_vec(cell.gravity)}" cone="elliptic"
-          noslip_iterations="{NOSLIP_ITERATIONS}"/>
+          noslip_iterations="{NOSLIP_ITERATIONS}" sleep_tolerance="{SLEEP_TOLERANCE}">
+    <flag sleep="{'enable' if sleep else 'disable'}"/></option>
   <visual><global offwidth="1280" offheight="960"/><quality shadowsize="2048"/>
     <headlight ambient="0.35 0.35 0.35" diffuse="0.5 0.5 0.5"/><rgba haze="0.85 0.88 0.92 1"/>
   </visual>
@@ -378,7 +405,7 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                   mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "spatula"), h_g,
                   {n: gid(n) for n in ("blade", "grill", *every, "table")}, contact,
                   tuple(int(model.geom_bodyid[gid(n)]) for n in names),
-                  tuple(tuple(gid(g) for g in parts[n]) for n in names))
+                  tuple(tuple(gid(g) for g in parts[n]) for n in names), bool(sleep))
     mujoco.mj_forward(model, data)
     return scene
 
@@ -422,6 +449,7 @@ def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | N
             yaw 0 whatever it is: the disc is symmetric, and turning its 32-gon mesh would
             only move its contact points.
     """
+    _awake(scene, burger)
     d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
     if q is not None:
         d.qpos[:ARM_JOINTS] = q
@@ -433,6 +461,14 @@ def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | N
     d.qvel[scene.qvel_of(burger)] = 0.0
     _rest_hinges(scene, burger, gravcomp=0.0)
     mujoco.mj_forward(scene.model, d)
+
+
+def _awake(scene: Scene, burger: int) -> None:
+    """Raise :class:`ConfigError` if burger ``burger`` sleeps: writing its state would not wake
+    it, and it would hang where it was put (module docstring)."""
+    if scene.sleeps and not scene.data.body_awake[scene.burger_bodies[burger]]:
+        raise ConfigError("cannot place a sleeping burger: build the scene with sleep=False "
+                          "to move burgers during a run")
 
 
 def _rest_hinges(scene: Scene, burger: int, gravcomp: float) -> None:

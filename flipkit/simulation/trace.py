@@ -38,11 +38,17 @@ class BurgerTrace:
         self._br, self._sr = np.zeros((n, 9)), np.zeros((n, 9))
         self.ts, self.tg = np.zeros(n, bool), np.zeros(n, bool)
         self.fs, self.fg, self.fbg = np.zeros(n), np.zeros(n), np.zeros(n)
-        g = scene.geoms  # recorded geom pair (sorted) -> (touch flags or None, forces)
-        self._slots = {tuple(sorted((g["blade"], g["grill"]))): (None, self.fbg)}
-        for part in scene.burger_geoms[0]:  # every strip of the patty is the burger
-            self._slots[tuple(sorted((part, g["blade"])))] = (self.ts, self.fs)
-            self._slots[tuple(sorted((part, g["grill"])))] = (self.tg, self.fg)
+        g, ngeom = scene.geoms, scene.model.ngeom
+        # the slot of each geom pair: 0 not recorded, 1 blade-grill, 2 burger-blade,
+        # 3 burger-grill (every strip of the patty is the burger)
+        self._slot = np.zeros((ngeom, ngeom), np.intp)
+        pairs = [(g["blade"], g["grill"], 1)]
+        for part in scene.burger_geoms[0]:
+            pairs += [(part, g["blade"], 2), (part, g["grill"], 3)]
+        for a, b, slot in pairs:
+            self._slot[a, b] = self._slot[b, a] = slot
+        self._asleep = (lambda: not self.data.body_awake[self.burger_body]) if scene.sleeps \
+            else (lambda: False)
 
     @property
     def br(self) -> np.ndarray:
@@ -53,17 +59,28 @@ class BurgerTrace:
         return self._sr.reshape(-1, 3, 3)
 
     def __call__(self, k: int) -> None:
-        """Record sample k from the scene's current data; forces summed in contact order."""
+        """Record sample k from the scene's current data; forces summed in contact order.
+
+        A sleeping burger (:class:`~flipkit.simulation.scene.Scene` ``sleeps``) is not in
+        MuJoCo's contact list: it lies as it fell asleep, so its flags and forces are those
+        of sample k − 1.
+        """
         d, b, s = self.data, self.burger_body, self.site
         self.sp[k], self._sr[k] = d.site_xpos[s], d.site_xmat[s]
         self.bp[k], self._br[k] = d.xpos[b], d.xmat[b]
-        for a, c, force in self.scene.contacts():
-            slot = self._slots.get((a, c) if a < c else (c, a))
-            if slot is not None:
-                touch, forces = slot
-                if touch is not None:
-                    touch[k] = True
-                forces[k] += force
+        if d.ncon:
+            con, efc = d.contact, d.efc_force
+            slot = self._slot[con.geom[:, 0], con.geom[:, 1]]
+            adr = con.efc_address
+            force = efc[adr] if efc.size else np.zeros(len(adr))  # normal force: first row
+            force[adr < 0] = 0.0  # a contact without constraint rows has none
+            sums = np.bincount(slot, weights=force, minlength=4)
+            seen = np.bincount(slot, minlength=4)
+            self.fbg[k], self.fs[k], self.fg[k] = sums[1:]
+            self.ts[k], self.tg[k] = seen[2] > 0, seen[3] > 0
+        if k and self._asleep():
+            self.ts[k], self.tg[k] = self.ts[k - 1], self.tg[k - 1]
+            self.fs[k], self.fg[k] = self.fs[k - 1], self.fg[k - 1]
 
     def trimmed(self, n: int) -> "BurgerTrace":
         """This trace cut to its first n samples (views, not copies)."""
