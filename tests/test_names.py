@@ -33,3 +33,15 @@ def test_execution_modes():
 
     assert MODES == (FEEDFORWARD, POSITION) == ("feedforward", "position")
     assert execute.MODES is MODES and CLI_MODES == MODES
+
+
+def test_the_command_line_offers_every_named_location_set():
+    from flipkit.cli.common import LOCATION_SET_CHOICES
+    from flipkit.config import LOCATION_SETS, MORE_LOCATIONS, TABLE1_LOCATIONS, CellConfig
+    from flipkit.behaviors.targets import check_location
+
+    assert LOCATION_SET_CHOICES == tuple(LOCATION_SETS)
+    assert LOCATION_SETS["table1"] is TABLE1_LOCATIONS
+    assert not set(MORE_LOCATIONS) & set(TABLE1_LOCATIONS)  # "more" is beyond Table I
+    for loc in MORE_LOCATIONS:
+        check_location(CellConfig(), loc)  # on the grill

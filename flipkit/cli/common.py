@@ -15,6 +15,7 @@ from flipkit.fileio import write_text
 from flipkit.planning.plans.plan_doc import read_plan_doc
 
 SOLVER_CHOICES = ("sqp", "ipopt", "auto")
+LOCATION_SET_CHOICES = ("table1", "more")  # flipkit.config.LOCATION_SETS
 
 
 def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import (MAX_GRID, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
-                                check_int, deferred)
+from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_GRID, MAX_WORKERS, SOLVER_CHOICES,
+                                add_sweep_arguments, check_int, deferred)
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 
@@ -27,8 +27,9 @@ def register(subparsers) -> None:
                     "+ IK baseline; write per-location status, failure reason and wall "
                     "times, and a summary (success fractions, IK failure reasons, median "
                     "time per subbehaviour).")
-    parser.add_argument("--locations", choices=("table1",),
-                        help="a named location set: table1 = the paper's ten Table I points")
+    parser.add_argument("--locations", choices=LOCATION_SET_CHOICES,
+                        help="a named location set: table1 = the paper's ten Table I points, "
+                             "more = five others over the grill")
     parser.add_argument("--grid", nargs=2, type=int, metavar=("NX", "NY"),
                         help="an NX x NY grid of cell centres over the grill area, each in [1, 50]")
     parser.add_argument("--burger", nargs=3, type=float, action="append", metavar=("X", "Y", "Z"),

@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import (MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES, add_sweep_arguments,
-                                check_float, check_int, deferred, precheck_plan)
+from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES,
+                                add_sweep_arguments, check_float, check_int, deferred,
+                                precheck_plan)
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 
@@ -32,9 +33,9 @@ def register(subparsers) -> None:
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--plan", metavar="PLAN.json",
                       help="a solved flip or serve plan file (serve: judged on the table)")
-    what.add_argument("--locations", choices=("table1",),
-                      help="plan every location of a named set (table1: the paper's ten), "
-                           "then simulate")
+    what.add_argument("--locations", choices=LOCATION_SET_CHOICES,
+                      help="plan every location of a named set (table1: the paper's ten; "
+                           "more: five others over the grill), then simulate")
     parser.add_argument("--trials", type=int, required=True, metavar="K",
                         help=f"simulated trials per location, in [1, {MAX_TRIALS}]")
     parser.add_argument("--seed", type=int, default=0, metavar="S",

@@ -248,3 +248,10 @@ TABLE1_LOCATIONS = (  # Table I of the paper: p^b (m), robot base frame (shared/
     (0.68, -0.31, 0.072), (0.69, -0.16, 0.072), (0.73, -0.13, 0.072), (0.73, -0.18, 0.072),
     (0.75, -0.45, 0.072), (0.84, 0.12, 0.072),
 )
+MORE_LOCATIONS = (  # five places off Table I, spread over the grill's reach (robot base frame)
+    (0.62, -0.05, 0.072), (0.70, 0.05, 0.072), (0.80, -0.30, 0.072), (0.85, -0.10, 0.072),
+    (0.66, -0.45, 0.072),
+)
+LOCATION_SETS = {"table1": TABLE1_LOCATIONS, "more": MORE_LOCATIONS}
+"""The named burger-location sets of ``flipkit validate`` and ``flipkit compare-ik``
+(``--locations``): the paper's ten Table I points, and five more of flipkit's choosing."""

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 
 from flipkit.cli.common import write_json
-from flipkit.experiments.compare_ik import LOCATION_SETS, compare_ik, format_summary
+from flipkit.config import LOCATION_SETS
+from flipkit.experiments.compare_ik import compare_ik, format_summary
 from flipkit.experiments.sweep import grill_grid, make_executor
 
 

@@ -8,7 +8,7 @@ import argparse
 from flipkit.cli.common import write_json
 from flipkit.cli.validate import format_table
 from flipkit.errors import ConfigError
-from flipkit.experiments.compare_ik import LOCATION_SETS
+from flipkit.config import LOCATION_SETS
 from flipkit.experiments.pauses import format_pauses
 from flipkit.experiments.sweep import make_executor
 from flipkit.experiments.trials import validate_locations, validate_plan_file
