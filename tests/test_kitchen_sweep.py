@@ -146,11 +146,25 @@ def fake_timeline(landing_b1=(0.64, -0.33)):
 
 
 def test_where_each_burger_lies_and_when():
-    tl, _ = fake_timeline()
+    tl, fps = fake_timeline()
     lying = lying_burgers(tl)
     assert [(lie.burger, lie.landed, lie.t0, lie.t1) for lie in lying] == [
         ("b1", False, 0, 87.0), ("b1", True, 90.0, 148.0),
         ("b2", False, 15, 102.0), ("b2", True, 105.0, 163.0)]
+    assert all(lie.spread == 0.0 for lie in lying)
+    # with the plans' footprints, a landed burger lies within its flip's landing spread
+    spreads = [lie.spread for lie in lying_burgers(tl, CELL, fps.__getitem__)]
+    assert spreads == [0.0, pytest.approx(0.015), 0.0, 0.0]  # b2's flip has no landing disc
+
+
+def test_a_landed_burger_is_kept_clear_by_its_landing_spread_too():
+    fp = blade_at(0.7, -0.2)
+    edge = -0.2 + W / 2
+    at = (0.7, edge + R + M + 0.005)  # clear of the blade by 5 mm beyond the margin ...
+    assert meetings(fp, "flip:b1", 0.0, [Lying("b2", at, 0.0, 1e9)], CELL) == []
+    landed = Lying("b2", at, 0.0, 1e9, landed=True, spread=0.02)  # ... unless it may lie 2 cm off
+    (meet,) = meetings(fp, "flip:b1", 0.0, [landed], CELL)
+    assert meet.overlap_m == pytest.approx(0.015)
 
 
 def test_a_met_burger_is_landed_clear_of_the_blade_nearest_its_drop():
@@ -159,8 +173,9 @@ def test_a_met_burger_is_landed_clear_of_the_blade_nearest_its_drop():
     blade = blade_at(0.64, -0.33).blade[0][2]
     radius = R + 0.015  # b1's landing disc
 
-    def clear(c):  # b2's blade at 103 s, b2 lying (dropped, then landed) over b1's stay
-        return (point_polygon_distance(c, blade) >= R + M
+    def clear(c):  # b2's blade at 103 s, b2 lying (dropped, then landed) over b1's stay;
+        # b1 lies within its landing disc of the spot
+        return (point_polygon_distance(c, blade) >= radius + M
                 and np.hypot(c[0] - 0.75, c[1] + 0.45) >= radius + R + M)
 
     grid = [(x, y) for x in np.arange(0.60, 0.88 + 1e-9, M / 2)

@@ -40,10 +40,13 @@ class CookConflictError(FlipkitError):
     """A motion of the cook would meet another burger and no landing spot avoids it."""
 
 
-def lying_burgers(timeline) -> list[Lying]:
+def lying_burgers(timeline, cell: CellConfig | None = None,
+                  footprints: Callable | None = None) -> list[Lying]:
     """Where each burger lies on the grill, when: at its drop place from its drop to the
     start of its flip (for good if the flip is not executed), then at its flip's predicted
-    landing point from the landing to the start of its serve (for good without one)."""
+    landing point from the landing to the start of its serve (for good without one), within
+    the flip's landing spread of it (its footprint's landing disc beyond the burger's radius;
+    with ``cell`` and ``footprints``, else 0)."""
     motions = {(m.kind, m.burger): m for m in timeline.motions if m.ok and m.event is not None}
     out = []
     for rec in timeline.burgers:
@@ -53,8 +56,17 @@ def lying_burgers(timeline) -> list[Lying]:
         if flip is not None:
             landed = rec.landing if rec.landing is not None else (b.x, b.y)
             out.append(Lying(b.burger, tuple(landed), flip.event,
-                             serve.start if serve else math.inf, landed=True))
+                             serve.start if serve else math.inf, landed=True,
+                             spread=_landing_spread(flip, cell, footprints)))
     return out
+
+
+def _landing_spread(flip, cell, footprints) -> float:
+    """How far (m) beyond the burger's radius a flip's landing disc reaches (0 unknown)."""
+    if cell is None or footprints is None or flip.plan is None:
+        return 0.0
+    landing = footprints(flip.plan).landing
+    return 0.0 if landing is None else max(landing[2] - cell.burger.diameter / 2, 0.0)
 
 
 class Footprints:
@@ -77,7 +89,7 @@ def cook_meetings(timeline, cell: CellConfig, footprints: Footprints | None = No
     """Every meeting of an executed motion with a burger lying while it runs, with that
     burger's :class:`Lying` record, in time order."""
     footprints = footprints or Footprints(cell)
-    lying = lying_burgers(timeline)
+    lying = lying_burgers(timeline, cell, footprints)
     out = []
     for m in timeline.motions:
         if not m.ok or m.event is None or m.plan is None:
@@ -112,28 +124,28 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
         return None
     rec = next(b for b in timeline.burgers if b.burger.burger == burger)
     own = footprints(flip.plan)
-    radius = own.landing[2] if own.landing is not None else r
+    radius = own.landing[2] if own.landing is not None else r  # it lies within this of P
     t0, t1 = flip.event, serve.start if serve is not None else math.inf
-    lying = lying_burgers(timeline)
+    lying = lying_burgers(timeline, cell, footprints)
     P = landing_candidates(cell, margin / 2)
     ok = np.ones(len(P), bool)
     for spot in exclude:
         ok &= np.hypot(*(P - np.asarray(spot)).T) > margin
     for lie in lying:
         if lie.burger != burger and lie.t0 <= t1 and lie.t1 >= t0:
-            ok &= np.hypot(*(P - np.asarray(lie.xy)).T) >= radius + r + margin
+            ok &= np.hypot(*(P - np.asarray(lie.xy)).T) >= radius + r + lie.spread + margin
     for m in motions.values():
         if m.burger == burger or m.plan is None or m.end < t0 or m.start > t1:
             continue
         fp = footprints(m.plan)
         for t, _seg, poly in fp.blade:
             if t0 <= m.start + t <= t1:
-                ok &= points_polygon_distance(P, poly) >= r + margin
+                ok &= points_polygon_distance(P, poly) >= radius + margin
         for t, _seg, a, b in fp.carried:
             if t0 <= m.start + t <= t1:
-                ok &= points_segment_distance(P, a, b) >= 2 * r + margin
+                ok &= points_segment_distance(P, a, b) >= r + radius + margin
         if fp.landing is not None and t0 <= m.start + fp.landing[0] <= t1:
-            ok &= np.hypot(*(P - np.asarray(fp.landing[1])).T) >= fp.landing[2] + r + margin
+            ok &= np.hypot(*(P - np.asarray(fp.landing[1])).T) >= fp.landing[2] + radius + margin
     if serve is not None and serve.plan is not None:  # the serve scoops from the new spot: its low part moves with it
         fp = footprints(serve.plan)
         old = np.asarray(rec.landing if rec.landing is not None else (rec.burger.x,
@@ -144,10 +156,10 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
             d_centre = np.asarray(lie.xy) - (P - old)  # the lying burger, seen from the serve
             for t, seg, poly in fp.blade:
                 if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    ok &= points_polygon_distance(d_centre, poly) >= r + margin
+                    ok &= points_polygon_distance(d_centre, poly) >= r + lie.spread + margin
             for t, seg, a, b in fp.carried:
                 if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    ok &= points_segment_distance(d_centre, a, b) >= 2 * r + margin
+                    ok &= points_segment_distance(d_centre, a, b) >= 2 * r + lie.spread + margin
     if not ok.any():
         return None
     drop = np.array([rec.burger.x, rec.burger.y])

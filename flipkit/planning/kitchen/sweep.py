@@ -25,7 +25,11 @@ them in three ways, each computed from the plan and the cell (no other numbers):
 
 ``margin`` defaults to the placement spread the robust flips plan for
 (:class:`~flipkit.config.ScoopUncertainty`: ``k_sigma × placement_sigma``): a burger may
-lie that far from where it was recorded.
+lie that far from where it was recorded. A burger a flip landed may lie farther from the
+landing point, by the flip's landing spread (``Lying.spread``: where the landing disc
+reaches beyond the burger's radius); each distance above grows by it. (In a simulated
+five-burger cook a burger landed 2.8 cm from its predicted point, and the next flip's blade
+came down on its rim.)
 """
 
 from __future__ import annotations
@@ -45,13 +49,16 @@ SAMPLE_DT = 0.005  # s between samples of a plan: the blade moves < 2 mm between
 @dataclass(frozen=True)
 class Lying:
     """A burger lying still on the grill at ``xy`` (m) from ``t0`` to ``t1`` (s, cook clock);
-    ``landed``: where its flip put it (else where it was dropped)."""
+    ``landed``: where its flip put it (else where it was dropped); ``spread`` (m): how much
+    farther than the margin from ``xy`` it may lie (a landed burger: its flip's landing
+    spread, the landing disc's radius beyond the burger's; 0 where it was dropped)."""
 
     burger: str
     xy: tuple
     t0: float
     t1: float
     landed: bool = False
+    spread: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -262,7 +269,8 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
     if not lying:
         return []
     xy = np.array([b.xy for b in lying], float)
-    since, until = (np.array([getattr(b, f) for b in lying], float) for f in ("t0", "t1"))
+    since, until, spread = (np.array([getattr(b, f) for b in lying], float)
+                            for f in ("t0", "t1", "spread"))
 
     def check(t, part, seg, depth_of):  # every burger lying at t, at once
         live = (since <= t) & (t <= until)
@@ -273,14 +281,14 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
 
     for t, seg, poly in fp.blade:
         check(start + t, "blade", seg,
-              lambda: r + margin - points_polygon_distance(xy, poly))
+              lambda: r + spread + margin - points_polygon_distance(xy, poly))
     for t, seg, a, c in fp.carried:
         check(start + t, "carried burger", seg,
-              lambda: 2 * r + margin - points_segment_distance(xy, a, c))
+              lambda: 2 * r + spread + margin - points_segment_distance(xy, a, c))
     if fp.landing is not None:
         t, point, radius = fp.landing
         check(start + t, "landing", "flip",
-              lambda: radius + r + margin - np.hypot(*(xy - np.asarray(point)).T))
+              lambda: radius + r + spread + margin - np.hypot(*(xy - np.asarray(point)).T))
     return sorted(worst.values(), key=lambda m: (m.t, m.burger))
 
 
