@@ -129,23 +129,31 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
     lying = lying_burgers(timeline, cell, footprints)
     P = landing_candidates(cell, margin / 2)
     ok = np.ones(len(P), bool)
+
+    def keep(passes):  # narrow the candidates still in to those ``passes(points)`` accepts
+        idx = np.flatnonzero(ok)
+        if idx.size:
+            ok[idx] = passes(P[idx])
+
     for spot in exclude:
-        ok &= np.hypot(*(P - np.asarray(spot)).T) > margin
+        keep(lambda Q: np.hypot(*(Q - np.asarray(spot)).T) > margin)
     for lie in lying:
         if lie.burger != burger and lie.t0 <= t1 and lie.t1 >= t0:
-            ok &= np.hypot(*(P - np.asarray(lie.xy)).T) >= radius + r + lie.spread + margin
+            keep(lambda Q: np.hypot(*(Q - np.asarray(lie.xy)).T)
+                 >= radius + r + lie.spread + margin)
     for m in motions.values():
         if m.burger == burger or m.plan is None or m.end < t0 or m.start > t1:
             continue
         fp = footprints(m.plan)
         for t, _seg, poly in fp.blade:
             if t0 <= m.start + t <= t1:
-                ok &= points_polygon_distance(P, poly) >= radius + margin
+                keep(lambda Q: points_polygon_distance(Q, poly) >= radius + margin)
         for t, _seg, a, b in fp.carried:
             if t0 <= m.start + t <= t1:
-                ok &= points_segment_distance(P, a, b) >= r + radius + margin
+                keep(lambda Q: points_segment_distance(Q, a, b) >= r + radius + margin)
         if fp.landing is not None and t0 <= m.start + fp.landing[0] <= t1:
-            ok &= np.hypot(*(P - np.asarray(fp.landing[1])).T) >= fp.landing[2] + radius + margin
+            keep(lambda Q: np.hypot(*(Q - np.asarray(fp.landing[1])).T)
+                 >= fp.landing[2] + radius + margin)
     if serve is not None and serve.plan is not None:  # the serve scoops from the new spot: its low part moves with it
         fp = footprints(serve.plan)
         old = np.asarray(rec.landing if rec.landing is not None else (rec.burger.x,
@@ -153,13 +161,15 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
         there = [lie for lie in lying if lie.burger != burger
                  and lie.t0 <= serve.end and lie.t1 >= serve.start]
         for lie in there:
-            d_centre = np.asarray(lie.xy) - (P - old)  # the lying burger, seen from the serve
+            seen = np.asarray(lie.xy) + old  # the lying burger seen from the serve: seen - Q
             for t, seg, poly in fp.blade:
                 if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    ok &= points_polygon_distance(d_centre, poly) >= r + lie.spread + margin
+                    keep(lambda Q: points_polygon_distance(seen - Q, poly)
+                         >= r + lie.spread + margin)
             for t, seg, a, b in fp.carried:
                 if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    ok &= points_segment_distance(d_centre, a, b) >= 2 * r + lie.spread + margin
+                    keep(lambda Q: points_segment_distance(seen - Q, a, b)
+                         >= 2 * r + lie.spread + margin)
     if not ok.any():
         return None
     drop = np.array([rec.burger.x, rec.burger.y])
@@ -188,6 +198,7 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
     """
     lands: dict[str, tuple] = {}
     tried: dict[str, list] = {}
+    fps = Footprints(cell)  # kept over the rounds: a plan made again is a new key
     for round_ in range(max_rounds + 1):
         timeline = schedule(dict(lands))
         failed = [b for b in lands if any(m.burger == b and m.kind == "flip" and not m.ok
@@ -198,7 +209,6 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
             continue
         if not timeline.ok:
             return timeline, lands
-        fps = Footprints(cell)
         found = cook_meetings(timeline, cell, fps, margin)
         if not found:
             return timeline, lands
