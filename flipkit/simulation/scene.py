@@ -176,12 +176,19 @@ class Scene:
         contact without constraint rows (``efc_address`` −1) has none. A sleeping burger (a
         scene that sleeps) has none: MuJoCo skips it, and it lies as it fell asleep.
         """
+        pairs, force = self.contact_arrays()
+        return [(a, b, f) for (a, b), f in zip(pairs.tolist(), force.tolist())]
+
+    def contact_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`contacts` as arrays: the geom pairs (ncon×2) and normal forces (N, ncon)."""
         d = self.data
         if d.ncon == 0:
-            return []
-        efc = d.efc_force
-        return [(a, b, efc[adr] if adr >= 0 else 0.0)
-                for (a, b), adr in zip(d.contact.geom.tolist(), d.contact.efc_address.tolist())]
+            return np.zeros((0, 2), int), np.zeros(0)
+        con, efc = d.contact, d.efc_force
+        adr = con.efc_address
+        force = efc[adr] if efc.size else np.zeros(len(adr))
+        force[adr < 0] = 0.0
+        return con.geom, force
 
     def blade_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """World position (m) and rotation of the spatula frame (after mj_kinematics)."""

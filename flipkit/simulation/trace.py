@@ -47,8 +47,7 @@ class BurgerTrace:
             pairs += [(part, g["blade"], 2), (part, g["grill"], 3)]
         for a, b, slot in pairs:
             self._slot[a, b] = self._slot[b, a] = slot
-        self._asleep = (lambda: not self.data.body_awake[self.burger_body]) if scene.sleeps \
-            else (lambda: False)
+        self.sleeps = scene.sleeps
 
     @property
     def br(self) -> np.ndarray:
@@ -69,16 +68,13 @@ class BurgerTrace:
         self.sp[k], self._sr[k] = d.site_xpos[s], d.site_xmat[s]
         self.bp[k], self._br[k] = d.xpos[b], d.xmat[b]
         if d.ncon:
-            con, efc = d.contact, d.efc_force
-            slot = self._slot[con.geom[:, 0], con.geom[:, 1]]
-            adr = con.efc_address
-            force = efc[adr] if efc.size else np.zeros(len(adr))  # normal force: first row
-            force[adr < 0] = 0.0  # a contact without constraint rows has none
+            pairs, force = self.scene.contact_arrays()
+            slot = self._slot[pairs[:, 0], pairs[:, 1]]
             sums = np.bincount(slot, weights=force, minlength=4)
             seen = np.bincount(slot, minlength=4)
             self.fbg[k], self.fs[k], self.fg[k] = sums[1:]
             self.ts[k], self.tg[k] = seen[2] > 0, seen[3] > 0
-        if k and self._asleep():
+        if k and self.sleeps and not d.body_awake[b]:
             self.ts[k], self.tg[k] = self.ts[k - 1], self.tg[k - 1]
             self.fs[k], self.fg[k] = self.fs[k - 1], self.fg[k - 1]
 
