@@ -28,12 +28,15 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError
 from flipkit.model.robot import Robot
-from flipkit.planning.kitchen.sweep import (Lying, Meeting, default_margin, footprint,
-                                           meetings, points_polygon_distance,
-                                           points_segment_distance)
+from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
+from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
 
 MAX_ROUNDS = 4  # plan-schedule-check rounds before a cook with meetings left is refused
 LOW_SEGMENTS = ("go_to_burger", "scoop", "pickup")  # a serve's segments that move with its burger
+# Footprint samples tested at once against the candidate spots still in. Each test removes
+# most of them, so small chunks keep the later tests small (the five-burger cook's
+# free_landing: 2.0 s in chunks of 4, 2.9 s of 16, 2.8 s of 64, 2.3 s one sample at a time).
+CHUNK = 4
 
 
 class CookConflictError(FlipkitError):
@@ -145,12 +148,10 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
         if m.burger == burger or m.plan is None or m.end < t0 or m.start > t1:
             continue
         fp = footprints(m.plan)
-        for t, _seg, poly in fp.blade:
-            if t0 <= m.start + t <= t1:
-                keep(lambda Q: points_polygon_distance(Q, poly) >= radius + margin)
-        for t, _seg, a, b in fp.carried:
-            if t0 <= m.start + t <= t1:
-                keep(lambda Q: points_segment_distance(Q, a, b) >= r + radius + margin)
+        for polys, counts in _blade_chunks(fp, m.start, t0, t1):
+            keep(lambda Q: polygon_distances(Q, polys, counts).min(axis=0) >= radius + margin)
+        for a, b in _carried_chunks(fp, m.start, t0, t1):
+            keep(lambda Q: segment_distances(Q, a, b).min(axis=0) >= r + radius + margin)
         if fp.landing is not None and t0 <= m.start + fp.landing[0] <= t1:
             keep(lambda Q: np.hypot(*(Q - np.asarray(fp.landing[1])).T)
                  >= fp.landing[2] + radius + margin)
@@ -162,19 +163,44 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
                  and lie.t0 <= serve.end and lie.t1 >= serve.start]
         for lie in there:
             seen = np.asarray(lie.xy) + old  # the lying burger seen from the serve: seen - Q
-            for t, seg, poly in fp.blade:
-                if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    keep(lambda Q: points_polygon_distance(seen - Q, poly)
-                         >= r + lie.spread + margin)
-            for t, seg, a, b in fp.carried:
-                if seg in LOW_SEGMENTS and lie.t0 <= serve.start + t <= lie.t1:
-                    keep(lambda Q: points_segment_distance(seen - Q, a, b)
-                         >= 2 * r + lie.spread + margin)
+            for polys, counts in _blade_chunks(fp, serve.start, lie.t0, lie.t1, LOW_SEGMENTS):
+                keep(lambda Q: polygon_distances(seen - Q, polys, counts).min(axis=0)
+                     >= r + lie.spread + margin)
+            for a, b in _carried_chunks(fp, serve.start, lie.t0, lie.t1, LOW_SEGMENTS):
+                keep(lambda Q: segment_distances(seen - Q, a, b).min(axis=0)
+                     >= 2 * r + lie.spread + margin)
     if not ok.any():
         return None
     drop = np.array([rec.burger.x, rec.burger.y])
     best = np.argmin(np.where(ok, np.hypot(*(P - drop).T), np.inf))
     return tuple(float(v) for v in P[best])
+
+
+def _within(ts, segs, start, t0, t1, only) -> list[np.ndarray]:
+    """Indices of the samples at ``start + ts`` within [t0, t1], of segments ``only`` if given,
+    in chunks of at most :data:`CHUNK`."""
+    keep = (t0 <= start + ts) & (start + ts <= t1)
+    if only is not None:
+        keep &= np.array([seg in only for seg in segs], bool)
+    idx = np.flatnonzero(keep)
+    return [idx[k:k + CHUNK] for k in range(0, len(idx), CHUNK)]
+
+
+def _blade_chunks(fp, start, t0, t1, only=None):
+    """The footprint's blade sections within [t0, t1] (cook clock, the motion started at
+    ``start``), as padded polygon arrays in chunks."""
+    if not fp.blade:
+        return []
+    ts, segs, polys, counts = fp.blade_arrays()
+    return [(polys[i], counts[i]) for i in _within(ts, segs, start, t0, t1, only)]
+
+
+def _carried_chunks(fp, start, t0, t1, only=None):
+    """The footprint's carried-burger strokes within [t0, t1], as (starts, ends) in chunks."""
+    if not fp.carried:
+        return []
+    ts, segs, a, b = fp.carried_arrays()
+    return [(a[i], b[i]) for i in _within(ts, segs, start, t0, t1, only)]
 
 
 def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,

@@ -42,6 +42,10 @@ from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.config import CellConfig, ScoopUncertainty
 from flipkit.model.robot import Robot
+from flipkit.planning.kitchen.planar import (pad_polygons, point_polygon_distance,  # noqa: F401
+                                            point_segment_distance, points_polygon_distance,
+                                            points_segment_distance, polygon_distances,
+                                            segment_distances)
 
 SAMPLE_DT = 0.005  # s between samples of a plan: the blade moves < 2 mm between them
 
@@ -99,6 +103,27 @@ class Footprint:
     blade: list = field(default_factory=list)
     carried: list = field(default_factory=list)
     landing: tuple | None = None
+    _arrays: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def blade_arrays(self) -> tuple[np.ndarray, list, np.ndarray, np.ndarray]:
+        """:attr:`blade` as arrays, made once: times (m,), segments, the sections padded
+        (m×K×2) and their vertex counts (m,)
+        (:func:`~flipkit.planning.kitchen.planar.pad_polygons`)."""
+        if "blade" not in self._arrays:
+            polys, counts = pad_polygons([poly for _t, _s, poly in self.blade])
+            self._arrays["blade"] = (np.array([t for t, _s, _p in self.blade], float),
+                                     [seg for _t, seg, _p in self.blade], polys, counts)
+        return self._arrays["blade"]
+
+    def carried_arrays(self) -> tuple[np.ndarray, list, np.ndarray, np.ndarray]:
+        """:attr:`carried` as arrays, made once: times (m,), segments, starts and ends (m×2)."""
+        if "carried" not in self._arrays:
+            c = self.carried
+            self._arrays["carried"] = (
+                np.array([x[0] for x in c], float), [x[1] for x in c],
+                np.array([x[2] for x in c], float).reshape(-1, 2),
+                np.array([x[3] for x in c], float).reshape(-1, 2))
+        return self._arrays["carried"]
 
 
 def default_margin() -> float:
@@ -149,43 +174,6 @@ def slab_section(polygon, z_lo: float, z_hi: float) -> np.ndarray:
                 out.append(a + s * (b - a))
         poly = np.array(out).reshape(-1, 3)
     return poly
-
-
-def point_polygon_distance(point, polygon) -> float:
-    """Distance (m) in the plane from ``point`` to a convex polygon (k×2, in order; also a
-    segment or a point): 0 inside it; ``inf`` for no polygon."""
-    return float(points_polygon_distance(np.asarray(point, float)[None, :2], polygon)[0])
-
-
-def points_polygon_distance(points, polygon) -> np.ndarray:
-    """:func:`point_polygon_distance` of many points (n×2) at once."""
-    P = np.asarray(points, float)[:, :2]
-    poly = np.asarray(polygon, float)[:, :2]
-    best = np.full(len(P), np.inf)
-    for k in range(len(poly)):
-        best = np.minimum(best, points_segment_distance(P, poly[k], poly[(k + 1) % len(poly)]))
-    if len(poly) >= 3:
-        edges = np.roll(poly, -1, axis=0) - poly
-        cross = (edges[None, :, 0] * (P[:, None, 1] - poly[None, :, 1])
-                 - edges[None, :, 1] * (P[:, None, 0] - poly[None, :, 0]))
-        inside = np.all(cross >= -1e-15, axis=1) | np.all(cross <= 1e-15, axis=1)
-        best[inside] = 0.0
-    return best
-
-
-def points_segment_distance(points, a, b) -> np.ndarray:
-    """:func:`point_segment_distance` of many points (n×2) at once."""
-    P = np.asarray(points, float)[:, :2]
-    a, b = np.asarray(a, float)[:2], np.asarray(b, float)[:2]
-    ab = b - a
-    n = float(ab @ ab)
-    s = np.zeros(len(P)) if n == 0 else np.clip((P - a) @ ab / n, 0.0, 1.0)
-    return np.linalg.norm(P - (a + s[:, None] * ab), axis=1)
-
-
-def point_segment_distance(point, a, b) -> float:
-    """Distance (m) in the plane from ``point`` to the segment from ``a`` to ``b``."""
-    return float(points_segment_distance(np.asarray(point, float)[None, :2], a, b)[0])
 
 
 def _samples(seg, dt: float):
@@ -272,23 +260,30 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
     since, until, spread = (np.array([getattr(b, f) for b in lying], float)
                             for f in ("t0", "t1", "spread"))
 
-    def check(t, part, seg, depth_of):  # every burger lying at t, at once
-        live = (since <= t) & (t <= until)
-        if live.any():
-            depth = depth_of()
-            for k in np.flatnonzero(live & (depth > 0)):
-                note(lying[k], part, seg, t, float(depth[k]))
+    def check(ts, segs, part, depth_of):  # every sample and every burger lying then, at once
+        when = start + ts[:, None]
+        live = (since[None] <= when) & (when <= until[None])
+        if not live.any():
+            return
+        depth = np.where(live, depth_of(), -np.inf)
+        for name in dict.fromkeys(b.burger for b in lying):  # the deepest per burger: the first
+            cols = np.flatnonzero([b.burger == name for b in lying])
+            sub = depth[:, cols]
+            i, j = np.unravel_index(np.argmax(sub), sub.shape)
+            note(lying[cols[j]], part, segs[i], float(start + ts[i]), float(sub[i, j]))
 
-    for t, seg, poly in fp.blade:
-        check(start + t, "blade", seg,
-              lambda: r + spread + margin - points_polygon_distance(xy, poly))
-    for t, seg, a, c in fp.carried:
-        check(start + t, "carried burger", seg,
-              lambda: 2 * r + spread + margin - points_segment_distance(xy, a, c))
+    if fp.blade:
+        ts, segs, polys, counts = fp.blade_arrays()
+        check(ts, segs, "blade",
+              lambda: r + spread + margin - polygon_distances(xy, polys, counts))
+    if fp.carried:
+        ts, segs, a, c = fp.carried_arrays()
+        check(ts, segs, "carried burger",
+              lambda: 2 * r + spread + margin - segment_distances(xy, a, c))
     if fp.landing is not None:
         t, point, radius = fp.landing
-        check(start + t, "landing", "flip",
-              lambda: radius + r + spread + margin - np.hypot(*(xy - np.asarray(point)).T))
+        check(np.array([t]), ["flip"], "landing",
+              lambda: (radius + r + spread + margin - np.hypot(*(xy - np.asarray(point)).T))[None])
     return sorted(worst.values(), key=lambda m: (m.t, m.burger))
 
 
