@@ -66,3 +66,32 @@ def test_parallel_batch_equals_the_serial_one():
         np.testing.assert_array_equal(a.segments[0].q[0], b.segments[0].q[0])  # same start
         for sa, sb in zip(a.segments, b.segments):  # the same plan, bit for bit
             np.testing.assert_array_equal(sa.q, sb.q)
+
+
+def test_a_flip_asked_for_again_does_not_plan_its_serve_again(monkeypatch):
+    """Each round of a cook's clearance asks for every flip again; the serve from an unchanged
+    landing is the plan already made (it was planned anew every round, one wasted serve per
+    burger and round)."""
+    import concurrent.futures as cf
+    from types import SimpleNamespace
+
+    from flipkit.planning.kitchen import prefetch
+    from flipkit.planning.kitchen.motions import MotionJob
+
+    planned = []
+
+    def fake_plan(kind, job, q_start, cell, solver, atlas=None):
+        planned.append((kind, job.burger))
+        return SimpleNamespace(ok=True, landing=(0.70, -0.20), planning_time_s=0.0)
+
+    monkeypatch.setattr(prefetch, "plan_motion", fake_plan)
+    order = check_cook(ORDER, CELL)
+    with cf.ThreadPoolExecutor(1) as pool:
+        planners = PrefetchPlanners(order, ("flip", "serve"), CELL.robot.q_home,
+                                    table_spots(CELL), pool, CELL)
+        flip = MotionJob("flip", "b1", order[0].location(CELL))
+        for _round in range(3):
+            planners["flip"](flip, CELL.robot.q_home)
+        pool.shutdown(wait=True)
+    assert planned.count(("serve", "b1")) == 1
+    assert planned.count(("flip", "b1")) == 1

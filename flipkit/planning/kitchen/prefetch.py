@@ -87,8 +87,8 @@ class PrefetchPlanners(Mapping):
         pm = fut.result()
         pm.ready_s = self._ready.get(job.key, time.perf_counter() - self._t0)
         if job.kind == "flip" and "serve" in self.kinds and pm.ok and job.burger in self._spots:
-            self._submit(MotionJob("serve", job.burger, (*pm.landing, self.cell.grill.height),
-                                   self._spots[job.burger]))
+            self.prefetch(MotionJob("serve", job.burger, (*pm.landing, self.cell.grill.height),
+                                    self._spots[job.burger]))
         return pm
 
     def __getitem__(self, kind: str):
