@@ -14,7 +14,7 @@ from flipkit.planning.kitchen.clearance import (CookConflictError, clear_cook, f
                                                lying_burgers)
 from flipkit.planning.kitchen.cook import CookBurger
 from flipkit.planning.kitchen.sweep import (Footprint, Lying, approach_height,
-                                           blade_rectangle, blade_section, default_margin, meetings,
+                                           blade_rectangle, blade_section, blade_sections, default_margin, meetings,
                                            point_polygon_distance, point_segment_distance,
                                            points_polygon_distance, slab_section)
 
@@ -71,6 +71,28 @@ def test_a_blade_pressed_into_the_grill_counts_whole_and_a_raised_one_not_at_all
     tip_down = blade_section(pitched(theta), (0.7, -0.2, H - 0.003 + L / 2 * math.sin(theta)),
                              CELL)
     assert tip_down[:, 2].max() == pytest.approx(H + T) and tip_down[:, 2].min() < H
+
+
+def test_the_sections_of_many_poses_at_once_are_each_pose_s_section():
+    """blade_sections (every sample of a footprint at once) against blade_section per pose:
+    random pitches, rolls and heights around the burger's top, so that the plane cuts the
+    blade through two, three or no corners (fixed seed)."""
+    rng = np.random.default_rng(5)
+    Rs, ps = [], []
+    for _ in range(300):
+        a, b, c = rng.uniform(-0.5, 0.5, 3)
+        Rs.append(yawed(c) @ pitched(a) @ np.array([[1, 0, 0], [0, math.cos(b), -math.sin(b)],
+                                                    [0, math.sin(b), math.cos(b)]]))
+        ps.append((0.7, -0.2, H + T + rng.uniform(-0.06, 0.06)))
+    polys, counts = blade_sections(np.array(Rs), np.array(ps), CELL)
+    seen = set()
+    for R, p, poly, n in zip(Rs, ps, polys, counts):
+        one = blade_section(R, p, CELL)
+        assert n == len(one)
+        assert np.allclose(poly[:n], one, rtol=0, atol=1e-15)
+        assert np.all(poly[n:] == poly[0])  # padded with the first vertex
+        seen.add(int(n))
+    assert seen == {0, 3, 4, 5}  # no section, a corner, half the blade, all but a corner
 
 
 def test_distances_to_a_polygon_inside_along_an_edge_and_at_a_corner():

@@ -155,6 +155,30 @@ def blade_section(R, p, cell: CellConfig) -> np.ndarray:
     return slab_section(blade_rectangle(R, p, cell), -math.inf, top)
 
 
+def blade_sections(Rs, ps, cell: CellConfig) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`blade_section` at m blade poses at once (rotations m×3×3, centres m×3): the
+    sections padded (m×5×3, each after its own vertices with its first; a rectangle cut by a
+    plane has at most five) and their vertex counts (m,), 0 where the blade is above."""
+    Rs, ps = np.asarray(Rs, float), np.asarray(ps, float)
+    top = cell.grill.height + cell.burger.thickness
+    hl, hw = cell.spatula.length / 2, cell.spatula.width / 2
+    local = np.array([[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw]])
+    C = ps[:, None, :] + np.einsum("kj,mij->mki", local, Rs[:, :, :2])  # m×4 corners
+    below = C[..., 2] <= top
+    slots, keep = np.zeros((len(C), 8, 3)), np.zeros((len(C), 8), bool)
+    for k in range(4):  # Sutherland-Hodgman on the plane z = top, every pose at once
+        a, b, ia, ib = C[:, k], C[:, (k + 1) % 4], below[:, k], below[:, (k + 1) % 4]
+        dz = np.where(ia != ib, b[:, 2] - a[:, 2], 1.0)
+        slots[:, 2 * k], keep[:, 2 * k] = a, ia
+        slots[:, 2 * k + 1] = a + ((top - a[:, 2]) / dz)[:, None] * (b - a)
+        keep[:, 2 * k + 1] = ia != ib
+    order = np.argsort(~keep, axis=1, kind="stable")[:, :5]
+    polys, counts = np.take_along_axis(slots, order[..., None], axis=1), keep.sum(axis=1)
+    pad = np.arange(5)[None, :] >= counts[:, None]
+    polys[pad] = np.repeat(polys[:, :1], 5, axis=1)[pad]
+    return polys, counts
+
+
 def slab_section(polygon, z_lo: float, z_hi: float) -> np.ndarray:
     """The part of a planar convex polygon (k×3, in order) with ``z_lo <= z <= z_hi``,
     clipped edge by edge (Sutherland–Hodgman on the two planes); (0, 3) when empty."""
@@ -203,16 +227,21 @@ def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMP
     on_blade = np.append(_on_blade(plan), 0.0)
     out, t0, carrying = Footprint(), 0.0, False
     location = np.asarray(plan.burger["location"], float)[:2]
+    times, segs, polys, counts = [], [], [], []
     for seg in plan.segments:
         ts, qs = _samples(seg, dt)
         release = (getattr(seg, "release", None) or {}).get("time")
+        Ms = [robot.placement(q) for q in qs]
+        Rs, ps = np.array([M.rotation for M in Ms]), np.array([M.translation for M in Ms])
+        sec, n = blade_sections(Rs, ps, cell)
+        low = np.flatnonzero(n)
+        out.blade += [(t0 + ts[i], seg.name, sec[i, :n[i], :2]) for i in low]
+        times.append(t0 + ts[low])
+        segs += [seg.name] * len(low)
+        polys.append(sec[low, :, :2])
+        counts.append(n[low])
         prev = None
-        for t, q in zip(ts, qs):
-            M = robot.placement(q)
-            R, p = M.rotation, M.translation
-            section = blade_section(R, p, cell)
-            if len(section):
-                out.blade.append((t0 + t, seg.name, section[:, :2]))
+        for t, R, p in zip(ts, Rs, ps):
             if carrying and (release is None or t <= release):
                 centre = p + R @ on_blade
                 if centre[2] < top:
@@ -236,6 +265,8 @@ def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMP
                            tuple(float(v) for v in landing["point"][:2]),
                            cell.burger.diameter / 2 + spread)
         t0 += float(seg.T)
+    out._arrays["blade"] = (np.concatenate(times), segs, np.concatenate(polys),
+                            np.concatenate(counts))
     return out
 
 
@@ -288,7 +319,7 @@ def meetings(fp: Footprint, motion: str, start: float, lying, cell: CellConfig,
 
 
 __all__ = ["SAMPLE_DT", "Footprint", "Lying", "Meeting", "approach_height", "blade_rectangle",
-           "blade_section",
+           "blade_section", "blade_sections",
            "default_margin",
            "footprint", "meetings", "point_polygon_distance", "point_segment_distance",
            "points_polygon_distance", "points_segment_distance", "slab_section"]
