@@ -7,15 +7,24 @@ Why a child: the OR-Tools wheel ships its own ``libhighs.so.1``, older than the 
 ``highspy`` (which cvxpy imports), and one process cannot load both — whichever comes
 second fails to load with an undefined symbol (google/or-tools issue #5246). The planners
 load cvxpy; the child loads only OR-Tools, and no module of the package imports OR-Tools
-but this one's ``__main__``. The child costs about 0.6 s of start-up per schedule.
+but this one's ``__main__``.
+
+One child serves every schedule of the process: it reads one problem per line and answers
+each with one line, so only the first schedule pays its start (about 0.4 s, importing
+OR-Tools), and :func:`warm` starts it ahead, while the motions are being planned. A child
+that fails or does not answer in time is killed, and the next schedule starts a new one.
 """
 
 from __future__ import annotations
 
+import atexit
 import json
 import math
+import select
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from dataclasses import asdict
 
@@ -40,6 +49,78 @@ class CpSatProcessError(FlipkitError):
     """The CP-SAT child process failed (its last error line) or did not answer in time."""
 
 
+def _readable(stream, timeout: float) -> bool:
+    """Whether ``stream`` has something to read within ``timeout`` (s)."""
+    return bool(select.select([stream], [], [], timeout)[0])
+
+
+class Child:
+    """The CP-SAT child process of this process (module docstring), started on demand."""
+
+    def __init__(self):
+        self._proc: subprocess.Popen | None = None
+        self._err = None  # the child's stderr: a file, so that it can never fill a pipe
+        self._lock = threading.Lock()
+
+    def warm(self) -> None:
+        """Start the child unless it runs; it imports OR-Tools while the caller goes on."""
+        with self._lock:
+            self._start()
+
+    def _start(self) -> None:
+        if self._proc is None or self._proc.poll() is not None:
+            self._err = tempfile.TemporaryFile("w+")
+            self._proc = subprocess.Popen([sys.executable, "-m", __name__], text=True,
+                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                          stderr=self._err)
+
+    def ask(self, problem: dict, timeout: float) -> dict:
+        """The child's answer to ``problem``, within ``timeout`` s of wall time.
+
+        Raises:
+            CpSatProcessError: The child died (its last error line) or did not answer.
+        """
+        with self._lock:
+            self._start()
+            proc = self._proc
+            try:
+                proc.stdin.write(json.dumps(problem) + "\n")
+                proc.stdin.flush()
+            except OSError:
+                pass  # it died: said below
+            if not _readable(proc.stdout, timeout):
+                self.close()
+                raise CpSatProcessError(f"the CP-SAT process did not answer within "
+                                        f"{timeout:g} s")
+            line = proc.stdout.readline()
+            if not line:
+                code = proc.wait()
+                self._err.seek(0)
+                last = (self._err.read().strip().splitlines() or ["no message"])[-1]
+                self.close()
+                raise CpSatProcessError(f"the CP-SAT process failed (exit {code}): {last}")
+            return json.loads(line)
+
+    def close(self) -> None:
+        """Stop the child (the next :meth:`ask` starts another)."""
+        proc, self._proc = self._proc, None
+        if proc is not None and proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        if self._err is not None:
+            self._err.close()
+            self._err = None
+
+
+CHILD = Child()
+atexit.register(CHILD.close)
+
+
+def warm() -> None:
+    """Start the CP-SAT child now, so that the first schedule does not wait for it."""
+    CHILD.warm()
+
+
 def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                    earliest_s: float = -math.inf, time_limit_s: float = 10.0,
                    workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
@@ -55,7 +136,8 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
         relax: The first objective when the windows cannot be met: "max" or "count".
 
     Returns:
-        The schedule; ``wall_s`` counts the child process's start too.
+        The schedule; ``wall_s`` is the round trip to the child (its start too, if this
+        schedule started it).
 
     Raises:
         ScheduleTimeoutError: No schedule found within ``time_limit_s``.
@@ -69,17 +151,7 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                else None, "time_limit_s": time_limit_s, "workers": workers, "seed": seed,
                "relax": relax}
     t0 = time.perf_counter()
-    try:
-        run = subprocess.run([sys.executable, "-m", __name__], input=json.dumps(problem),
-                             capture_output=True, text=True,
-                             timeout=wall_bound(time_limit_s))
-    except subprocess.TimeoutExpired:
-        raise CpSatProcessError(f"the CP-SAT process did not answer within "
-                                f"{wall_bound(time_limit_s):g} s") from None
-    if run.returncode != 0:
-        last = (run.stderr.strip().splitlines() or ["no message"])[-1]
-        raise CpSatProcessError(f"the CP-SAT process failed (exit {run.returncode}): {last}")
-    reply = json.loads(run.stdout)
+    reply = CHILD.ask(problem, wall_bound(time_limit_s))
     if "timeout" in reply:
         raise ScheduleTimeoutError(reply["timeout"])
     breach = reply["breach"]
@@ -110,10 +182,12 @@ def answer(problem: dict, cp) -> dict:
             "proved_infeasible": r.proved_infeasible}
 
 
-__all__ = ["CHILD_MARGIN_S", "CpSatProcessError", "answer", "solve_schedule"]
+__all__ = ["CHILD", "CHILD_MARGIN_S", "Child", "CpSatProcessError", "answer", "solve_schedule",
+           "warm"]
 
 
-if __name__ == "__main__":  # the child process: a problem on stdin, the answer on stdout
+if __name__ == "__main__":  # the child: a problem per line on stdin, an answer per line out
     from ortools.sat.python import cp_model
 
-    json.dump(answer(json.load(sys.stdin), cp_model), sys.stdout)
+    for request in sys.stdin:
+        print(json.dumps(answer(json.loads(request), cp_model)), flush=True)

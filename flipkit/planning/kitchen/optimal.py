@@ -27,7 +27,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.kitchen.cook import SECOND_SIDE_S
 from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes
-from flipkit.planning.kitchen.cpsat_process import solve_schedule
+from flipkit.planning.kitchen.cpsat_process import solve_schedule, warm
 from flipkit.planning.kitchen.motions import KINDS, MotionJob, MotionPlanner
 from flipkit.planning.kitchen.schedule import (BurgerRecord, MotionRecord, Timeline,
                                               check_cook_inputs)
@@ -69,6 +69,7 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
     """
     cell, kinds, order, spots, assigned = check_cook_inputs(burgers, planners, kinds, cell,
                                                             spots, dwell_s)
+    warm()  # the CP-SAT child starts while the motions are planned
     serve = "serve" in kinds
     q0 = np.asarray(q_start, float)
     t0 = min(b.t_drop for b in order) if plan_start is None else float(plan_start)
