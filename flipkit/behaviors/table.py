@@ -29,8 +29,10 @@ def place_cone(ctx) -> list[int]:
 
 _to_table = partial(task_path_guess, joint_fallback=True)  # a straight carry may pass the base
 
-# The carry covers up to ~1 m under the cone (planned μ 0.4: ≤ 3.9 m/s² sideways; 1 m takes
-# ≥ 1.01 s bang-bang), so its bound is 1.2 s; a farther spot gets the stretched bound.
+# The carry holds the burger in the cone planned for the least sticky burger (μ 0.16,
+# docs/robust-flips.md §2), the blade tilting into its acceleration. Within 1.2 s it solved at
+# the serves tried; a farther spot (about 1.4 m) gets the stretched bound, and within 0.9 s
+# two of three serves tried needed it (docs/benchmarks/2026-11-27-kitchen-planning.md).
 CARRY = Subbehavior(
     "carry", duration=(0.6, 1.2), carries_burger=True, end="rest", needs=("spot",),
     floor=sv.table_floor, exempt=tool_leaves_grill,
