@@ -20,6 +20,9 @@ if TYPE_CHECKING:  # the cell imports this module
     from flipkit.config.cell import BurgerConfig, CellConfig, SpatulaConfig
 
 
+BLADE_FLEX = ("contact", "hinge")  # the simulated blade's flex (PhysicsConfig.blade_flex)
+
+
 @dataclass(frozen=True)
 class PhysicsConfig:
     """Simulation-only physics of the cell (MuJoCo scene, closed-loop execution).
@@ -70,6 +73,12 @@ class PhysicsConfig:
             structural damping is far below 1 (a struck blade rings); the squeezed oil film
             and the burger residue on a griddle add an unknown amount. No source: 1
             (critically damped: a pressed blade does not chatter), range 0.3-2 (ours).
+        blade_flex: How the simulated blade flexes (:mod:`flipkit.simulation.scene`, "Blade
+            flex"): ``"contact"`` (default), a rigid blade whose penetration of a compliant
+            blade-grill contact stands for the flex (the blade's faces then sink below the
+            grill's surface by the deflection); ``"hinge"``, the blade on a hinge at its neck
+            with the cantilever's tip stiffness, meeting the grill in a stiff contact (its tip
+            stays on the surface). A modelling choice, not a physical value.
         blade_tip_mass: Effective mass (kg) the blade tip presents along the grill normal,
             1/(J M⁻¹ Jᵀ) of the arm with its spatula at the tip, vertical row: measured on the
             scoops of the Table I plans 0.34-0.75 kg (the wrist's small inertia). 0.5 kg;
@@ -105,6 +114,7 @@ class PhysicsConfig:
     blade_modulus: float = 193e9
     blade_dampratio: float = 1.0
     blade_tip_mass: float = 0.5
+    blade_flex: str = "contact"
     timestep: float = 0.0005
     servo_rate_hz: float = 125.0
     latency_s: float = 0.008
@@ -122,6 +132,8 @@ class PhysicsConfig:
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1 or n % 2 == 0:
             raise ConfigError(f"physics burger_strips must be an odd integer >= 1 (1: a rigid "
                               f"disc), got {n!r}")
+        if self.blade_flex not in BLADE_FLEX:
+            raise InvalidChoiceError("physics blade_flex", self.blade_flex, BLADE_FLEX)
         if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
             raise ConfigError(f"physics latency_s must be >= 0 s, got {self.latency_s!r}")
         if self.edge_thickness >= self.blade_thickness:

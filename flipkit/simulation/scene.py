@@ -38,6 +38,18 @@ force is exactly k x whatever A is (tests/test_scene.py), and the instantaneous 
 push the constraint takes is A/(A + R) < 0.1 %. Friction on this pair stays Coulomb through
 the ``noslip`` iterations.
 
+Blade flex (``physics.blade_flex``). The contact above lets the rigid blade sink into the
+grill by the tip's deflection, so its faces go below the grill's surface: under the patty the
+tip's top face rode from 0.35 mm below to 0.8 mm above the grill over the Table I scoops, as
+the servo and the blade's roll shared the press. With ``"hinge"`` the blade is a body of its
+own on a hinge about its y axis at its neck (x = −l/2), of rotational stiffness k L² and
+damping b L² (:func:`hinge_flex`: the tip meets the cantilever's k and b, L the blade length),
+carrying the spatula's mass and inertia (moved there from the last link, so the arm's
+dynamics with the hinge at rest are the planner's). It meets the grill and the table in a
+stiff steel contact (:data:`STEEL_TIMECONST_STEPS`), so its tip stays on the surface and its
+faces above it. The spatula's mass swinging on the hinge rings at about 19 Hz (a 1 mm blade
+alone: 31 Hz); the hinge rotates the blade rigidly where a real one bends.
+
 Several burgers (``burgers=n`` > 1, a whole cook: :mod:`flipkit.simulation.cook`). Burger k is
 the body and geom ``burger_k``, with the same pairs as the single burger (blade, grill,
 table) and a pair with every other burger, so that burgers cannot pass through each other;
@@ -87,6 +99,10 @@ BLADE_IMPEDANCE = 0.01
 # edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
 # spring-damper, so that the pressed edge meets k and b in all.
 BLADE_EDGE_CONTACTS = 2
+# A flexing blade meets the grill and the table steel on steel: MuJoCo's stiffest recommended
+# contact, a time constant of two timesteps, critically damped (MuJoCo Modeling chapter,
+# solref: "not smaller than 2 times the physics timestep").
+STEEL_TIMECONST_STEPS = 2
 # Collision bit of the burgers' geoms in a several-burger scene: burger-burger contacts come from
 # MuJoCo's broad phase (a pair per strip pair would be thousands); every other geom has none.
 BURGER_BIT = 2
@@ -138,7 +154,9 @@ class Scene:
             surface height (m). geoms: ``{"blade", "grill", "burger", "table"}`` geom ids.
         burger_qpos, burger_qvel: Slices of the (first) burger's free joint in qpos / qvel.
         blade_contact: The blade-grill pair's physical ``stiffness`` (N/m) and ``damping``
-            (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them.
+            (N s/m) and the MuJoCo ``solref`` (−s, −c) and ``impedance`` d realising them;
+            on a flexing blade (``physics.blade_flex`` "hinge") the hinge's (:func:`hinge_flex`),
+            ``flex`` "hinge" and the stiff contact's ``solref``.
         burger_bodies: Root body id of each burger (one, or ``burgers`` of :func:`build_scene`);
             with several, ``geoms`` holds ``burger_k`` for each instead of ``burger``. A
             root is the patty's middle strip (:mod:`flipkit.simulation.patty`): its pose
@@ -234,14 +252,18 @@ def _joint_axis(joint) -> np.ndarray:
     raise ConfigError(f"scene supports revolute joints only, got {name}")
 
 
-def _arm_bodies(robot: Robot, sp_xml: str) -> str:
-    """Nested <body> elements of the six joints; ``sp_xml`` goes into the last one."""
+def _arm_bodies(robot: Robot, sp_xml: str, carried=None) -> str:
+    """Nested <body> elements of the six joints; ``sp_xml`` goes into the last one.
+    ``carried``: an inertia (last joint's frame) that a body in ``sp_xml`` carries instead of
+    the last link (the spatula, on a flexing blade)."""
     m = robot.model
     if m.njoints - 1 != ARM_JOINTS or any(m.parents[j] != j - 1 for j in range(1, m.njoints)):
         raise ConfigError(f"scene needs a serial {ARM_JOINTS}-joint arm, got {m.njoints - 1}")
     opened, close = [], []
     for j in range(1, m.njoints):
         M, I = m.jointPlacements[j], m.inertias[j]
+        if carried is not None and j == m.njoints - 1:
+            I = I - carried
         axis = _joint_axis(m.joints[j])
         full = I.inertia
         fi = _vec([full[0, 0], full[1, 1], full[2, 2], full[0, 1], full[0, 2], full[1, 2]])
@@ -303,13 +325,27 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     sp_pos, sp_quat = _vec(S.translation), _quat(S.rotation)
     flange = robot.model.frames[robot.model.getFrameId(cell.robot.tool_frame)].placement
     back = S.act(np.array([-sp.length / 2, 0.0, 0.0]))
+    hinge = ph.blade_flex == "hinge"
+    at = f' pos="{sp.length / 2:.12g} 0 0"' if hinge else ""  # the blade centre from the neck
+    blade = (f'<site name="spatula" size="0.005" rgba="1 0 0 1"{at}/>'
+             f'<geom name="blade" type="mesh" mesh="blade" contype="0" conaffinity="0" '
+             f'mass="0" rgba="0.78 0.8 0.84 1"{at}/>')
+    carried = None
+    if hinge:  # module docstring, "Blade flex": the spatula's mass moves onto the blade
+        body = robot.payload[0]["inertia_obj"]
+        carried = S.act(body)
+        flex = hinge_flex(cell)
+        full = body.inertia
+        fi = _vec([full[0, 0], full[1, 1], full[2, 2], full[0, 1], full[0, 2], full[1, 2]])
+        blade = (f'<body name="blade_flex" pos="{-sp.length / 2:.12g} 0 0">'
+                 f'<joint name="blade_flex" type="hinge" axis="0 1 0" limited="false" '
+                 f'stiffness="{flex["stiffness"]:.9g}" damping="{flex["damping"]:.9g}"/>'
+                 f'<inertial pos="{_vec(body.lever + [sp.length / 2, 0, 0])}" '
+                 f'mass="{body.mass:.12g}" fullinertia="{fi}"/>{blade}</body>')
     sp_xml = (
         f'<geom type="capsule" fromto="{_vec(flange.translation)} {_vec(back)}" size="0.008" '
         f'contype="0" conaffinity="0" rgba="0.15 0.15 0.15 1" mass="0"/>'
-        f'<body name="spatula" pos="{sp_pos}" quat="{sp_quat}">'
-        f'<site name="spatula" size="0.005" rgba="1 0 0 1"/>'
-        f'<geom name="blade" type="mesh" mesh="blade" contype="0" conaffinity="0" mass="0" '
-        f'rgba="0.78 0.8 0.84 1"/></body>')
+        f'<body name="spatula" pos="{sp_pos}" quat="{sp_quat}">{blade}</body>')
     tau_b = ph.burger_timeconst(bg, mass)
     r, h2 = bg.diameter / 2, bg.thickness / 2
     gx, gy = np.mean(gr.x_range), np.mean(gr.y_range)
@@ -324,6 +360,10 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                 f'friction="{f} {f} 0.001 0.0001 0.0001" '
                 f'solref="{solref[0]:.6g} {solref[1]:.6g}"{solimp}/>')
 
+    # the blade-grill and blade-table pairs: the flex's spring (solref set after compiling) or,
+    # on a flexing blade, steel on steel
+    steel = ((STEEL_TIMECONST_STEPS * ph.timestep, 1.0), None) if hinge else \
+        ((-1.0, -1.0), BLADE_IMPEDANCE)
     names = ["burger"] if burgers == 1 else [f"burger_{k}" for k in range(burgers)]
     soft = (tau_b, ph.burger_dampratio)
 
@@ -389,22 +429,25 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
     <geom name="table" type="box" size="{tsx:.6g} {tsy:.6g} 0.02"
           pos="{tx:.6g} {ty:.6g} {tb.height - 0.02:.6g}" contype="0" conaffinity="0"
           rgba="0.6 0.45 0.3 1"/>
-    {_arm_bodies(robot, sp_xml)}
+    {_arm_bodies(robot, sp_xml, carried)}
     {bodies}
   </worldbody>
   <contact>
-    {pair("blade", "grill", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
+    {pair("blade", "grill", ph.mu_blade_grill, *steel)}
     {pairs}
-    {pair("blade", "table", ph.mu_blade_grill, (-1.0, -1.0), BLADE_IMPEDANCE)}
+    {pair("blade", "table", ph.mu_blade_grill, *steel)}
     {excludes}
   </contact>
 </mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
-    contact = _blade_contact(model, cell)
-    for name in ("blade_grill", "blade_table"):
-        model.pair_solref[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)] = \
-            contact["solref"]
-    xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
+    if hinge:
+        contact = {**hinge_flex(cell), "flex": "hinge", "solref": steel[0]}
+    else:
+        contact = _blade_contact(model, cell)
+        for name in ("blade_grill", "blade_table"):
+            model.pair_solref[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)] = \
+                contact["solref"]
+        xml = xml.replace('solref="-1 -1"', 'solref="{:.9g} {:.9g}"'.format(*contact["solref"]))
     data = mujoco.MjData(model)
     gid = lambda n: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
     every = [g for n in names for g in parts[n]]
@@ -415,6 +458,16 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
                   tuple(tuple(gid(g) for g in parts[n]) for n in names), bool(sleep))
     mujoco.mj_forward(model, data)
     return scene
+
+
+def hinge_flex(cell: CellConfig) -> dict:
+    """The flexing blade's hinge (module docstring, "Blade flex"): the tip's physical
+    ``stiffness`` k (N/m) and ``damping`` b (N s/m) as the hinge's rotational stiffness
+    k L² (N m/rad) and damping b L² (N m s/rad), L the blade length from neck to tip."""
+    ph, sp = cell.physics, cell.spatula
+    k, b = ph.blade_stiffness(sp), ph.blade_damping(sp)
+    return {"tip_stiffness": k, "tip_damping": b, "stiffness": k * sp.length**2,
+            "damping": b * sp.length**2}
 
 
 def _blade_contact(model: mujoco.MjModel, cell: CellConfig) -> dict:
