@@ -56,3 +56,48 @@ def test_the_persistent_solver_adds_every_violated_row_in_one_round(monkeypatch)
     res, _, status, solved = D.run_osqp(driver, problem, 1e-8, None)
     assert solved and len(rounds) == 2 and rounds[1] - rounds[0] == n
     np.testing.assert_allclose(x.value, 1.0, atol=1e-6)
+
+
+def _constant_row_problem(u_shift=0.0):
+    """A condensed turn-back QP (tests/data/qp_constant_row.npz: min ½‖v‖² + qᵀv s.t.
+    A v ≤ u, 19 variables, 16 rows) whose row 9 is numerically zero (norm 1e-15) at its bound
+    (u = −2e-32): a row the equality rows fix, left by round-off."""
+    import cvxpy as cp
+    from pathlib import Path
+
+    data = np.load(Path(__file__).parent / "data" / "qp_constant_row.npz")
+    v = cp.Variable(19)
+    A, u, q = cp.Parameter((16, 19)), cp.Parameter(16), cp.Parameter(19)
+    A.value, q.value = data["A"], data["q"]
+    u.value = data["u"] + u_shift * (np.arange(16) == 9)
+    problem = cp.Problem(cp.Minimize(0.5 * cp.sum_squares(v) + q @ v), [A @ v <= u])
+    return problem, v, data
+
+
+def test_a_constant_row_is_left_out_of_the_working_set():
+    """With the constant row in its working set OSQP's ADMM blows up and reports the QP
+    primal infeasible (at eps 1e-6; the zero step is feasible). Left out, the driver solves
+    it, and its solution is OSQP's on the other rows."""
+    from flipkit.solvers import osqp_driver as D
+
+    problem, v, data = _constant_row_problem()
+    assert np.linalg.norm(data["A"][9]) < 1e-14 and abs(data["u"][9]) < 1e-30
+    driver = D.OSQPDriver(problem, compact=True)
+    _, _, status, solved = D.run_osqp(driver, problem, 1e-6, None)
+    assert solved, status
+    keep = np.arange(16) != 9
+    ref = osqp.OSQP(algebra="builtin")
+    ref.setup(sp.csc_matrix(np.eye(19)), data["q"], sp.csc_matrix(data["A"][keep]),
+              -np.inf * np.ones(15), data["u"][keep], eps_abs=1e-9, eps_rel=1e-9, verbose=False)
+    np.testing.assert_allclose(v.value, ref.solve(raise_error=False).x, atol=1e-5)
+
+
+def test_a_constant_row_that_fails_at_zero_stays_in():
+    """A constant row whose bound no step can meet (0 ≤ −1) is not left out: the QP is
+    infeasible, and the driver says so."""
+    from flipkit.solvers import osqp_driver as D
+
+    problem, _, _ = _constant_row_problem(u_shift=-1.0)
+    driver = D.OSQPDriver(problem, compact=True)
+    _, _, status, solved = D.run_osqp(driver, problem, 1e-6, None)
+    assert not solved and "infeasible" in status, status

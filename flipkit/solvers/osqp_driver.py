@@ -42,6 +42,14 @@ from flipkit.solvers.stdout_redirect import c_stdout_silenced
 import osqp
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
+# A row whose largest entry is below NULL_ROW times the largest row's is numerically zero: a
+# row that the equality rows fix (its gradient lies outside the condensed null space, e.g. a
+# bound on a state the endpoint rows pin), left at ~1e-15 by round-off. Handed to OSQP it
+# wrecks the ADMM (measured on a turn back's condensed QP: a row of norm 1e-15 at its bound
+# made OSQP report "primal infeasible" with iterates of 1e9 at rho 1 or eps 1e-6, where the
+# zero step was feasible; without the row it solved in 70-160 iterations). Such a row is
+# constant, so it is left out of the working set whenever its bounds hold at zero.
+NULL_ROW = 1e-10
 ADD_PER_ROUND = 10  # compact mode: most violated dropped rows added per round
 INITIAL_SLACK = 1e-2  # first working set: inequality rows this close to a bound at d = 0
 INITIAL_ROWS = 2  # working set carried between solves: at most this many rows per variable
@@ -199,23 +207,27 @@ class OSQPDriver:
             P, A = self._on_pattern(0, P), self._on_pattern(1, A)
         ineq = ~(l == u)
         cap = INITIAL_ROWS * A.shape[1]
+        size = abs(A).max(axis=1).toarray().ravel()
+        constant = size <= NULL_ROW * size.max(initial=0.0)
         if self._active is None:  # first solve: the rows within INITIAL_SLACK of a bound
             margin = np.where(ineq, np.minimum(u, -l), np.inf)
             self._active = _capped(margin <= INITIAL_SLACK, np.zeros(len(l)), margin, cap)
-        work = ~ineq | self._active
         tol = settings["eps_abs"] + settings["eps_rel"] * np.maximum(np.abs(np.where(np.isfinite(l), l, 0)),
                                                                      np.abs(np.where(np.isfinite(u), u, 0)))
+        constant &= (l <= tol) & (u >= -tol)  # held by every x: left out (NULL_ROW)
+        work = (~ineq | self._active) & ~constant
         total = 0
         for rnd in range(MAX_ROUNDS + 1):
             if rnd == MAX_ROUNDS:
-                work[:] = True
+                work[:] = ~constant
             round_solve = self._solve_compact if self.compact else self._solve_persistent
             res = round_solve(P, q, A, l, u, work, settings, rnd == 0)
             total += res.info.iter
             if res.x is None or not np.all(np.isfinite(res.x)):
                 break
             self._x, self._y = res.x, res.y
-            if res.info.status_val not in (1, 2) or work.all():  # solved (inaccurate) or full
+            if res.info.status_val not in (1, 2) or work.all() or rnd == MAX_ROUNDS:
+                # solved (inaccurate), or every row that is not constant was in
                 break
             z = A @ res.x
             viol = np.where(work, 0.0, np.maximum(l - z, z - u))
