@@ -1,5 +1,5 @@
-"""A single-burger scene lets a burger at rest sleep; the record keeps its contacts, and the
-blade wakes it."""
+"""A burger at rest sleeps; the records keep its contacts, the blade wakes it, and so does
+moving it (place, park) in a scene of several burgers."""
 
 import mujoco
 import numpy as np
@@ -75,8 +75,6 @@ def test_the_blade_wakes_a_sleeping_burger(bare, flip_plan):
     scene, _, awake = _rest(bare, sleep=True, steps=100, xy=p_b[:2])
     d, root = scene.data, scene.burger_bodies[0]
     assert not awake[-1]
-    with pytest.raises(ConfigError, match="sleeping burger"):
-        place_burger(scene, p_b[:2])  # writing its state would not wake it: it would hang
     before = d.xpos[root].copy()
     q_under = _raised(bare, flip_plan.segment("scoop").q[-1], 0.004)  # into the burger's bottom
     _hold_arm(scene, q_under)
@@ -86,8 +84,32 @@ def test_the_blade_wakes_a_sleeping_burger(bare, flip_plan):
     assert d.xpos[root][2] - before[2] > 2e-4  # simulated again: the blade lifted it
 
 
-def test_several_burgers_never_sleep(bare):
-    assert not build_scene(bare, burgers=2).sleeps
-    assert build_scene(bare).sleeps and not build_scene(bare, sleep=False).sleeps
-    with pytest.raises(ConfigError, match="cannot sleep"):
-        build_scene(bare, burgers=2, sleep=True)
+def test_moving_a_sleeping_burger_wakes_it(bare):
+    """In a scene of two burgers (the cook's), a burger asleep on the grill is put elsewhere,
+    3 cm up, and another is parked asleep and then placed: each wakes, falls and lies where it
+    was put, and the cook's record keeps a sleeping burger's grill contact."""
+    from flipkit.simulation.cook_record import CookRecorder
+    from flipkit.simulation.scene import park_burger
+
+    scene = build_scene(bare, burgers=2)
+    assert scene.sleeps and not build_scene(bare, burgers=2, sleep=False).sleeps
+    d, (b0, b1) = scene.data, scene.burger_bodies
+    place_burger(scene, (0.70, -0.10), q=bare.cell.robot.q_home, burger=0)
+    rec = CookRecorder(scene, [], dt=scene.model.opt.timestep)
+    for _ in range(300):
+        _hold_arm(scene, bare.cell.robot.q_home)
+        flags = rec._contacts()  # as rec.sample does at every step
+    assert not d.body_awake[b0] and not d.body_awake[b1]  # on the grill, and parked
+    own = set(scene.burger_geoms[0])
+    assert not any(a in own or b in own for a, b, _ in scene.contacts())  # MuJoCo skips it
+    assert flags[0][1] and flags[0][3] > 0  # the record still has it on the grill
+    place_burger(scene, (0.78, 0.05), burger=0, height=bare.cell.grill.height + 0.03)
+    place_burger(scene, (0.65, -0.30), burger=1)
+    assert d.body_awake[b0] and d.body_awake[b1]
+    for _ in range(400):
+        _hold_arm(scene, bare.cell.robot.q_home)
+    rest = bare.cell.grill.height + bare.cell.burger.thickness / 2
+    np.testing.assert_allclose(d.xpos[b0], [0.78, 0.05, rest], atol=2e-3)  # fell 3 cm
+    np.testing.assert_allclose(d.xpos[b1], [0.65, -0.30, rest], atol=2e-3)
+    park_burger(scene, 1)
+    assert d.body_awake[b1]

@@ -181,7 +181,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
     records = timeline.burgers
     index = {b.burger.burger: k for k, b in enumerate(records)}
     n = len(records)
-    scene = build_scene(robot, cell, burgers=n, sleep=False)  # it places burgers as it runs
+    scene = build_scene(robot, cell, burgers=n)
     m, d = scene.model, scene.data
     control = ArmController.of(robot, cell.physics, mode, rate_hz, m.opt.timestep)
     dt = control.substeps * m.opt.timestep

@@ -68,6 +68,7 @@ class CookRecorder:
         self.frames: list = []
         self.next_frame = -np.inf
         self._open = np.zeros(n, bool)
+        self._flags = [[False, False, 0.0, 0.0] for _ in range(n)]  # the last step's, per burger
 
     def placed(self, k: int) -> None:
         """Burger k was put into the cell (at rest): it lies there from now on."""
@@ -121,9 +122,13 @@ class CookRecorder:
 
     def _contacts(self) -> list:
         """Per burger ``[touch blade, touch grill, blade force N, grill force N]`` of the last
-        step's contacts; burger–burger contact time accumulated."""
+        step's contacts; burger–burger contact time accumulated. A sleeping burger is not in
+        MuJoCo's contact list: it lies as it fell asleep, so its flags are the previous
+        step's (as :class:`~flipkit.simulation.trace.BurgerTrace` keeps them)."""
         sc, g = self.scene, self.scene.geoms
-        out = [[False, False, 0.0, 0.0] for _ in sc.burger_bodies]
+        awake = sc.data.body_awake[np.asarray(sc.burger_bodies)]
+        out = [[False, False, 0.0, 0.0] if awake[k] else list(self._flags[k])
+               for k in range(len(sc.burger_bodies))]
         touching = set()
         for a, b, force in sc.contacts():
             ka, kb = self.owner[a], self.owner[b]
@@ -138,6 +143,7 @@ class CookRecorder:
             out[k][j + 2] += force
         for k in touching:
             self.contact_s[k] += self.dt
+        self._flags = out
         return out
 
 

@@ -61,16 +61,18 @@ the cook simulation, not relied on. All n start *parked* (:func:`park_burger`): 
 ``burger=k`` puts one at rest on the grill (or table) and gives it back its weight. With one
 burger (the default) the scene is unchanged: body and geom ``burger``, on the grill.
 
-Sleeping (one burger). A burger lying still on the grill costs a step as much as one being
-scooped: its five strips keep about twenty contacts. A single-burger scene therefore lets
-MuJoCo put a burger at rest to sleep (``<flag sleep="enable"/>``): a tree whose speed stays
-below :data:`SLEEP_TOLERANCE` for MuJoCo's ``mjMINAWAKE`` steps is frozen and skipped until an
-awake body touches it (the blade arriving), when it is simulated again. The arm never sleeps
-(``sleep="never"``). A frozen burger keeps the contacts it fell asleep with: the record of a
-run (:class:`~flipkit.simulation.trace.BurgerTrace`) carries them on, so the judges still see
+Sleeping. A burger lying still on the grill costs a step as much as one being scooped: its
+five strips keep about twenty contacts. The scene therefore lets MuJoCo put a burger at rest
+to sleep (``<flag sleep="enable"/>``): a tree whose speed stays below
+:data:`SLEEP_TOLERANCE` for MuJoCo's ``mjMINAWAKE`` steps is frozen and skipped until an awake
+body touches it (the blade arriving), when it is simulated again. The arm never sleeps
+(``sleep="never"``). A frozen burger keeps the contacts it fell asleep with: the records of
+a run (:class:`~flipkit.simulation.trace.BurgerTrace`,
+:class:`~flipkit.simulation.cook_record.CookRecorder`) carry them on, so the judges still see
 it lying on the grill. A step costs about half as much (27 µs against 52 µs over a Table I
-flip). Scenes of several burgers do not sleep: the cook moves burgers by writing their state (:func:`place_burger`,
-:func:`park_burger`), which does not wake a sleeping tree.
+flip). :func:`place_burger` and :func:`park_burger` wake the burger they move: they write
+−0.0 into its velocities, MuJoCo's documented wake signal (a non-zero bit pattern that is
+zero), besides its new pose.
 """
 
 from __future__ import annotations
@@ -298,21 +300,16 @@ def build_scene(robot: Robot | None = None, cell: CellConfig | None = None, *,
         mass: Burger mass (kg); default ``cell.burger.mass``.
         burgers: Number of burgers, ≥ 1. One: the burger lies at ``burger_xy``. Several:
             all start parked (module docstring); ``burger_xy`` must be ``None``.
-        sleep: Let a burger at rest sleep (module docstring); default with one burger only.
+        sleep: Let a burger at rest sleep (module docstring); default ``True``.
 
     Raises:
-        ConfigError: ``burgers`` not a positive integer, ``burger_xy`` with several, or
-            ``sleep`` with several.
+        ConfigError: ``burgers`` not a positive integer, or ``burger_xy`` with several.
     """
     if isinstance(burgers, bool) or not isinstance(burgers, (int, np.integer)) or burgers < 1:
         raise ConfigError(f"burgers must be a positive integer, got {burgers!r}")
     if burgers > 1 and burger_xy is not None:
         raise ConfigError("burger_xy places the single burger; several start parked")
-    if sleep is None:
-        sleep = burgers == 1
-    if sleep and burgers > 1:
-        raise ConfigError("a scene of several burgers cannot sleep: the cook moves burgers by "
-                          "writing their state, which does not wake them")
+    sleep = True if sleep is None else bool(sleep)
     robot = robot or Robot(cell, with_burger=False)
     cell = cell or robot.cell
     ph, sp, bg, gr, tb = cell.physics, cell.spatula, cell.burger, cell.grill, cell.table
@@ -509,7 +506,6 @@ def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | N
             yaw 0 whatever it is: the disc is symmetric, and turning its 32-gon mesh would
             only move its contact points.
     """
-    _awake(scene, burger)
     d, h2 = scene.data, scene.robot.cell.burger.thickness / 2
     if q is not None:
         d.qpos[:ARM_JOINTS] = q
@@ -518,17 +514,17 @@ def place_burger(scene: Scene, xy, q=None, *, burger: int = 0, height: float | N
         heading = 0.0
     c, s_ = np.cos(heading / 2), np.sin(heading / 2)
     d.qpos[scene.qpos_of(burger)] = [*np.asarray(xy, float)[:2], surface + h2, c, 0, 0, s_]
-    d.qvel[scene.qvel_of(burger)] = 0.0
     _rest_hinges(scene, burger, gravcomp=0.0)
+    _wake(scene, burger)
     mujoco.mj_forward(scene.model, d)
 
 
-def _awake(scene: Scene, burger: int) -> None:
-    """Raise :class:`ConfigError` if burger ``burger`` sleeps: writing its state would not wake
-    it, and it would hang where it was put (module docstring)."""
-    if scene.sleeps and not scene.data.body_awake[scene.burger_bodies[burger]]:
-        raise ConfigError("cannot place a sleeping burger: build the scene with sleep=False "
-                          "to move burgers during a run")
+def _wake(scene: Scene, burger: int) -> None:
+    """Burger ``burger`` at rest and awake: −0.0 in its velocities, MuJoCo's wake signal
+    (module docstring)."""
+    _, va = scene.hinges_of(burger)
+    scene.data.qvel[scene.qvel_of(burger)] = -0.0
+    scene.data.qvel[va] = -0.0
 
 
 def _rest_hinges(scene: Scene, burger: int, gravcomp: float) -> None:
@@ -551,6 +547,6 @@ def park_burger(scene: Scene, burger: int) -> None:
         raise ConfigError("only a scene of several burgers parks them (build_scene(burgers=n))")
     d = scene.data
     d.qpos[scene.qpos_of(burger)] = [*_park_position(burger), 1, 0, 0, 0]
-    d.qvel[scene.qvel_of(burger)] = 0.0
     _rest_hinges(scene, burger, gravcomp=1.0)
+    _wake(scene, burger)
     mujoco.mj_forward(scene.model, d)
