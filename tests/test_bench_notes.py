@@ -1,4 +1,7 @@
-"""The translate bench says why a peer's iterations exceed 1.5 × exact IPOPT's."""
+"""The translate bench says why a peer's iterations exceed 1.5 × exact IPOPT's, and names
+the machine it ran on."""
+
+from pathlib import Path
 
 from flipkit.experiments.bench import TRANSLATE_SOLVERS
 from flipkit.experiments.iteration_notes import ITERATION_RATIO, iteration_notes
@@ -31,3 +34,22 @@ def test_a_peer_without_a_profile_is_said_to_be_so():
     rows = [{"ipopt_exact": _row(20, None), "ipopt": _row(50, None)}]
     med = {"ipopt_exact": {"iterations": 20.0}, "ipopt": {"iterations": 50.0}}
     assert iteration_notes(rows, names, med, TRANSLATE_SOLVERS)[0].endswith("not profiled")
+
+
+def test_the_machine_line_names_the_cpu_and_its_simd_kernels():
+    """The bench's machine line names the CPU model (from /proc/cpuinfo) and whether numpy's
+    loops use AVX-512, on which the last bits of a plan depend."""
+    from numpy._core._multiarray_umath import __cpu_features__
+
+    from flipkit.experiments import bench
+
+    line = bench.machine()
+    assert line.startswith("machine: ") and "Python " in line
+    simd = ", AVX-512" if __cpu_features__.get("AVX512_SKX") else ", no AVX-512"
+    assert bench.cpu_model().endswith(simd)
+    model = Path("/proc/cpuinfo")
+    if model.is_file():
+        names = [ln.split(":", 1)[1].strip() for ln in model.read_text().splitlines()
+                 if ln.startswith("model name")]
+        if names:
+            assert bench.cpu_model() == names[0] + simd

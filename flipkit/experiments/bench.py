@@ -40,6 +40,7 @@ import sys
 import time
 import warnings
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 
@@ -83,9 +84,29 @@ PAPER_FIVE_BURGERS_S = 90.0  # Sec. I: 4–5 burgers within 90 s
 PAPER_EE_OPT_S = 1.0  # Sec. I: the end-effector optimisation takes < 1 s
 
 
+def cpu_model() -> str:
+    """The CPU's model name (Linux ``/proc/cpuinfo``; else ``platform.processor()``), and
+    whether numpy's SIMD loops use AVX-512: the floating-point kernels, on which the last bits
+    of a plan depend; ``?`` where unknown."""
+    name = platform.processor() or "?"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        from numpy._core._multiarray_umath import __cpu_features__
+        name += ", AVX-512" if __cpu_features__.get("AVX512_SKX") else ", no AVX-512"
+    except ImportError:  # pragma: no cover - another numpy layout
+        pass
+    return name
+
+
 def machine() -> str:
-    """One line: CPU count, platform, Python, BLAS/OpenMP thread setting."""
-    return (f"machine: {os.cpu_count()} CPUs, {platform.platform()}, {platform.processor() or '?'}"
+    """One line: CPU count, platform, CPU model, Python, BLAS/OpenMP thread setting."""
+    return (f"machine: {os.cpu_count()} CPUs, {platform.platform()}, {cpu_model()}"
             f", Python {platform.python_version()}, OMP_NUM_THREADS="
             f"{os.environ.get('OMP_NUM_THREADS', 'unset')}")
 
