@@ -91,9 +91,12 @@ class PhysicsConfig:
             The paper's arm is unnamed: CB3 rate 125 Hz, range 125-500 Hz.
         latency_s: Delay (s) between a desired state and its arrival at the joint servo in
             ``position`` mode. One 125 Hz period of transport plus one of the controller's
-            cycle is 16 ms; the UR10 performance analysis of DTU (Ravn, Andersen, Andersen
-            2014, "UR10 Performance Analysis", orbit.dtu.dk) measures the real-time
-            interface's delays, its number was not read here: 8 ms, range 2-20 ms (ours).
+            cycle is 16 ms. Measured on a UR10e streaming at 500 Hz, a target echoed back
+            without ``servoj`` returned 4-6 ms later (UniversalRobots/
+            Universal_Robots_Client_Library issue 86, cross-correlation); through ``servoj``
+            with a lookahead time of 0.03 s, 34 ms: its smoothing, which this model does not
+            have (docs/benchmarks/2026-11-27-servoj-lookahead.md). 8 ms, range 2-20 ms
+            (ours, around the measured transport).
         kp, kd: Joint PD gains (N m/rad, N m s/rad), the values of
             :data:`flipkit.simulation.tracking.DEFAULT_KP` / ``DEFAULT_KD`` (about critical damping at
             q_home, stated there); UR does not publish its servo gains.
@@ -209,8 +212,9 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
     "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
-    "physics.latency_s": (0.002, 0.020, _NO_SOURCE + " (UR10 Performance Analysis, DTU 2014, "
-                          "measures it; not read)"),
+    "physics.latency_s": (0.002, 0.020, "UR10e at 500 Hz: 4-6 ms from sent to reported, "
+                          "without servoj's smoothing (Universal_Robots_Client_Library issue "
+                          "86); range ours around it"),
 }
 """Plausible range (lo, hi) of each physical parameter, with its source text: the values a
 sensitivity study sweeps one at a time (see :func:`with_parameter`)."""
