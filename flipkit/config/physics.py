@@ -103,6 +103,14 @@ class PhysicsConfig:
         servo_gain_scale: Factor on ``kp`` and ``kd`` of the simulated servo: the real gains
             are unknown, while the commands of :mod:`flipkit.planning.plans.servo_command` are
             computed with the nominal ones. 1; range 0.5-2 (no source: UR publishes none).
+        servo_lookahead_s: Smoothing (s) of the ``position`` commands between their
+            servo-rate samples and the joint PD: UR's ``servoj`` ``lookahead_time``
+            ([0.03, 0.2] s, URScript manual), modelled as a first-order low-pass of that time
+            constant (the form is ours; UR publishes none). The cell sets it, so the
+            compensated commands are made for it
+            (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0 (default): no
+            smoothing, the held commands reach the PD as they are
+            (docs/benchmarks/2026-11-27-servoj-lookahead.md).
     """
 
     mu_grill: float = 0.5
@@ -124,6 +132,7 @@ class PhysicsConfig:
     kp: tuple = (2000.0, 2000.0, 1000.0, 300.0, 300.0, 50.0)
     kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
     servo_gain_scale: float = 1.0
+    servo_lookahead_s: float = 0.0
 
     def __post_init__(self):
         for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
@@ -137,8 +146,11 @@ class PhysicsConfig:
                               f"disc), got {n!r}")
         if self.blade_flex not in BLADE_FLEX:
             raise InvalidChoiceError("physics blade_flex", self.blade_flex, BLADE_FLEX)
-        if not (math.isfinite(self.latency_s) and self.latency_s >= 0):
-            raise ConfigError(f"physics latency_s must be >= 0 s, got {self.latency_s!r}")
+        for name in ("latency_s", "servo_lookahead_s"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value)
+                    and value >= 0):
+                raise ConfigError(f"physics {name} must be >= 0 s, got {value!r}")
         if self.edge_thickness >= self.blade_thickness:
             raise ConfigError("physics edge_thickness must be below blade_thickness, got "
                               f"{self.edge_thickness} >= {self.blade_thickness}")
@@ -183,9 +195,9 @@ class PhysicsConfig:
         return max(tau, 2 * self.timestep)
 
 
-# PhysicsConfig fields that are numerical settings of the simulation: no plan depends on them
-# (the atlas's staleness hash leaves them out)
-SIMULATION_ONLY = ("burger_strips",)
+# PhysicsConfig fields that no plan depends on: numerical settings of the simulation and how
+# the simulated servo treats its commands (the atlas's staleness hash leaves them out)
+SIMULATION_ONLY = ("burger_strips", "servo_lookahead_s")
 
 _NO_SOURCE = "no source found; range ours"
 PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time

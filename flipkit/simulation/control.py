@@ -2,7 +2,8 @@
 
 A plan becomes :class:`References` on the controller's clock (:func:`plan_references`): the
 desired state (per-segment cubic Hermite q, q̇; linear u) and, in position mode, the delayed,
-servo-rate commands the robot's PD receives. :class:`ArmController` turns the measured state
+servo-rate commands the robot's PD receives (smoothed first where the servo smooths them,
+``physics.servo_lookahead_s``). :class:`ArmController` turns the measured state
 into joint torques (the two controllers of :mod:`flipkit.simulation.execute`), and
 :func:`step_references` runs one plan on a scene as it is, whatever else the scene holds:
 :func:`~flipkit.simulation.execute.execute_plan` on a one-burger cell, the cook simulation
@@ -11,7 +12,7 @@ into joint torques (the two controllers of :mod:`flipkit.simulation.execute`), a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import mujoco
@@ -20,7 +21,8 @@ import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.model.robot import Robot
-from flipkit.planning.plans.servo_command import command_lead, position_command
+from flipkit.planning.plans.servo_command import (command_lead, lookahead_command,
+                                                  position_command, smoothed)
 from flipkit.simulation.modes import FEEDFORWARD, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene
 
@@ -35,11 +37,27 @@ def pause_steps(wall_s: float, dt: float) -> float:
     return dt * np.ceil(wall_s / dt - 1e-9)
 
 
-def desired(plan, t: np.ndarray):
+def hold_torque(plan) -> np.ndarray:
+    """The torque (N·m) that holds the plan's final configuration at rest: gravity of the
+    model of its last segment (with the payload that segment carries).
+
+    A plan ends at rest (q̇ = 0), but its last node's torque includes M q̈ of an acceleration
+    that ends there; held after the plan, that torque moved the arm on (measured after a
+    serve's return home: 2.2 cm at the blade within 0.1 s, towards a rest Kp⁻¹ M q̈ away in
+    position mode, 0.04 rad at the elbow)."""
+    last = plan.segments[-1]
+    return np.asarray(plan.robot_for(last).inverse_dynamics(
+        last.q[-1], np.zeros_like(last.q[-1]), np.zeros_like(last.q[-1])), float)
+
+
+def desired(plan, t: np.ndarray, accelerations: bool = False, hold_u=None):
     """Plan's desired q, q̇ (per-segment cubic Hermite) and u (per-segment linear) at times t
-    (s, from 0); after the last segment the final q with q̇ = 0 and the final u."""
+    (s, from 0); after the last segment the final q with q̇ = 0 and ``hold_u`` (default the
+    final u; :func:`hold_torque` holds it at rest). With ``accelerations``, also q̈ (the
+    splines' second derivative; 0 after the plan), last."""
     n, start = len(t), 0.0
     q, qd, u = np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS)), np.zeros((n, ARM_JOINTS))
+    qdd = np.zeros((n, ARM_JOINTS)) if accelerations else None
     bounds = {}
     for seg in plan.segments:
         ts = start + seg.t - seg.t[0]
@@ -47,12 +65,18 @@ def desired(plan, t: np.ndarray):
         spl = CubicHermiteSpline(ts, seg.q, seg.qd, axis=0)
         tt = np.clip(t[sel], ts[0], ts[-1])
         q[sel], qd[sel] = spl(tt), spl(tt, 1)
+        if accelerations:
+            qdd[sel] = spl(tt, 2)
         u[sel] = np.column_stack([np.interp(tt, ts, seg.u[:, j]) for j in range(ARM_JOINTS)])
         bounds[seg.name] = (float(ts[0]), float(ts[-1]))
         start = float(ts[-1])
     after = t > start + 1e-12
     last = plan.segments[-1]
-    q[after], qd[after], u[after] = last.q[-1], 0.0, last.u[-1]
+    q[after], qd[after] = last.q[-1], 0.0
+    u[after] = last.u[-1] if hold_u is None else hold_u
+    if accelerations:
+        qdd[after] = 0.0
+        return q, qd, u, bounds, qdd
     return q, qd, u, bounds
 
 
@@ -90,12 +114,16 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
         hold: Time (s) the last desired state is held after the plan.
         servo: The cell's model of its servo, which the commands use (a
             :class:`~flipkit.config.PhysicsConfig`); default the plan's nominal one
-            (``plan.cell().physics``).
+            (``plan.cell().physics``). Its smoothing is taken from ``physics``
+            (``servo_lookahead_s``): the cell sets it.
     """
     nominal = plan.cell().physics if servo is None else servo
+    # the servo's smoothing is the cell's own setting (servoj's lookahead): always known
+    nominal = replace(nominal, servo_lookahead_s=physics.servo_lookahead_s)
     T = sum(float(s.t[-1] - s.t[0]) for s in plan.segments) + pause
     t = dt * np.arange(int(np.floor((T + hold) / dt + 1e-9)) + 1)
-    q_des, qd_des, u_ff, bounds = desired(plan, paused(t, t_pause, pause))
+    rest = hold_torque(plan)  # after the plan: its final configuration held at rest
+    q_des, qd_des, u_ff, bounds = desired(plan, paused(t, t_pause, pause), hold_u=rest)
     bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
                   b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
     if mode == POSITION:  # servo-rate samples, arriving latency_s late, zero-order hold
@@ -103,9 +131,13 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
             / physics.servo_rate_hz
         lead = command_lead(nominal) if command == "compensated" else 0.0
         sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
-        q_s, qd_s, u_s, _ = desired(plan, paused(sent + lead, t_pause, pause))
-        q_cmd, qd_cmd = (c[held] for c in position_command(q_s, qd_s, u_s, robot.model,
-                                                           nominal, command))
+        q_s, qd_s, u_s, _, qdd_s = desired(plan, paused(sent + lead, t_pause, pause), True,
+                                           hold_u=rest)
+        q_c, qd_c = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
+        if command == "compensated":  # made for the servo's smoothing, as the cell sets it
+            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s, sent, nominal)
+        tau = physics.servo_lookahead_s  # the servo smooths the held stream (if it does)
+        q_cmd, qd_cmd = smoothed(q_c[held], dt, tau), smoothed(qd_c[held], dt, tau)
     else:
         q_cmd, qd_cmd = q_des, qd_des
     return References(t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd)

@@ -21,6 +21,10 @@ burger included while carried), delivered through the position interface. The ti
 sample will act is the send time plus the transport latency plus half a servo period (the
 middle of its hold). The compensation uses the nominal servo model; its gains, rate and
 latency are uncertain and swept by the sensitivity study.
+
+A servo that smooths its commands (``servo_lookahead_s`` > 0, UR's ``servoj`` lookahead)
+passes them through a first-order low-pass (:func:`smoothed`) before its PD; the commands are
+then made for it by the filter's inverse (:func:`lookahead_command`).
 """
 
 from __future__ import annotations
@@ -32,6 +36,43 @@ from flipkit.errors import ConfigError, InvalidChoiceError
 
 COMMANDS = ("compensated", "raw")
 """``compensated``: q_c as in the module docstring; ``raw``: the plan's (q, q̇) as they are."""
+
+
+def lookahead_command(q_c, qd_c, qdd, t, physics) -> tuple[np.ndarray, np.ndarray]:
+    """Commands made for the servo's smoothing (``physics.servo_lookahead_s`` = τ, a
+    first-order low-pass y' = (x − y)/τ between the commands and the PD): its inverse,
+    x = q_c + τ q̇_c and ẋ = q̇ + τ q̈, so that the smoothed command is (q_c, q̇) where the
+    plan is smooth. q̇_c is the rate of the command itself (finite differences over the
+    samples: it includes the rate of the torque compensation), q̈ the plan's. τ = 0 or a
+    single sample: the commands as they are.
+
+    Args:
+        q_c, qd_c: Commands (rad, rad/s), n×nq (:func:`position_command`).
+        qdd: The plan's accelerations (rad/s²) at the samples, n×nq.
+        t: The samples' times (s), increasing, n.
+        physics: The cell's model of its servo (:class:`~flipkit.config.PhysicsConfig`).
+    """
+    tau = float(physics.servo_lookahead_s)
+    q_c, qd_c = np.asarray(q_c, float), np.asarray(qd_c, float)
+    if tau == 0.0 or len(q_c) < 2:
+        return q_c, qd_c
+    rate = np.gradient(q_c, np.asarray(t, float), axis=0)
+    return q_c + tau * rate, qd_c + tau * np.asarray(qdd, float)
+
+
+def smoothed(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """The servo's smoothing of a command stream ``x`` (n×nq) sampled every ``dt`` s: the
+    first-order low-pass of time constant ``tau`` (s), exact for a stream held between
+    samples, starting at x[0]; ``tau`` = 0: ``x``."""
+    x = np.asarray(x, float)
+    if tau == 0.0 or len(x) == 0:
+        return x
+    a = -np.expm1(-dt / tau)
+    y = np.empty_like(x)
+    y[0] = x[0]
+    for k in range(1, len(x)):
+        y[k] = y[k - 1] + a * (x[k - 1] - y[k - 1])
+    return y
 
 
 def command_lead(physics) -> float:
@@ -67,4 +108,4 @@ def position_command(q_d, qd_d, u_d, controller_model, physics,
     return q_d + (u_d - gravity) / kp, qd_d.copy()
 
 
-__all__ = ["COMMANDS", "command_lead", "position_command"]
+__all__ = ["COMMANDS", "command_lead", "lookahead_command", "position_command", "smoothed"]

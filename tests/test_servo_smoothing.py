@@ -1,0 +1,94 @@
+"""The held state after a plan, and the servo's optional smoothing of position commands
+(``physics.servo_lookahead_s``, UR's servoj lookahead)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from flipkit.config import CellConfig, PhysicsConfig
+from flipkit.errors import ConfigError
+from flipkit.model.robot import Robot
+from flipkit.planning.plans.servo_command import lookahead_command, smoothed
+from flipkit.simulation.control import hold_torque, plan_references
+
+
+@pytest.fixture(scope="module")
+def bare():
+    return Robot(CellConfig(), with_burger=False)
+
+
+def test_after_the_plan_its_final_configuration_is_held_at_rest(flip_plan, bare):
+    """After the plan the desired torque is gravity at the final configuration (not the last
+    node's torque, which carries M q̈ of an acceleration ending there), so position commands
+    are the final q itself."""
+    last = flip_plan.segments[-1]
+    g = bare.inverse_dynamics(last.q[-1], np.zeros(6), np.zeros(6))
+    np.testing.assert_allclose(hold_torque(flip_plan), g, atol=1e-9)
+    assert np.abs(last.u[-1] - g).max() > 1.0  # the last node is not static
+    ph = flip_plan.cell().physics
+    refs = plan_references(flip_plan, bare, ph, "position", "compensated", 1e-3, 0.2)
+    after = refs.t > flip_plan.duration + ph.latency_s + 2.0 / ph.servo_rate_hz
+    assert after.sum() > 100
+    np.testing.assert_allclose(refs.u_ff[after], np.tile(g, (after.sum(), 1)), atol=1e-9)
+    np.testing.assert_allclose(refs.q_cmd[after], np.tile(last.q[-1], (after.sum(), 1)),
+                               atol=1e-9)
+
+
+def test_a_negative_or_unfinite_lookahead_is_refused():
+    for bad in (-0.01, float("nan"), float("inf")):
+        with pytest.raises(ConfigError, match="servo_lookahead_s"):
+            PhysicsConfig(servo_lookahead_s=bad)
+
+
+def test_the_smoothing_is_a_first_order_low_pass_of_the_held_stream():
+    """A unit step held from sample 1 on reaches 1 − exp(−k dt/τ) k samples later."""
+    dt, tau = 1e-3, 0.03
+    x = np.ones((200, 1))
+    x[0] = 0.0
+    y = smoothed(x, dt, tau)
+    k = np.arange(200)
+    want = np.where(k == 0, 0.0, 1.0 - np.exp(-(k - 1) * dt / tau))
+    np.testing.assert_allclose(y[:, 0], want, atol=1e-12)
+    assert smoothed(x, dt, 0.0) is not None and np.array_equal(smoothed(x, dt, 0.0), x)
+
+
+def test_commands_made_for_the_smoothing_come_out_of_it_as_planned():
+    """A smooth command stream, its filter inverse applied, leaves the low-pass within a
+    small fraction of the lag the plain stream gets."""
+    dt, tau = 1e-3, 0.03
+    t = np.arange(0, 1.0, dt)
+    q = np.sin(2 * np.pi * t)[:, None]
+    qd = (2 * np.pi * np.cos(2 * np.pi * t))[:, None]
+    qdd = (-(2 * np.pi) ** 2 * np.sin(2 * np.pi * t))[:, None]
+    ph = PhysicsConfig(servo_lookahead_s=tau)
+    x, v = lookahead_command(q, qd, qdd, t, ph)
+    late = t > 5 * tau  # after the start transient
+    plain = np.abs(smoothed(q, dt, tau) - q)[late].max()
+    made = np.abs(smoothed(x, dt, tau) - q)[late].max()
+    assert plain > 0.1 and made < 0.02 * plain
+    assert np.abs(smoothed(v, dt, tau) - qd)[late].max() < 0.02 * np.abs(
+        smoothed(qd, dt, tau) - qd)[late].max()
+    same = lookahead_command(q, qd, qdd, t, PhysicsConfig())
+    assert np.array_equal(same[0], q) and np.array_equal(same[1], qd)
+
+
+def test_the_smoothing_reaches_the_pd_and_the_commands_are_made_for_it(flip_plan, bare):
+    """With a lookahead the PD's references are the smoothed stream of commands made for the
+    smoothing: close to the unsmoothed model's commands once under way; without one, the
+    references are exactly today's."""
+    ph = flip_plan.cell().physics
+    args = (flip_plan, bare)
+    plain = plan_references(*args, ph, "position", "compensated", 1e-3, 0.2)
+    again = plan_references(*args, replace(ph, servo_lookahead_s=0.0), "position",
+                            "compensated", 1e-3, 0.2)
+    assert np.array_equal(plain.q_cmd, again.q_cmd)
+    smooth = plan_references(*args, replace(ph, servo_lookahead_s=0.03), "position",
+                             "compensated", 1e-3, 0.2)
+    raw = plan_references(*args, replace(ph, servo_lookahead_s=0.03), "position", "raw",
+                          1e-3, 0.2)
+    busy = (plain.t > 0.2) & (plain.t < flip_plan.duration)
+    rms = lambda d: np.sqrt(np.mean(d[busy] ** 2, axis=0))  # noqa: E731  (rad, per joint)
+    made = rms(smooth.q_cmd - plain.q_cmd)
+    lagged = rms(raw.q_cmd - plan_references(*args, ph, "position", "raw", 1e-3, 0.2).q_cmd)
+    assert np.all(made < 0.2 * lagged), (made, lagged)  # measured 0.06-0.09 x
