@@ -224,6 +224,8 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
     "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
+    "physics.servo_lookahead_s": (0.03, 0.2, "servoj lookahead_time 0.03-0.2 s (URScript "
+                                  "manual); its smoothing's form ours; nominal 0: none"),
     "physics.latency_s": (0.002, 0.020, "UR10e at 500 Hz: 4-6 ms from sent to reported, "
                           "without servoj's smoothing (Universal_Robots_Client_Library issue "
                           "86); range ours around it"),
@@ -233,14 +235,15 @@ sensitivity study sweeps one at a time (see :func:`with_parameter`)."""
 
 
 KNOWN_PARAMETERS = ("physics.blade_thickness", "physics.bevel_length", "physics.edge_thickness",
-                    "physics.servo_rate_hz")
+                    "physics.servo_rate_hz", "physics.servo_lookahead_s")
 """The parameters of :data:`PHYSICAL_RANGES` that a cell knows: it chose its spatula (the
 blade's geometry) and its robot controller (the servo rate: a CB-series arm streams at
-125 Hz, an e-Series at 500 Hz). The others it cannot measure: the burger, the frictions, the
-contact damping, the servo's gains and latency. A plan is made for what the cell knows. The
-planner models the blade as its top face with a 3 mm collision box (``spatula.thickness``,
-an envelope of the blade's thickness range), so the blade's geometry does not change a plan.
-The servo rate changes the position commands (:func:`known_physics`)."""
+125 Hz, an e-Series at 500 Hz; the ``servoj`` lookahead it sends). The others it cannot
+measure: the burger, the frictions, the contact damping, the servo's gains and latency. A
+plan is made for what the cell knows. The planner models the blade as its top face with a
+3 mm collision box (``spatula.thickness``, an envelope of the blade's thickness range), so
+the blade's geometry does not change a plan. The servo rate and the lookahead change the
+position commands (:func:`known_physics`)."""
 
 
 def known_physics(physics: PhysicsConfig, values: dict) -> PhysicsConfig:
