@@ -106,11 +106,14 @@ class PhysicsConfig:
         servo_lookahead_s: Smoothing (s) of the ``position`` commands between their
             servo-rate samples and the joint PD: UR's ``servoj`` ``lookahead_time``
             ([0.03, 0.2] s, URScript manual), modelled as a first-order low-pass of that time
-            constant (the form is ours; UR publishes none). The cell sets it, so the
-            compensated commands are made for it
-            (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0 (default): no
-            smoothing, the held commands reach the PD as they are
-            (docs/benchmarks/2026-11-27-servoj-lookahead.md).
+            constant (the form is ours; UR publishes none; its group delay matches the
+            measured lag, docs/benchmarks/2026-11-27-servoj-lookahead.md). The cell sets it,
+            so the compensated commands are made for it
+            (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0 (default):
+            no smoothing, the held commands reach the PD as they are. flipkit's URScript
+            export sends 0.1 s; smoothed, a plan's start, a step of the torque compensation,
+            lags by centimetres for about τ (measured at τ 0.1 s: 5 cm during the go to
+            burger), so the default stays the model without smoothing.
     """
 
     mu_grill: float = 0.5
@@ -225,7 +228,7 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
     "physics.servo_lookahead_s": (0.03, 0.2, "servoj lookahead_time 0.03-0.2 s (URScript "
-                                  "manual); its smoothing's form ours; nominal 0: none"),
+                                  "manual; 0.1 s flipkit's export); its smoothing's form ours"),
     "physics.latency_s": (0.002, 0.020, "UR10e at 500 Hz: 4-6 ms from sent to reported, "
                           "without servoj's smoothing (Universal_Robots_Client_Library issue "
                           "86); range ours around it"),
