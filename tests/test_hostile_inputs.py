@@ -207,6 +207,20 @@ def test_numeric_options_out_of_range(tmp_path, capsys, monkeypatch, argv, flag)
     assert re.search(r"\[[-0-9.e]+, [-0-9.e]+\]", line)
 
 
+@pytest.mark.parametrize("extra, contains", [
+    (["--mode", "position", "--servo-lookahead", "0.01"], ["--servo-lookahead", "0 (no smoothing)",
+                                                          "[0.03, 0.2] s"]),
+    (["--mode", "position", "--servo-lookahead", "nan"], ["--servo-lookahead", "[0.03, 0.2] s"]),
+    (["--servo-lookahead", "0.1"], ["--servo-lookahead needs --mode position"]),
+])
+def test_the_servo_lookahead_is_a_servoj_one_and_for_position_commands(tmp_path, capsys,
+                                                                        monkeypatch, extra,
+                                                                        contains):
+    monkeypatch.chdir(tmp_path)
+    refused(capsys, ["validate", "--plan", "p.json", "--trials", "1", "--json", "v.json",
+                     *extra], watch=tmp_path, contains=contains)
+
+
 def test_t_drop_is_bounded(tmp_path, capsys):
     cook = tmp_path / "cook.csv"
     cook.write_text("burger,t_drop,x,y\nb1,1e308,0.69,-0.16\n")

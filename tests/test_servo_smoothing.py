@@ -92,3 +92,20 @@ def test_the_smoothing_reaches_the_pd_and_the_commands_are_made_for_it(flip_plan
     made = rms(smooth.q_cmd - plain.q_cmd)
     lagged = rms(raw.q_cmd - plan_references(*args, ph, "position", "raw", 1e-3, 0.2).q_cmd)
     assert np.all(made < 0.2 * lagged), (made, lagged)  # measured 0.06-0.09 x
+
+
+def test_trials_with_a_lookahead_carry_it_and_are_cached_apart():
+    """A validation's trials with a lookahead run the servo that smooths (their physics
+    says so, and their cache keys differ); without one, the nominal jobs as before."""
+    from flipkit.experiments.perturbations import Perturbations
+    from flipkit.experiments.trial_jobs import servo_physics, trial_jobs, trial_key
+
+    assert servo_physics(0.0) is None
+    assert servo_physics(0.1) == {"physics.servo_lookahead_s": 0.1}
+    with pytest.raises(ConfigError, match="lookahead"):
+        servo_physics(-1.0)
+    plain = trial_jobs("{}", 1, 0, Perturbations(), mode="position")[0]
+    smooth = trial_jobs("{}", 1, 0, Perturbations(), mode="position",
+                        physics=servo_physics(0.1))[0]
+    assert "physics" not in plain and smooth["physics"] == {"physics.servo_lookahead_s": 0.1}
+    assert trial_key(plain) != trial_key(smooth)

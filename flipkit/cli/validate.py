@@ -11,10 +11,12 @@ any trial runs, nothing written.
 from __future__ import annotations
 
 import argparse
+import math
 
 from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES,
                                 add_sweep_arguments, check_float, check_int, deferred,
                                 precheck_plan)
+from flipkit.config.physics import SERVOJ_LOOKAHEAD
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 
@@ -53,6 +55,11 @@ def register(subparsers) -> None:
                         help="position mode's commands: the plan pre-compensated for the servo "
                              "(compensated, default; docs/robust-flips.md) or the plan's "
                              "(q, qd) as they are (raw)")
+    parser.add_argument("--servo-lookahead", type=float, default=0.0, metavar="S",
+                        help="with --mode position: the servo smooths its commands as UR's "
+                             "servoj does with this lookahead_time, 0 or in [0.03, 0.2] s, and "
+                             "the commands are made for it (default 0: no smoothing; "
+                             "docs/robust-flips.md section 3)")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
@@ -91,6 +98,15 @@ def run(args: argparse.Namespace) -> int:
     if args.contingencies and not args.replan:
         raise ConfigError("--contingencies needs --replan: they are re-plans made ahead")
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")
+    lo, hi = SERVOJ_LOOKAHEAD
+    if args.servo_lookahead != 0.0:
+        if not (math.isfinite(args.servo_lookahead) and lo <= args.servo_lookahead <= hi):
+            raise ConfigError(f"--servo-lookahead must be 0 (no smoothing) or a number in "
+                              f"[{lo:g}, {hi:g}] s (servoj lookahead_time), got "
+                              f"{args.servo_lookahead!r}")
+        if args.mode != "position":
+            raise ConfigError("--servo-lookahead needs --mode position: it smooths position "
+                              "commands")
     if args.workers is not None:
         check_int("--workers", args.workers, 1, MAX_WORKERS)
     inputs = [args.plan]

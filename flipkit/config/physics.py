@@ -201,6 +201,7 @@ class PhysicsConfig:
 # PhysicsConfig fields that no plan depends on: numerical settings of the simulation and how
 # the simulated servo treats its commands (the atlas's staleness hash leaves them out)
 SIMULATION_ONLY = ("burger_strips", "servo_lookahead_s")
+SERVOJ_LOOKAHEAD = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
 
 _NO_SOURCE = "no source found; range ours"
 PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time
@@ -227,7 +228,7 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
     "physics.servo_rate_hz": (125.0, 500.0, "UR CB-series 125 Hz, e-Series 500 Hz "
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
-    "physics.servo_lookahead_s": (0.03, 0.2, "servoj lookahead_time 0.03-0.2 s (URScript "
+    "physics.servo_lookahead_s": (*SERVOJ_LOOKAHEAD, "servoj lookahead_time 0.03-0.2 s (URScript "
                                   "manual; 0.1 s flipkit's export); its smoothing's form ours"),
     "physics.latency_s": (0.002, 0.020, "UR10e at 500 Hz: 4-6 ms from sent to reported, "
                           "without servoj's smoothing (Universal_Robots_Client_Library issue "

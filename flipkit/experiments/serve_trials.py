@@ -23,7 +23,7 @@ from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
-                                            trial_jobs, trial_key)
+                                            servo_physics, trial_jobs, trial_key)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.planners.serve import replan_serve, table_spot
 from flipkit.planning.plans.verify import require_verified
@@ -93,8 +93,10 @@ def _failure(scoop, pickup, serve) -> dict | None:
 def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations(), *,
                    executor=None, cache_dir=None, progress: bool = True,
                    rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
-                   replan: bool = False, command: str = "compensated") -> dict:
-    """Run ``trials`` simulated executions of the serve plan file ``path``.
+                   replan: bool = False, command: str = "compensated",
+                   servo_lookahead_s: float = 0.0) -> dict:
+    """Run ``trials`` simulated executions of the serve plan file ``path`` (``servo_lookahead_s``
+    as :func:`flipkit.experiments.trials.validate`).
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "replan", "locations":
@@ -113,7 +115,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
-                      replan, command=command)
+                      replan, servo_physics(servo_lookahead_s), command=command)
     results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,
                         desc="trials")
     entry = {"location": plan.burger["location"].tolist(),
@@ -129,7 +131,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
                        for r in results]}
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
-            "locations": [entry], "tracking": entry["tracking"],
+            "servo_lookahead_s": float(servo_lookahead_s), "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
                         "independent": entry["independent"],
                         "pause": pause_summary(entry["rests"]) if replan else None}}

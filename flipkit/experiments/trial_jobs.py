@@ -6,6 +6,7 @@ merged over trials."""
 from __future__ import annotations
 
 import json
+import math
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import PhysicsConfig
+from flipkit.errors import ConfigError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
@@ -49,6 +51,16 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
              "replan": bool(replan), "command": command, **extra} for i in range(trials)]
 
 
+def servo_physics(lookahead_s: float) -> dict | None:
+    """The trials' ``physics`` for a servo that smooths its commands with ``lookahead_s``
+    (s, ``physics.servo_lookahead_s``, a parameter the cell knows: the commands are made for
+    it); ``None`` for 0, so that the trials' cache keys stay those of the nominal servo."""
+    value = float(lookahead_s)
+    if not (math.isfinite(value) and value >= 0):
+        raise ConfigError(f"servo lookahead must be >= 0 s, got {lookahead_s!r}")
+    return {"physics.servo_lookahead_s": value} if value > 0 else None
+
+
 def trial_key(job: dict) -> dict:
     """Cache key of a trial job: the plan's digest instead of its text, the contingency
     record's (:mod:`flipkit.experiments.contingent`) instead of it, and the digest of the
@@ -76,5 +88,5 @@ def merge_tracking(errors: list) -> dict:
     return out
 
 
-__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "merge_tracking", "plan_from_text",
+__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "merge_tracking", "plan_from_text", "servo_physics",
            "plan_text", "trial_jobs", "trial_key"]

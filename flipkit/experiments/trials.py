@@ -33,7 +33,7 @@ from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
-                                            trial_jobs, trial_key)
+                                            servo_physics, trial_jobs, trial_key)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
@@ -224,7 +224,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
              executor=None, cache_dir=None, progress: bool = True,
              rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
              replan: bool = False, command: str = "compensated",
-             contingencies: bool = False) -> dict:
+             contingencies: bool = False, servo_lookahead_s: float = 0.0) -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -243,6 +243,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             ``executor``; read back from ``cache_dir`` when made there before) and the
             re-plans hand them out (:mod:`flipkit.experiments.contingent`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
+        servo_lookahead_s: Position mode's servo smooths its commands with this lookahead
+            (s, ``physics.servo_lookahead_s``; the commands are made for it); 0: it does not.
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
@@ -255,11 +257,12 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         raise InvalidChoiceError("execution mode", mode, MODES)
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    physics = servo_physics(servo_lookahead_s)
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
         if text is not None:
             new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan,
-                             command=command)
+                             physics, command=command)
             jobs, owner = jobs + new, owner + [k] * len(new)
     records = {}
     if contingencies and replan:
@@ -273,6 +276,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             entry["contingencies"] = contingency_summary(records[text])
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
+            "servo_lookahead_s": float(servo_lookahead_s),
             "contingencies": bool(contingencies and replan),
             "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),

@@ -24,6 +24,7 @@ def run(args: argparse.Namespace) -> int:
                               f"{plan.behavior} plan")
     common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
                   replan=args.replan, command=args.command,
+                  servo_lookahead_s=args.servo_lookahead,
                   **({"contingencies": True} if args.contingencies else {}))
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from flipkit.config.physics import SERVOJ_LOOKAHEAD
 from flipkit.errors import ConfigError, ExportError, InvalidChoiceError
 from flipkit.fileio import write_text
 from flipkit.model.robot import Robot
@@ -34,7 +35,7 @@ from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import COMMANDS, command_lead, position_command
 from flipkit.planning.plans.verify import TOL, require_verified
 
-LOOKAHEAD_RANGE = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
+LOOKAHEAD_RANGE = SERVOJ_LOOKAHEAD  # s, servoj lookahead_time (URScript manual)
 GAIN_RANGE = (100.0, 2000.0)  # servoj gain, proportional (URScript manual)
 START_TOL_RANGE = (1e-4, 0.1)  # rad, the start guard's tolerance per joint
 CYCLE_HZ = 500.0  # Hz: an e-Series controller cycle (2 ms); t must be whole cycles
