@@ -6,7 +6,6 @@ merged over trials."""
 from __future__ import annotations
 
 import json
-import math
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
@@ -14,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import PhysicsConfig
-from flipkit.errors import ConfigError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
@@ -55,9 +53,7 @@ def servo_physics(lookahead_s: float) -> dict | None:
     """The trials' ``physics`` for a servo that smooths its commands with ``lookahead_s``
     (s, ``physics.servo_lookahead_s``, a parameter the cell knows: the commands are made for
     it); ``None`` for 0, so that the trials' cache keys stay those of the nominal servo."""
-    value = float(lookahead_s)
-    if not (math.isfinite(value) and value >= 0):
-        raise ConfigError(f"servo lookahead must be >= 0 s, got {lookahead_s!r}")
+    value = PhysicsConfig(servo_lookahead_s=float(lookahead_s)).servo_lookahead_s  # checked
     return {"physics.servo_lookahead_s": value} if value > 0 else None
 
 

@@ -131,11 +131,12 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
             / physics.servo_rate_hz
         lead = command_lead(nominal) if command == "compensated" else 0.0
         sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
-        q_s, qd_s, u_s, _, qdd_s = desired(plan, paused(sent + lead, t_pause, pause), True,
-                                           hold_u=rest)
+        made = command == "compensated" and nominal.servo_lookahead_s > 0  # for the smoothing
+        q_s, qd_s, u_s, _, *qdd_s = desired(plan, paused(sent + lead, t_pause, pause), made,
+                                            hold_u=rest)
         q_c, qd_c = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
-        if command == "compensated":  # made for the servo's smoothing, as the cell sets it
-            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s, sent, nominal)
+        if made:  # the cell sets its smoothing, so its commands are made for it
+            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s[0], sent, nominal)
         tau = physics.servo_lookahead_s  # the servo smooths the held stream (if it does)
         q_cmd, qd_cmd = smoothed(q_c[held], dt, tau), smoothed(qd_c[held], dt, tau)
     else:

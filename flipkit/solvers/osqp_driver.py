@@ -42,7 +42,7 @@ from flipkit.solvers.stdout_redirect import c_stdout_silenced
 import osqp
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
-# A row whose largest entry is below NULL_ROW times the largest row's is numerically zero: a
+# A row whose norm is below NULL_ROW times the largest row's is numerically zero: a
 # row that the equality rows fix (its gradient lies outside the condensed null space, e.g. a
 # bound on a state the endpoint rows pin), left at ~1e-15 by round-off. Handed to OSQP it
 # wrecks the ADMM (measured on a turn back's condensed QP: a row of norm 1e-15 at its bound
@@ -207,7 +207,8 @@ class OSQPDriver:
             P, A = self._on_pattern(0, P), self._on_pattern(1, A)
         ineq = ~(l == u)
         cap = INITIAL_ROWS * A.shape[1]
-        size = abs(A).max(axis=1).toarray().ravel()
+        A = A.tocsc()  # (a no-op: every path builds CSC) row norms from its row indices
+        size = np.sqrt(np.bincount(A.indices, weights=A.data ** 2, minlength=A.shape[0]))
         constant = size <= NULL_ROW * size.max(initial=0.0)
         if self._active is None:  # first solve: the rows within INITIAL_SLACK of a bound
             margin = np.where(ineq, np.minimum(u, -l), np.inf)

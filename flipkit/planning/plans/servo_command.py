@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+from scipy.signal import lfilter
 
 from flipkit.errors import ConfigError, InvalidChoiceError
 
@@ -63,16 +64,14 @@ def lookahead_command(q_c, qd_c, qdd, t, physics) -> tuple[np.ndarray, np.ndarra
 def smoothed(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
     """The servo's smoothing of a command stream ``x`` (n×nq) sampled every ``dt`` s: the
     first-order low-pass of time constant ``tau`` (s), exact for a stream held between
-    samples, starting at x[0]; ``tau`` = 0: ``x``."""
+    samples (y_k = y_{k−1} + a (x_{k−1} − y_{k−1}), a = 1 − e^{−dt/τ}), starting at x[0];
+    ``tau`` = 0: ``x``."""
     x = np.asarray(x, float)
     if tau == 0.0 or len(x) == 0:
         return x
     a = -np.expm1(-dt / tau)
-    y = np.empty_like(x)
-    y[0] = x[0]
-    for k in range(1, len(x)):
-        y[k] = y[k - 1] + a * (x[k - 1] - y[k - 1])
-    return y
+    # y_k − (1 − a) y_{k−1} = a x_{k−1}, the state set so that y_0 = x_0
+    return lfilter([0.0, a], [1.0, a - 1.0], x, axis=0, zi=x[:1])[0]
 
 
 def command_lead(physics) -> float:
