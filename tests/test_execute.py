@@ -143,9 +143,13 @@ def test_validate_checks_the_mode_and_records_it(flip_plan_file):
     out = run_trial(job)
     assert out["mode"] == "position" and set(out["ok"]) == {"scoop", "pickup", "flip"}
     assert out["command"] == "compensated"
-    assert out["tracking"]["go_to_burger"]["max_m"] < 0.005  # compensated commands
+    # compensated commands track within 5 mm once under way (the servo's smoothing lags the
+    # go to burger's first step of torque by up to a centimetre), the plan as it is lags
+    under_way = ("scoop", "pickup", "flip", "turn_back")
+    assert max(out["tracking"][k]["max_m"] for k in under_way) < 0.005
+    assert out["tracking"]["go_to_burger"]["max_m"] < 0.015
     raw = run_trial(trial_jobs(text, 1, 0, Perturbations(), mode="position", command="raw")[0])
-    assert raw["tracking"]["go_to_burger"]["max_m"] > 0.005  # the plan as it is: a lag
+    assert min(raw["tracking"][k]["max_m"] for k in under_way) > 0.02
 
 
 def test_pressed_blade_is_the_blades_spring_and_does_not_bounce(flip_plan):

@@ -125,7 +125,9 @@ def test_the_default_command_is_the_position_modes_compensation(plan, robot, tmp
     """The first segment is a cubic: the plan 8 ms (latency) + half a servo period ahead is
     known in closed form, u between nodes is linear, and Kp (q_c − q_d) + g_c(q_d)
     must give back the plan's torque u_d (the burger's weight, which the controller's model
-    lacks, makes the offset non-zero)."""
+    lacks, makes the offset non-zero). The stream sent is q_c made for servoj's smoothing
+    at the default lookahead (0.1 s): x = q_c + τ q̇_c, q̇_c by differences within the
+    segment."""
     out = tmp_path / "c.script"
     rate_args = [] if rate == 125.0 else ["--rate", f"{rate:g}"]  # the default: 125 Hz
     assert main(["export", str(plan.to_json(tmp_path / "p.json")), "--format", "urscript",
@@ -141,10 +143,15 @@ def test_the_default_command_is_the_position_modes_compensation(plan, robot, tmp
     u_d = np.column_stack([np.interp(t[first], seg.t, seg.u[:, j]) for j in range(6)])
     data = robot.model.createData()
     g_c = np.array([pin.computeGeneralizedGravity(robot.model, data, x) for x in q_d])
-    offset = prog["q"][first] - q_d
     kp = np.asarray(physics.kp)
-    np.testing.assert_allclose(offset * kp + g_c, u_d, atol=HALF_ULP * kp.max() + 1e-6)
-    assert np.abs(offset).max() > 1e-4
+    q_c = q_d + (u_d - g_c) / kp
+    tau = physics.servo_lookahead_s
+    assert tau == 0.1 and "lookahead_time 0.1 s" in "\n".join(prog["head"])
+    x = q_c + tau * np.gradient(q_c, t[first], axis=0)
+    # the last τ/2 (and a sample) carry the spread step to the next segment
+    inner = t[first] < seg.T - tau / 2 - 1.0 / rate
+    np.testing.assert_allclose(prog["q"][first][inner], x[inner], atol=HALF_ULP + 1e-9)
+    assert np.abs(q_c - q_d).max() > 1e-4
     within_limits(robot, prog["q"])
 
 
@@ -156,7 +163,11 @@ def test_a_flip_streams_within_the_limits(flip_plan, tmp_path):
     assert np.abs(prog["q_start"] - flip_plan.segments[0].q[0]).max() <= HALF_ULP
     within_limits(Robot(flip_plan.cell(), with_burger=False), prog["q"])
     raw = export.evaluate(flip_plan, np.arange(n) / 500.0 + 0.008 + 0.5 / 500.0)[0]
-    assert 1e-3 < np.abs(prog["q"] - raw).max() < 0.1  # rad: the compensation, small
+    # rad: the compensation and the smoothing's lead τ q̇ (τ 0.1 s, |q̇| ≤ 3.2 rad/s)
+    assert 1e-3 < np.abs(prog["q"] - raw).max() < 0.1 * 3.2 + 0.05
+    # no sample is an impulse: where segments meet, the compensation steps, and the stream
+    # steps with it (a step inverted through the smoothing would be τ/Δt = 50 times larger)
+    assert np.abs(np.diff(prog["q"], axis=0)).max() < 0.1
 
 
 def test_a_command_outside_the_limits_is_refused(plan):

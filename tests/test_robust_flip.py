@@ -170,13 +170,16 @@ def test_compensated_command_gives_the_plan_torque_at_the_plan_state(flip_plan):
 
 
 def test_compensated_position_mode_tracks_like_feedforward(flip_plan):
+    """From the scoop on (the servo's smoothing cannot follow the step of torque at the
+    plan's start: test_servo_smoothing bounds that lag during the go to burger)."""
     from flipkit.simulation.execute import execute_plan
 
     worst = {}
     for mode, command in (("feedforward", "compensated"), ("position", "compensated"),
                           ("position", "raw")):
         ex = execute_plan(flip_plan, mode, None, command=command)
-        worst[mode, command] = max(e["max_m"] for e in ex.errors.values())
+        worst[mode, command] = max(e["max_m"] for k, e in ex.errors.items()
+                                   if k != "go_to_burger")
     assert worst["position", "compensated"] < 1.5 * worst["feedforward", "compensated"]
     assert worst["position", "raw"] > 2 * worst["position", "compensated"]
 

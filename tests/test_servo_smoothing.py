@@ -73,6 +73,27 @@ def test_commands_made_for_the_smoothing_come_out_of_it_as_planned():
     assert np.array_equal(same[0], q) and np.array_equal(same[1], qd)
 
 
+def test_a_step_between_segments_is_sent_bounded_and_comes_out_in_place():
+    """Where segments meet the compensation steps by Δ. Inverted exactly that would be an
+    impulse (τ/Δt times Δ for a sample); the commands spread it over τ around the step, so
+    they stay within about Δ of the stream, and the smoothed command is back on the stream
+    within τ after the step, where the step passed as it is still lags by Δ/e."""
+    dt, tau, c = 8e-3, 0.1, 100
+    t = dt * np.arange(300)
+    q = np.where(np.arange(300) >= c, 1.0, 0.0)[:, None] + 0.2 * t[:, None]  # ramp + step
+    pieces = (np.arange(300) >= c).astype(int)
+    ph = PhysicsConfig(servo_lookahead_s=tau)
+    x, _ = lookahead_command(q, np.zeros_like(q), np.zeros_like(q), t, ph, pieces)
+    assert np.abs(x - q - tau * 0.2).max() < 1.05  # no impulse: within Δ (m dt ≈ τ)
+    after = slice(c + int(round(tau / dt)), c + int(round(2 * tau / dt)))
+    spread = np.abs(smoothed(x, dt, tau) - q)[after].max()
+    passed = x - np.where(np.abs(x - q - tau * 0.2) > 1e-9, x - q - tau * 0.2, 0.0)
+    lagging = np.abs(smoothed(passed, dt, tau) - q)[after].max()
+    assert spread < 0.05 and lagging > 0.3, (spread, lagging)
+    one = lookahead_command(q, np.zeros_like(q), np.zeros_like(q), t, ph)[0]
+    assert np.abs(one - q).max() > 5.0  # one piece: the step inverted as an impulse
+
+
 def test_the_smoothing_reaches_the_pd_and_the_commands_are_made_for_it(flip_plan, bare):
     """With a lookahead the PD's references are the smoothed stream of commands made for the
     smoothing: close to the commands of a servo without it, once under way; with a lookahead
@@ -94,18 +115,42 @@ def test_the_smoothing_reaches_the_pd_and_the_commands_are_made_for_it(flip_plan
     assert np.all(made < 0.2 * lagged), (made, lagged)  # measured 0.06-0.09 x
 
 
-def test_trials_with_a_lookahead_carry_it_and_are_cached_apart():
-    """A validation's trials with a lookahead run the servo that smooths (their physics
-    says so, and their cache keys differ); without one, the nominal jobs as before."""
+def test_trials_with_another_lookahead_carry_it_and_are_cached_apart():
+    """The nominal servo smooths with servoj's default lookahead (0.1 s); a validation's
+    trials with another one (0: none) say so in their physics, and their cache keys
+    differ; with the default, the nominal jobs."""
     from flipkit.experiments.perturbations import Perturbations
-    from flipkit.experiments.trial_jobs import servo_physics, trial_jobs, trial_key
+    from flipkit.experiments.trial_jobs import lookahead_of, servo_physics, trial_jobs, trial_key
 
-    assert servo_physics(0.0) is None
-    assert servo_physics(0.1) == {"physics.servo_lookahead_s": 0.1}
+    assert PhysicsConfig().servo_lookahead_s == 0.1
+    assert servo_physics(None) is None and servo_physics(0.1) is None
+    assert servo_physics(0.0) == {"physics.servo_lookahead_s": 0.0}
+    assert servo_physics(0.2) == {"physics.servo_lookahead_s": 0.2}
+    assert lookahead_of(None) == 0.1 and lookahead_of(0.0) == 0.0
     with pytest.raises(ConfigError, match="lookahead"):
         servo_physics(-1.0)
     plain = trial_jobs("{}", 1, 0, Perturbations(), mode="position")[0]
-    smooth = trial_jobs("{}", 1, 0, Perturbations(), mode="position",
-                        physics=servo_physics(0.1))[0]
-    assert "physics" not in plain and smooth["physics"] == {"physics.servo_lookahead_s": 0.1}
-    assert trial_key(plain) != trial_key(smooth)
+    bare = trial_jobs("{}", 1, 0, Perturbations(), mode="position",
+                      physics=servo_physics(0.0))[0]
+    assert "physics" not in plain and bare["physics"] == {"physics.servo_lookahead_s": 0.0}
+    assert trial_key(plain) != trial_key(bare)
+
+
+def test_the_smoothing_starts_from_the_state_held_before_the_plan(flip_plan, bare):
+    """Before a plan the servo holds the arm at rest at the plan's first configuration, so
+    its smoothed command starts there (not at the first command, whose torque compensation
+    and lead it has yet to reach: the arm was kicked ahead and overshot by 5 cm at τ 0.1 s),
+    and it tracks the plan's start within a centimetre."""
+    from flipkit.simulation.execute import execute_plan
+
+    ph = replace(flip_plan.cell().physics, servo_lookahead_s=0.1)
+    refs = plan_references(flip_plan, bare, ph, "position", "compensated", 1e-3, 0.2)
+    first = flip_plan.segments[0]
+    np.testing.assert_allclose(refs.q_cmd[0], first.q[0], atol=1e-12)
+    np.testing.assert_allclose(refs.qd_cmd[0], first.qd[0], atol=1e-12)
+    # the first command does differ from the held state (the compensation of q̈(0))
+    sent = plan_references(flip_plan, bare, replace(ph, servo_lookahead_s=0.0), "position",
+                           "compensated", 1e-3, 0.2).q_cmd[0]
+    assert np.abs(sent - first.q[0]).max() > 5e-3
+    ex = execute_plan(flip_plan, "position", None, physics=ph, hold=0.0)
+    assert ex.errors["go_to_burger"]["max_m"] < 0.015  # measured 9.8 mm

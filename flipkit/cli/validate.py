@@ -55,11 +55,11 @@ def register(subparsers) -> None:
                         help="position mode's commands: the plan pre-compensated for the servo "
                              "(compensated, default; docs/robust-flips.md) or the plan's "
                              "(q, qd) as they are (raw)")
-    parser.add_argument("--servo-lookahead", type=float, default=0.0, metavar="S",
+    parser.add_argument("--servo-lookahead", type=float, default=None, metavar="S",
                         help="with --mode position: the servo smooths its commands as UR's "
-                             "servoj does with this lookahead_time, 0 or in [0.03, 0.2] s, and "
-                             "the commands are made for it (default 0: no smoothing; "
-                             "docs/robust-flips.md section 3)")
+                             "servoj does with this lookahead_time, in [0.03, 0.2] s, and the "
+                             "commands are made for it (default 0.1, servoj's default); 0: a "
+                             "servo without smoothing (docs/robust-flips.md section 3)")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
@@ -99,8 +99,9 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--contingencies needs --replan: they are re-plans made ahead")
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")
     lo, hi = SERVOJ_LOOKAHEAD
-    if args.servo_lookahead != 0.0:
-        if not (math.isfinite(args.servo_lookahead) and lo <= args.servo_lookahead <= hi):
+    if args.servo_lookahead is not None:
+        if not (args.servo_lookahead == 0.0
+                or (math.isfinite(args.servo_lookahead) and lo <= args.servo_lookahead <= hi)):
             raise ConfigError(f"--servo-lookahead must be 0 (no smoothing) or a number in "
                               f"[{lo:g}, {hi:g}] s (servoj lookahead_time), got "
                               f"{args.servo_lookahead!r}")

@@ -23,6 +23,10 @@ if TYPE_CHECKING:  # the cell imports this module
 BLADE_FLEX = ("contact", "hinge")  # the simulated blade's flex (PhysicsConfig.blade_flex)
 
 
+SERVOJ_LOOKAHEAD = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
+SERVOJ_LOOKAHEAD_DEFAULT = 0.1  # s, servoj's default lookahead_time (URScript manual)
+
+
 @dataclass(frozen=True)
 class PhysicsConfig:
     """Simulation-only physics of the cell (MuJoCo scene, closed-loop execution).
@@ -94,8 +98,8 @@ class PhysicsConfig:
             cycle is 16 ms. Measured on a UR10e streaming at 500 Hz, a target echoed back
             without ``servoj`` returned 4-6 ms later (UniversalRobots/
             Universal_Robots_Client_Library issue 86, cross-correlation); through ``servoj``
-            with a lookahead time of 0.03 s, 34 ms: its smoothing, which this model does not
-            have (docs/benchmarks/2026-11-27-servoj-lookahead.md). 8 ms, range 2-20 ms
+            with a lookahead time of 0.03 s, 34 ms: its smoothing, modelled apart
+            (``servo_lookahead_s``). 8 ms, range 2-20 ms
             (ours, around the measured transport).
         kp, kd: Joint PD gains (N m/rad, N m s/rad), the values of
             :data:`flipkit.simulation.tracking.DEFAULT_KP` / ``DEFAULT_KD`` (about critical damping at
@@ -105,15 +109,13 @@ class PhysicsConfig:
             computed with the nominal ones. 1; range 0.5-2 (no source: UR publishes none).
         servo_lookahead_s: Smoothing (s) of the ``position`` commands between their
             servo-rate samples and the joint PD: UR's ``servoj`` ``lookahead_time``
-            ([0.03, 0.2] s, URScript manual), modelled as a first-order low-pass of that time
-            constant (the form is ours; UR publishes none; its group delay matches the
-            measured lag, docs/benchmarks/2026-11-27-servoj-lookahead.md). The cell sets it,
-            so the compensated commands are made for it
-            (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0 (default):
-            no smoothing, the held commands reach the PD as they are. flipkit's URScript
-            export sends 0.1 s; smoothed, a plan's start, a step of the torque compensation,
-            lags by centimetres for about τ (measured at τ 0.1 s: 5 cm during the go to
-            burger), so the default stays the model without smoothing.
+            ([0.03, 0.2] s, default 0.1 s, URScript manual; flipkit's URScript export sends
+            the same), modelled as a first-order low-pass of that time constant (the form is
+            ours; UR publishes none; its group delay matches the measured lag,
+            docs/benchmarks/2026-11-27-servoj-lookahead.md). The cell sets it, so the
+            compensated commands are made for it
+            (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0: no
+            smoothing, the held commands reach the PD as they are (no ``servoj`` does that).
     """
 
     mu_grill: float = 0.5
@@ -135,7 +137,7 @@ class PhysicsConfig:
     kp: tuple = (2000.0, 2000.0, 1000.0, 300.0, 300.0, 50.0)
     kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
     servo_gain_scale: float = 1.0
-    servo_lookahead_s: float = 0.0
+    servo_lookahead_s: float = SERVOJ_LOOKAHEAD_DEFAULT
 
     def __post_init__(self):
         for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
@@ -201,7 +203,6 @@ class PhysicsConfig:
 # PhysicsConfig fields that no plan depends on: numerical settings of the simulation and how
 # the simulated servo treats its commands (the atlas's staleness hash leaves them out)
 SIMULATION_ONLY = ("burger_strips", "servo_lookahead_s")
-SERVOJ_LOOKAHEAD = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
 
 _NO_SOURCE = "no source found; range ours"
 PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time
@@ -229,7 +230,7 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
                               "(UR 'Remote Control Via TCP/IP')"),
     "physics.servo_gain_scale": (0.5, 2.0, _NO_SOURCE + " (UR publishes no servo gains)"),
     "physics.servo_lookahead_s": (*SERVOJ_LOOKAHEAD, "servoj lookahead_time 0.03-0.2 s (URScript "
-                                  "manual; 0.1 s flipkit's export); its smoothing's form ours"),
+                                  "manual; default 0.1 s, as flipkit's export); its smoothing's form ours"),
     "physics.latency_s": (0.002, 0.020, "UR10e at 500 Hz: 4-6 ms from sent to reported, "
                           "without servoj's smoothing (Universal_Robots_Client_Library issue "
                           "86); range ours around it"),

@@ -22,8 +22,9 @@ from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
-from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
-                                            servo_physics, trial_jobs, trial_key)
+from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
+                                            plan_from_text, servo_physics, trial_jobs,
+                                            trial_key)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.planners.serve import replan_serve, table_spot
 from flipkit.planning.plans.verify import require_verified
@@ -94,7 +95,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
                    executor=None, cache_dir=None, progress: bool = True,
                    rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
                    replan: bool = False, command: str = "compensated",
-                   servo_lookahead_s: float = 0.0) -> dict:
+                   servo_lookahead_s: float | None = None) -> dict:
     """Run ``trials`` simulated executions of the serve plan file ``path`` (``servo_lookahead_s``
     as :func:`flipkit.experiments.trials.validate`).
 
@@ -131,7 +132,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
                        for r in results]}
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
-            "servo_lookahead_s": float(servo_lookahead_s), "locations": [entry], "tracking": entry["tracking"],
+            "servo_lookahead_s": lookahead_of(servo_lookahead_s), "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
                         "independent": entry["independent"],
                         "pause": pause_summary(entry["rests"]) if replan else None}}

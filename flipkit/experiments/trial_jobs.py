@@ -49,12 +49,21 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
              "replan": bool(replan), "command": command, **extra} for i in range(trials)]
 
 
-def servo_physics(lookahead_s: float) -> dict | None:
+def servo_physics(lookahead_s: float | None) -> dict | None:
     """The trials' ``physics`` for a servo that smooths its commands with ``lookahead_s``
     (s, ``physics.servo_lookahead_s``, a parameter the cell knows: the commands are made for
-    it); ``None`` for 0, so that the trials' cache keys stay those of the nominal servo."""
+    it; 0: no smoothing); ``None`` for the cell's default (``None`` or the default value),
+    so that the trials' cache keys stay those of the nominal servo."""
+    if lookahead_s is None:
+        return None
     value = PhysicsConfig(servo_lookahead_s=float(lookahead_s)).servo_lookahead_s  # checked
-    return {"physics.servo_lookahead_s": value} if value > 0 else None
+    default = PhysicsConfig().servo_lookahead_s
+    return None if value == default else {"physics.servo_lookahead_s": value}
+
+
+def lookahead_of(lookahead_s: float | None) -> float:
+    """The lookahead (s) that trials with ``lookahead_s`` run (``None``: the default)."""
+    return PhysicsConfig().servo_lookahead_s if lookahead_s is None else float(lookahead_s)
 
 
 def trial_key(job: dict) -> dict:
@@ -84,5 +93,5 @@ def merge_tracking(errors: list) -> dict:
     return out
 
 
-__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "merge_tracking", "plan_from_text", "servo_physics",
-           "plan_text", "trial_jobs", "trial_key"]
+__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "lookahead_of", "merge_tracking",
+           "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key"]

@@ -32,8 +32,9 @@ from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.sweep import run_sweep
-from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, merge_tracking, plan_from_text,
-                                            servo_physics, trial_jobs, trial_key)
+from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
+                                            plan_from_text, servo_physics, trial_jobs,
+                                            trial_key)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
@@ -224,7 +225,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
              executor=None, cache_dir=None, progress: bool = True,
              rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
              replan: bool = False, command: str = "compensated",
-             contingencies: bool = False, servo_lookahead_s: float = 0.0) -> dict:
+             contingencies: bool = False, servo_lookahead_s: float | None = None) -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -244,7 +245,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             re-plans hand them out (:mod:`flipkit.experiments.contingent`).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
         servo_lookahead_s: Position mode's servo smooths its commands with this lookahead
-            (s, ``physics.servo_lookahead_s``; the commands are made for it); 0: it does not.
+            (s, ``physics.servo_lookahead_s``; the commands are made for it); 0: it does not;
+            ``None``: the cell's default (0.1 s, servoj's default).
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
@@ -276,7 +278,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             entry["contingencies"] = contingency_summary(records[text])
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
-            "servo_lookahead_s": float(servo_lookahead_s),
+            "servo_lookahead_s": lookahead_of(servo_lookahead_s),
             "contingencies": bool(contingencies and replan),
             "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),

@@ -22,7 +22,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.servo_command import (command_lead, lookahead_command,
-                                                  position_command, smoothed)
+                                                  position_command, segment_labels, smoothed)
 from flipkit.simulation.modes import FEEDFORWARD, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene
 
@@ -132,13 +132,18 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
         lead = command_lead(nominal) if command == "compensated" else 0.0
         sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
         made = command == "compensated" and nominal.servo_lookahead_s > 0  # for the smoothing
-        q_s, qd_s, u_s, _, *qdd_s = desired(plan, paused(sent + lead, t_pause, pause), made,
-                                            hold_u=rest)
+        at = paused(sent + lead, t_pause, pause)  # plan times the samples act at
+        q_s, qd_s, u_s, _, *qdd_s = desired(plan, at, made, hold_u=rest)
         q_c, qd_c = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
         if made:  # the cell sets its smoothing, so its commands are made for it
-            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s[0], sent, nominal)
-        tau = physics.servo_lookahead_s  # the servo smooths the held stream (if it does)
-        q_cmd, qd_cmd = smoothed(q_c[held], dt, tau), smoothed(qd_c[held], dt, tau)
+            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s[0], sent, nominal,
+                                          segment_labels(plan, at))
+        # The servo smooths the held stream (if it does), from what it held before the
+        # plan: the plan's first state (at rest), not the first command, whose torque
+        # compensation and lead the smoothing has yet to reach.
+        tau = physics.servo_lookahead_s
+        q_cmd = smoothed(q_c[held], dt, tau, start=q_des[0])
+        qd_cmd = smoothed(qd_c[held], dt, tau, start=qd_des[0])
     else:
         q_cmd, qd_cmd = q_des, qd_des
     return References(t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd)

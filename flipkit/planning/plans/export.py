@@ -75,7 +75,7 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     return t, q, qd
 
 
-def evaluate(plan: Plan, t):
+def evaluate(plan: Plan, t, accelerations: bool = False):
     """The plan's interpolant at times ``t`` (s, from the plan's start).
 
     q and q̇ are as in :func:`resample`, u (N·m) is linear between nodes (as the simulation's
@@ -83,9 +83,11 @@ def evaluate(plan: Plan, t):
 
     Args:
         plan: The plan. t: Times (n,) (s), any order.
+        accelerations: Also return q̈ (n, nq) (rad/s²), the derivative of q̇'s interpolant.
 
     Returns:
-        (q, qd, u): positions (n, nq) (rad), velocities (n, nq) (rad/s), torques (n, nq) (N·m).
+        (q, qd, u): positions (n, nq) (rad), velocities (n, nq) (rad/s), torques (n, nq) (N·m);
+        (q, qd, u, qdd) with ``accelerations``.
     """
     t = np.asarray(t, float)
     durations = np.array([s.T for s in plan.segments])
@@ -93,15 +95,19 @@ def evaluate(plan: Plan, t):
     which = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(durations) - 1)
     nq = plan.segments[0].q.shape[1]
     q, qd, u = np.empty((t.size, nq)), np.empty((t.size, nq)), np.empty((t.size, nq))
+    qdd = np.empty((t.size, nq))
     for k, seg in enumerate(plan.segments):
         rows = which == k
         if not rows.any():
             continue
         local = np.clip(t[rows] - starts[k], 0.0, seg.T)
         q[rows] = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(local)
-        qd[rows] = CubicHermiteSpline(seg.t, seg.qd, seg.qdd, axis=0)(local)
+        rate = CubicHermiteSpline(seg.t, seg.qd, seg.qdd, axis=0)
+        qd[rows] = rate(local)
+        if accelerations:
+            qdd[rows] = rate(local, 1)
         u[rows] = np.column_stack([np.interp(local, seg.t, seg.u[:, j]) for j in range(nq)])
-    return q, qd, u
+    return (q, qd, u, qdd) if accelerations else (q, qd, u)
 
 
 def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL,

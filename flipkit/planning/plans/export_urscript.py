@@ -13,7 +13,9 @@ The positions streamed are, as in the simulation's position mode
 (:mod:`flipkit.simulation.execute`), the compensated command of
 :mod:`flipkit.planning.plans.servo_command` (default): the plan a transport latency plus half
 a servo period ahead, offset by Kp⁻¹ (u − g_c(q)) of flipkit's *modelled* servo (its Kp and
-latency, :class:`flipkit.config.PhysicsConfig`, are not identified on a real arm); or, with
+latency, :class:`flipkit.config.PhysicsConfig`, are not identified on a real arm), and made
+for the smoothing of the ``lookahead_time`` sent (the inverse of the servo model's low-pass,
+:func:`~flipkit.planning.plans.servo_command.lookahead_command`); or, with
 ``command="raw"``, the resampled q as it is. Either way every command lies within the
 model's joint limits, or nothing is written.
 """
@@ -26,13 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
-from flipkit.config.physics import SERVOJ_LOOKAHEAD
+from flipkit.config.physics import SERVOJ_LOOKAHEAD, SERVOJ_LOOKAHEAD_DEFAULT
 from flipkit.errors import ConfigError, ExportError, InvalidChoiceError
 from flipkit.fileio import write_text
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.export import evaluate, resample
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.plans.servo_command import COMMANDS, command_lead, position_command
+from flipkit.planning.plans.servo_command import (COMMANDS, command_lead, lookahead_command,
+                                                  position_command, segment_labels)
 from flipkit.planning.plans.verify import TOL, require_verified
 
 LOOKAHEAD_RANGE = SERVOJ_LOOKAHEAD  # s, servoj lookahead_time (URScript manual)
@@ -55,7 +58,7 @@ class ServoOptions:
         start_tol: The start guard's tolerance per joint (rad), in :data:`START_TOL_RANGE`.
     """
 
-    lookahead: float = 0.1
+    lookahead: float = SERVOJ_LOOKAHEAD_DEFAULT
     gain: float = 300.0
     command: str = "compensated"
     start_tol: float = 0.01
@@ -82,18 +85,27 @@ def check_servo_rate(rate: float) -> float:
     return float(rate)
 
 
-def servo_stream(plan: Plan, rate: float, command: str = "compensated", *, force=False):
-    """The samples' times t (n,) (s, t_j = j / rate) and position commands (n, 6) (rad)."""
+def servo_stream(plan: Plan, rate: float, command: str = "compensated", *,
+                 lookahead: float = 0.0, force=False):
+    """The samples' times t (n,) (s, t_j = j / rate) and position commands (n, 6) (rad).
+
+    ``compensated`` commands are made as the simulation's position mode makes them
+    (:func:`flipkit.simulation.control.plan_references`): for the servo model at this rate
+    and, with ``lookahead`` (s) > 0, for servoj's smoothing with that lookahead
+    (:func:`~flipkit.planning.plans.servo_command.lookahead_command`)."""
     if command not in COMMANDS:
         raise InvalidChoiceError("position command", command, COMMANDS)
     t, q, _ = resample(plan, check_servo_rate(rate), force=force)
     if command == "raw":
         return t, q
     cell = plan.cell()
-    nominal = replace(cell.physics, servo_rate_hz=rate)  # the servo model, at this rate
-    q_d, qd_d, u_d = evaluate(plan, t + command_lead(nominal))
+    nominal = replace(cell.physics, servo_rate_hz=rate,  # the servo model, at this rate
+                      servo_lookahead_s=float(lookahead))
+    at = t + command_lead(nominal)  # plan times the samples act at
+    q_d, qd_d, u_d, qdd_d = evaluate(plan, at, accelerations=True)
     model = Robot(cell, with_burger=False).model  # the controller's: arm and spatula
-    return t, position_command(q_d, qd_d, u_d, model, nominal, command)[0]
+    q_c, qd_c = position_command(q_d, qd_d, u_d, model, nominal, command)
+    return t, lookahead_command(q_c, qd_c, qdd_d, t, nominal, segment_labels(plan, at))[0]
 
 
 def check_limits(plan: Plan, t, q) -> None:
@@ -161,7 +173,8 @@ def write_urscript(plan: Plan, path, rate: float, options: ServoOptions = ServoO
         FlipkitError: A bad rate or option, or the file cannot be written.
     """
     where = "plan" if where is None else str(where)
-    t, q_cmd = servo_stream(plan, rate, options.command, force=force)
+    t, q_cmd = servo_stream(plan, rate, options.command, lookahead=options.lookahead,
+                            force=force)
     require_verified(plan, where, force=force, tol=tol)
     check_limits(plan, t, q_cmd)
     write_text(Path(path), urscript_text(plan, t, q_cmd, rate, options, Path(where).name))

@@ -22,9 +22,10 @@ sample will act is the send time plus the transport latency plus half a servo pe
 middle of its hold). The compensation uses the nominal servo model; its gains, rate and
 latency are uncertain and swept by the sensitivity study.
 
-A servo that smooths its commands (``servo_lookahead_s`` > 0, UR's ``servoj`` lookahead)
-passes them through a first-order low-pass (:func:`smoothed`) before its PD; the commands are
-then made for it by the filter's inverse (:func:`lookahead_command`).
+A servo that smooths its commands (``servo_lookahead_s`` > 0, UR's ``servoj`` lookahead;
+default 0.1 s, servoj's own) passes them through a first-order low-pass (:func:`smoothed`)
+before its PD; the commands are then made for it by the filter's inverse
+(:func:`lookahead_command`), within each segment of the plan.
 """
 
 from __future__ import annotations
@@ -39,39 +40,74 @@ COMMANDS = ("compensated", "raw")
 """``compensated``: q_c as in the module docstring; ``raw``: the plan's (q, q̇) as they are."""
 
 
-def lookahead_command(q_c, qd_c, qdd, t, physics) -> tuple[np.ndarray, np.ndarray]:
+def lookahead_command(q_c, qd_c, qdd, t, physics, pieces=None) -> tuple[np.ndarray, np.ndarray]:
     """Commands made for the servo's smoothing (``physics.servo_lookahead_s`` = τ, a
     first-order low-pass y' = (x − y)/τ between the commands and the PD): its inverse,
     x = q_c + τ q̇_c and ẋ = q̇ + τ q̈, so that the smoothed command is (q_c, q̇) where the
     plan is smooth. q̇_c is the rate of the command itself (finite differences over the
-    samples: it includes the rate of the torque compensation), q̈ the plan's. τ = 0 or a
-    single sample: the commands as they are.
+    samples of one piece: it includes the rate of the torque compensation), q̈ the plan's.
+    τ = 0: the commands as they are.
+
+    Where a plan's segments meet, its torque, and so the compensation, steps by Δ.
+    Inverting a step takes an impulse τ Δ: a command τ/Δt times the step for one sample
+    (12 Δ at 125 Hz and τ 0.1 s, 50 Δ at 500 Hz), which no arm should be sent. So the rate is
+    taken within each piece (``pieces``: the samples' segment labels), and each step's
+    impulse is spread over the samples within τ/2 of it: about Δ more command for τ. The
+    smoothed command then crosses the step centred on it and is back on the plan's within
+    τ after it (passed as it is, it would still lag by Δ/e there).
 
     Args:
         q_c, qd_c: Commands (rad, rad/s), n×nq (:func:`position_command`).
         qdd: The plan's accelerations (rad/s²) at the samples, n×nq.
         t: The samples' times (s), increasing, n.
         physics: The cell's model of its servo (:class:`~flipkit.config.PhysicsConfig`).
+        pieces: Integer labels (n,), equal along each smooth piece (a plan's segment);
+            default one piece.
     """
     tau = float(physics.servo_lookahead_s)
     q_c, qd_c = np.asarray(q_c, float), np.asarray(qd_c, float)
-    if tau == 0.0 or len(q_c) < 2:
+    if tau == 0.0 or len(q_c) == 0:
         return q_c, qd_c
-    rate = np.gradient(q_c, np.asarray(t, float), axis=0)
-    return q_c + tau * rate, qd_c + tau * np.asarray(qdd, float)
+    t = np.asarray(t, float)
+    labels = np.zeros(len(q_c), int) if pieces is None else np.asarray(pieces)
+    cuts = np.flatnonzero(np.diff(labels)) + 1
+    rate = np.zeros_like(q_c)
+    for a, b in zip(np.r_[0, cuts], np.r_[cuts, len(q_c)]):
+        if b - a >= 2:
+            rate[a:b] = np.gradient(q_c[a:b], t[a:b], axis=0)
+    x = q_c + tau * rate
+    for c in cuts:  # each step's impulse τ Δ, spread over τ centred on it: about Δ high
+        dt = t[c] - t[c - 1]
+        step = q_c[c] - q_c[c - 1] - 0.5 * dt * (rate[c - 1] + rate[c])
+        m = max(1, int(round(tau / dt)))
+        lo, hi = max(0, c - m // 2), min(len(x), c - m // 2 + m)
+        x[lo:hi] += tau * step / (m * dt)
+    return x, qd_c + tau * np.asarray(qdd, float)
 
 
-def smoothed(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
+def segment_labels(plan, t) -> np.ndarray:
+    """The segment index of each plan time ``t`` (s, from the plan's start): k on
+    [start_k, end_k) (0 before the start), ``len(plan.segments)`` from the end on."""
+    ends = np.cumsum([float(s.t[-1] - s.t[0]) for s in plan.segments])
+    return np.searchsorted(ends - 1e-12, np.asarray(t, float), side="left")
+
+
+def smoothed(x: np.ndarray, dt: float, tau: float, start=None) -> np.ndarray:
     """The servo's smoothing of a command stream ``x`` (n×nq) sampled every ``dt`` s: the
     first-order low-pass of time constant ``tau`` (s), exact for a stream held between
-    samples (y_k = y_{k−1} + a (x_{k−1} − y_{k−1}), a = 1 − e^{−dt/τ}), starting at x[0];
-    ``tau`` = 0: ``x``."""
+    samples (y_k = y_{k−1} + a (x_{k−1} − y_{k−1}), a = 1 − e^{−dt/τ}); ``tau`` = 0: ``x``.
+
+    Args:
+        start: The filter's output at sample 0 (nq,): what the servo held before the stream
+            began (the arm's state at rest before a plan). Default ``x[0]``.
+    """
     x = np.asarray(x, float)
     if tau == 0.0 or len(x) == 0:
         return x
     a = -np.expm1(-dt / tau)
-    # y_k − (1 − a) y_{k−1} = a x_{k−1}, the state set so that y_0 = x_0
-    return lfilter([0.0, a], [1.0, a - 1.0], x, axis=0, zi=x[:1])[0]
+    y0 = x[:1] if start is None else np.asarray(start, float).reshape(1, -1)
+    # y_k − (1 − a) y_{k−1} = a x_{k−1}, the state set so that y_0 = start
+    return lfilter([0.0, a], [1.0, a - 1.0], x, axis=0, zi=y0)[0]
 
 
 def command_lead(physics) -> float:
@@ -107,4 +143,5 @@ def position_command(q_d, qd_d, u_d, controller_model, physics,
     return q_d + (u_d - gravity) / kp, qd_d.copy()
 
 
-__all__ = ["COMMANDS", "command_lead", "lookahead_command", "position_command", "smoothed"]
+__all__ = ["COMMANDS", "command_lead", "lookahead_command", "position_command",
+           "segment_labels", "smoothed"]
