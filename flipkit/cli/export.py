@@ -24,7 +24,8 @@ DEFAULT_RATE = 125.0  # Hz: a CB3's servo rate (an e-Series: 500)
 FORMATS = {"csv": (".csv",), "urscript": (".script", ".urscript"), "ros2": (".yaml", ".yml")}
 # The servoj options (flipkit.planning.plans.export_urscript: ServoOptions, its ranges) and
 # the commands (flipkit.planning.plans.servo_command.COMMANDS), here without their imports.
-SERVO = {"lookahead": ("--lookahead", (0.03, 0.2), "s", 0.1, "servoj lookahead_time"),
+SERVO = {"lookahead": ("--lookahead", (0.03, 0.2), "s", 0.1,
+                       "servoj lookahead_time (compensated commands are made for its smoothing)"),
          "gain": ("--gain", (100.0, 2000.0), "", 300.0, "servoj gain (proportional)"),
          "start_tol": ("--start-tol", (1e-4, 0.1), "rad", 0.01,
                        "the start guard's tolerance per joint")}
