@@ -64,3 +64,36 @@ def test_small_study_runs_the_trials_at_each_setting(flip_plan_file):
         c = out["parameters"]["physics.mu_grill"][end]
         assert c["value"] == value and c["trials"] == 1
         assert set(c["success"]) == {"scoop", "pickup", "flip"}
+
+
+@pytest.mark.slow
+def test_a_planned_parameter_runs_the_plans_made_for_its_value(flip_plan, flip_plan_file):
+    """The blade's thickness changes the plan (the scoop model's lifted overhang): a plan
+    made for the thicker blade puts the burger further along it, and a study given plans for
+    an end runs those there (two plans, two trials) and the nominal plans elsewhere."""
+    from flipkit.config import PLANNED_PARAMETERS
+    from flipkit.experiments.trial_jobs import plan_text
+    from flipkit.planning.planners.planner import plan_flip
+
+    assert PLANNED_PARAMETERS == ("physics.blade_thickness",)
+    thick = with_parameter(CellConfig(), "physics.blade_thickness", 0.002)
+    other = plan_flip(tuple(flip_plan.burger["location"]), cell=thick)
+    assert other.status == "solved"
+    x = lambda p: p.segment("flip").landing["burger_on_blade"][0]  # noqa: E731
+    assert x(other) > x(flip_plan) + 0.001
+    text, other_text = flip_plan_file.read_text(), plan_text(other)
+    # the figures' planning jobs plan the same for a cell given by its parameters
+    from flipkit.experiments.trial_jobs import plan_from_text
+    from flipkit.figures.runs import plan_location_text
+
+    job = {"location": [float(v) for v in flip_plan.burger["location"]], "solver": "auto",
+           "cell": {"physics.blade_thickness": 0.002}}
+    made = plan_location_text(job)
+    assert made["status"] == "solved"
+    assert x(plan_from_text(made["text"])) == pytest.approx(x(other), abs=1e-6)
+    out = sensitivity.run_sensitivity(
+        [text], trials=1, parameters=["physics.blade_thickness"], replan=False,
+        replanned={("physics.blade_thickness", "high"): [other_text, other_text]})
+    ends = out["parameters"]["physics.blade_thickness"]
+    assert ends["high"]["trials"] == 2 and ends["low"]["trials"] == 1
+    assert out["nominal"]["trials"] == 1

@@ -21,7 +21,7 @@ from flipkit.behaviors.options import (SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND, SCO
                                        SCOOP_TIP_BAND)
 from flipkit.behaviors.spec import Subbehavior, Task
 from flipkit.config import CellConfig, ScoopUncertainty
-from flipkit.model.scoop import ScoopPath
+from flipkit.model.scoop import ScoopPath, overhang_share
 from flipkit.transcription.constraints import KinematicBlock
 
 
@@ -59,9 +59,13 @@ def scoop_scenarios(segment, location, models,
     blade, and the spread; ``models``: the cell's :class:`~flipkit.behaviors.models.Models`.
 
     The friction model of :mod:`flipkit.model.scoop` with the cell's nominal patty and grill
-    gives the predicted place (x, y) (m, blade frame). The scenarios bound its spread over what
-    the cell does not know (:class:`~flipkit.config.ScoopUncertainty`): the burger-blade
-    friction at both ends of its range combined with the burger put ± k σ along the scoop
+    gives the place (x, y) (m, blade frame). How much of the patty's overhang the tip carries
+    depends on how high the blade's top face rides above the grill, between flush with it and
+    the blade's thickness (:func:`~flipkit.model.scoop.overhang_share`), which the cell does not
+    know: the predicted place is the midpoint of the two ends' outcomes. The scenarios bound
+    its spread over that and what else the cell does not know
+    (:class:`~flipkit.config.ScoopUncertainty`): both ends of the overhang, combined with the
+    burger-blade friction at both ends of its range and the burger put ± k σ along the scoop
     (the extremes of x), and ± k σ sideways (y, which the scoop does not change).
 
     Returns:
@@ -73,9 +77,13 @@ def scoop_scenarios(segment, location, models,
     kw = {"diameter": cell.burger.diameter, "mu_grill": cell.physics.mu_grill,
           "rim": cell.physics.burger_edge_radius}
     mu, d = cell.burger.mu, uncertainty.placement
-    nominal = path.outcome(mu_blade=mu, **kw)
-    xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), **kw)[0]
-          for f in uncertainty.mu_scale for s in (-d, d)]
+    b = cell.burger
+    density = b.mass / (np.pi * b.diameter**2 / 4 * b.thickness)
+    ends = (0.0, overhang_share(cell.physics.burger_modulus, b.thickness, density,
+                                cell.physics.blade_thickness))
+    nominal = np.mean([path.outcome(mu_blade=mu, overhang=e, **kw) for e in ends], axis=0)
+    xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), overhang=e, **kw)[0]
+          for e in ends for f in uncertainty.mu_scale for s in (-d, d)]
     half = np.array([cell.spatula.length, cell.spatula.width]) / 2
     scenarios = [(min(xs), nominal[1]), (max(xs), nominal[1]),
                  (nominal[0], nominal[1] - d), (nominal[0], nominal[1] + d)]

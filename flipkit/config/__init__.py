@@ -16,14 +16,14 @@ Constructors validate their arguments and raise :class:`~flipkit.errors.ConfigEr
 from flipkit.config.cell import (GRAVITY, LOCATION_SETS, MORE_LOCATIONS, TABLE1_LOCATIONS,
                                  BurgerConfig, CellConfig,
                                  GrillConfig, RobotConfig, SpatulaConfig, TableConfig, TaskLimits)
-from flipkit.config.physics import (KNOWN_PARAMETERS, PHYSICAL_RANGES, PhysicsConfig,
-                                    known_physics, with_parameter)
+from flipkit.config.physics import (KNOWN_PARAMETERS, PHYSICAL_RANGES, PLANNED_PARAMETERS,
+                                    PhysicsConfig, known_physics, with_parameter)
 from flipkit.config.space import BACK_WALL, CellBox, SpaceConfig
 from flipkit.config.uncertainty import ScoopUncertainty
 from flipkit.config.urdf import default_urdf, portable_urdf, resolve_urdf, urdf_sha256
 
 __all__ = ["BACK_WALL", "GRAVITY", "KNOWN_PARAMETERS", "LOCATION_SETS", "MORE_LOCATIONS",
-           "PHYSICAL_RANGES", "TABLE1_LOCATIONS",
+           "PHYSICAL_RANGES", "PLANNED_PARAMETERS", "TABLE1_LOCATIONS",
            "BurgerConfig", "CellBox", "CellConfig", "GrillConfig", "PhysicsConfig", "RobotConfig",
            "ScoopUncertainty", "SpaceConfig", "SpatulaConfig", "TableConfig", "TaskLimits",
            "default_urdf", "known_physics", "portable_urdf", "resolve_urdf", "urdf_sha256",

@@ -246,9 +246,15 @@ blade's geometry) and its robot controller (the servo rate: a CB-series arm stre
 125 Hz, an e-Series at 500 Hz; the ``servoj`` lookahead it sends). The others it cannot
 measure: the burger, the frictions, the contact damping, the servo's gains and latency. A
 plan is made for what the cell knows. The planner models the blade as its top face with a
-3 mm collision box (``spatula.thickness``, an envelope of the blade's thickness range), so
-the blade's geometry does not change a plan. The servo rate and the lookahead change the
-position commands (:func:`known_physics`)."""
+3 mm collision box (``spatula.thickness``, an envelope of the blade's thickness range); the
+blade's thickness enters a plan through the scoop model only (how high the blade can lift
+the patty's overhang, :data:`PLANNED_PARAMETERS`). The servo rate and the lookahead change
+the position commands (:func:`known_physics`)."""
+
+PLANNED_PARAMETERS = ("physics.blade_thickness",)
+"""The known parameters that change a plan (the scoop model's overhang,
+:func:`flipkit.model.scoop.overhang_share`): a study that moves one plans again for each
+value (:func:`flipkit.experiments.sensitivity.run_sensitivity`'s ``replanned``)."""
 
 
 def known_physics(physics: PhysicsConfig, values: dict) -> PhysicsConfig:

@@ -55,7 +55,7 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
                     mode: str = FEEDFORWARD, replan: bool = True,
                     perturbations: Perturbations = Perturbations(),
                     rate_hz: float = TRACK_RATE_HZ, nominal: bool = True, executor=None,
-                    cache_dir=None, progress: bool = False) -> dict:
+                    cache_dir=None, progress: bool = False, replanned=None) -> dict:
     """Run the Table I trials of every plan at both ends of every parameter's range.
 
     Args:
@@ -66,6 +66,9 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
         seed, mode, replan, perturbations, rate_hz: As :func:`flipkit.experiments.trials.validate`.
         nominal: Also run the nominal cell (``result["nominal"]``).
         executor, cache_dir, progress: See :func:`flipkit.experiments.sweep.run_sweep`.
+        replanned: ``{(name, end): plan texts}``: for a parameter the cell knows and plans for
+            (:data:`flipkit.config.PLANNED_PARAMETERS`), the plans made for that setting's
+            value (their cell has it); they run instead of ``plan_texts`` there.
 
     Returns:
         ``{"plans", "trials", "seed", "mode", "replan", "nominal": counts or None,
@@ -84,10 +87,13 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
     if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
     cases = ([(None, None, None)] if nominal else []) + settings(parameters)
-    cells = [plan_from_text(text).cell() for text in plan_texts]
+    replanned = replanned or {}
+    cells = {}  # each plan's cell, read once
     jobs, owner = [], []
-    for k, (name, _, value) in enumerate(cases):
-        for text, cell in zip(plan_texts, cells):
+    for k, (name, end, value) in enumerate(cases):
+        texts = [t for t in replanned.get((name, end), plan_texts) if t is not None]
+        for text in texts:
+            cell = cells.get(text) or cells.setdefault(text, plan_from_text(text).cell())
             # a setting that leaves the plan's cell as it is (a range's end at the nominal
             # value) simulates the nominal cell: the nominal job, computed (and cached) once
             same = name is None or with_parameter(cell, name, value) == cell

@@ -207,13 +207,20 @@ def plan_location(job: dict) -> dict:
     atlas when it serves) and write the plan file (a sweep worker).
 
     Args:
-        job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``.
+        job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``, optionally
+            ``"cell": {dotted name: value}`` (keys of :data:`flipkit.config.PHYSICAL_RANGES`):
+            plan for the default cell with those values, from cold starts (the package's
+            atlas serves the default cell only).
 
     Returns:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
     """
+    cell = CellConfig()
+    for name, value in job.get("cell", {}).items():
+        cell = with_parameter(cell, name, value)
+    atlas = default_atlas() if not job.get("cell") else None
     try:
-        plan = plan_flip(job["location"], solver=job["solver"], atlas=default_atlas())
+        plan = plan_flip(job["location"], solver=job["solver"], cell=cell, atlas=atlas)
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
     path = plan.to_json(Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"]))

@@ -256,7 +256,8 @@ def plan_location_text(job: dict) -> dict:
     does (a sweep worker) and return the plan file's text instead of its path.
 
     Args:
-        job: ``{"location": [3] (m), "solver": str}``.
+        job: ``{"location": [3] (m), "solver": str}``, optionally ``"cell"`` (as
+            :func:`~flipkit.experiments.trials.plan_location`).
 
     Returns:
         ``{"status", "reason", "time_s" (s, planning wall time), "text" (the plan file's text,
@@ -269,17 +270,20 @@ def plan_location_text(job: dict) -> dict:
 
 
 def plan_targets(locations, solver: str = "auto", executor=None, progress: bool = False,
-                 cache_dir=None):
+                 cache_dir=None, cell: dict | None = None):
     """Plan pickup-and-flip at every location on the sweep and return the
     :func:`flipkit.experiments.trials.validate` targets ``[(location, plan_info, plan_text or
     None)]``, so that one set of plans serves several validations.
 
     With ``cache_dir`` (:func:`flipkit.experiments.sweep.run_sweep`'s cache, keyed by the
-    location and the solver) a plan made earlier by the same code is read back, not planned
-    again: the caller must give each code version its own directory
-    (:func:`flipkit.figures.pipeline.sweep_cache`).
+    location, the solver and ``cell``) a plan made earlier by the same code is read back, not
+    planned again: the caller must give each code version its own directory
+    (:func:`flipkit.figures.pipeline.sweep_cache`). ``cell``: ``{dotted name: value}``, plan
+    for the default cell with those values (cold starts).
     """
-    jobs = [{"location": [float(v) for v in loc], "solver": solver} for loc in locations]
+    extra = {"cell": {k: float(v) for k, v in cell.items()}} if cell else {}
+    jobs = [{"location": [float(v) for v in loc], "solver": solver, **extra}
+            for loc in locations]
     infos = run_sweep(plan_location_text, jobs, executor, cache_dir, progress=progress,
                       desc="plans")
     return [(job["location"], {k: r[k] for k in ("status", "reason", "time_s")},

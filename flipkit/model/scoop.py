@@ -23,6 +23,18 @@ the blade, [tip − l, tip], while the tip is low enough to slip under the patty
 grill; semi-implicit time steps of :data:`STEP_S` with the stick-slip transitions resolved
 within a step. Sideways (blade y) the patty is not moved: its offset is where p^b lies from
 the final blade centre.
+
+The patty's overhang. Where the tip has slipped under the patty and lifts it by δ (the
+height of the blade's top face above the grill), the part of the patty beyond the tip does
+not fall onto the grill at once: as a heavy beam (bending stiffness E I, weight q per
+length) lifted by δ at the tip it lies clear of the grill over ℓ = (24 E I δ / q)^¼, and the
+tip carries q ℓ / 2 of it, as if the blade's footprint reached ℓ / 2 beyond the tip
+(:func:`overhang_share`; for a patty of thickness h and density ρ, ℓ = (2 E h² δ / (ρ g))^¼,
+2.0 cm for 15 mm of 50 kPa patty lifted by a 1 mm blade). δ lies between 0 (the blade's top
+face flush with the grill, the tip sunk into it) and the blade's thickness (the blade resting
+on the grill); which it is depends on how the arm presses the blade and how the blade and
+grill yield, which the model does not know, so ``outcome`` takes the overhang as a parameter
+and the planner spans its range (:func:`~flipkit.behaviors.pick.scoop_scenarios`).
 """
 
 from __future__ import annotations
@@ -47,6 +59,19 @@ def footprint_share(centre: float, radius: float, lo: float, hi: float) -> float
         u = min(max((x - centre) / radius, -1.0), 1.0)
         return (math.asin(u) + u * math.sqrt(1.0 - u * u)) / math.pi + 0.5
     return max(below(hi) - below(lo), 0.0)
+
+
+def overhang_share(modulus: float, thickness: float, density: float, lift: float) -> float:
+    """How far beyond the tip (m) the blade carries a patty it lifts by ``lift`` (m): half the
+    length ℓ = (2 E h² δ / (ρ g))^¼ over which the patty's overhang, a heavy beam of modulus
+    ``modulus`` (Pa), thickness ``thickness`` (m) and density ``density`` (kg/m³), lies clear
+    of the grill (module docstring); 0 for ``lift`` = 0."""
+    for name, v in (("modulus", modulus), ("thickness", thickness), ("density", density)):
+        if not (np.isfinite(v) and v > 0):
+            raise ConfigError(f"scoop model: {name} must be positive, got {v!r}")
+    if not (np.isfinite(lift) and lift >= 0):
+        raise ConfigError(f"scoop model: lift must be >= 0 m, got {lift!r}")
+    return 0.5 * (2.0 * modulus * thickness**2 * lift / (density * GRAVITY)) ** 0.25
 
 
 def _sign(x: float) -> float:
@@ -106,7 +131,7 @@ class ScoopPath:
         self.end = end.translation[:2] - pb[:2]  # final blade centre from p^b (m)
 
     def outcome(self, *, diameter: float, mu_blade: float, mu_grill: float, rim: float,
-                shift=(0.0, 0.0)) -> np.ndarray:
+                shift=(0.0, 0.0), overhang: float = 0.0) -> np.ndarray:
         """The patty's centre on the blade (x, y) (m, blade frame) when the scoop ends.
 
         Args:
@@ -115,6 +140,8 @@ class ScoopPath:
             rim: Height (m) above the grill below which the tip slips under the patty's rim
                 (the rim's rounding radius).
             shift: The patty lying off p^b by (along the heading, sideways) (m).
+            overhang: How far beyond the tip the blade carries the patty (m,
+                :func:`overhang_share`); 0: only what lies over the blade.
 
         Raises:
             ConfigError: Non-finite or non-positive parameters.
@@ -123,12 +150,15 @@ class ScoopPath:
                         ("mu_grill", mu_grill), ("rim", rim)):
             if not (np.isfinite(v) and v > 0):
                 raise ConfigError(f"scoop model: {name} must be positive, got {v!r}")
+        if not (np.isfinite(overhang) and overhang >= 0):
+            raise ConfigError(f"scoop model: overhang must be >= 0 m, got {overhang!r}")
         along, aside = (float(v) for v in shift)
         xb, vb, radius, low = along, 0.0, diameter / 2, self.tip_height <= rim
         t, tip, speed = self.t.tolist(), self.tip.tolist(), self.speed.tolist()
         length, low = self.length, low.tolist()
         for k in range(len(t) - 1):
-            f = footprint_share(xb, radius, tip[k] - length, tip[k]) if low[k] else 0.0
+            f = (footprint_share(xb, radius, tip[k] - length, tip[k] + overhang) if low[k]
+                 else 0.0)
             if f == 0.0 and vb == 0.0:  # off the blade and at rest: nothing moves it
                 continue
             xb, vb = _step(xb, vb, speed[k], speed[k + 1], f, mu_blade, mu_grill,
@@ -137,4 +167,4 @@ class ScoopPath:
         return np.array([centre @ self.heading, centre @ self.side])
 
 
-__all__ = ["STEP_S", "ScoopPath", "footprint_share"]
+__all__ = ["STEP_S", "ScoopPath", "footprint_share", "overhang_share"]
