@@ -78,8 +78,7 @@ def scoop_scenarios(segment, location, models,
           "rim": cell.physics.burger_edge_radius}
     mu, d = cell.burger.mu, uncertainty.placement
     b = cell.burger
-    density = b.mass / (np.pi * b.diameter**2 / 4 * b.thickness)
-    ends = (0.0, overhang_share(cell.physics.burger_modulus, b.thickness, density,
+    ends = (0.0, overhang_share(cell.physics.burger_modulus, b.thickness, b.density,
                                 cell.physics.blade_thickness))
     nominal = np.mean([path.outcome(mu_blade=mu, overhang=e, **kw) for e in ends], axis=0)
     xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), overhang=e, **kw)[0]

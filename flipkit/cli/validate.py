@@ -11,12 +11,11 @@ any trial runs, nothing written.
 from __future__ import annotations
 
 import argparse
-import math
 
 from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES,
                                 add_sweep_arguments, check_float, check_int, deferred,
                                 precheck_plan)
-from flipkit.config.physics import SERVOJ_LOOKAHEAD
+from flipkit.config.physics import servo_lookahead
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 
@@ -98,13 +97,8 @@ def run(args: argparse.Namespace) -> int:
     if args.contingencies and not args.replan:
         raise ConfigError("--contingencies needs --replan: they are re-plans made ahead")
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")
-    lo, hi = SERVOJ_LOOKAHEAD
     if args.servo_lookahead is not None:
-        if not (args.servo_lookahead == 0.0
-                or (math.isfinite(args.servo_lookahead) and lo <= args.servo_lookahead <= hi)):
-            raise ConfigError(f"--servo-lookahead must be 0 (no smoothing) or a number in "
-                              f"[{lo:g}, {hi:g}] s (servoj lookahead_time), got "
-                              f"{args.servo_lookahead!r}")
+        servo_lookahead(args.servo_lookahead, "--servo-lookahead")
         if args.mode != "position":
             raise ConfigError("--servo-lookahead needs --mode position: it smooths position "
                               "commands")

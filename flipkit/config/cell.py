@@ -8,6 +8,7 @@ ours where the paper is silent. Constructors validate their arguments and raise
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -139,6 +140,16 @@ class BurgerConfig:
     def __post_init__(self):
         for name in ("diameter", "thickness", "mass", "mu"):
             positive(f"burger {name}", getattr(self, name))
+
+    @property
+    def area(self) -> float:
+        """Face area π d²/4 (m²)."""
+        return math.pi * self.diameter**2 / 4
+
+    @property
+    def density(self) -> float:
+        """Mass over the disc's volume (kg/m³)."""
+        return self.mass / (self.area * self.thickness)
 
 
 @dataclass(frozen=True)

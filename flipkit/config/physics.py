@@ -27,6 +27,18 @@ SERVOJ_LOOKAHEAD = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
 SERVOJ_LOOKAHEAD_DEFAULT = 0.1  # s, servoj's default lookahead_time (URScript manual)
 
 
+def servo_lookahead(value, what: str = "servo_lookahead_s") -> float:
+    """``value`` (s) as a servo lookahead: 0 (no smoothing) or within
+    :data:`SERVOJ_LOOKAHEAD`; else a one-line ConfigError naming ``what``."""
+    lo, hi = SERVOJ_LOOKAHEAD
+    ok = isinstance(value, (int, float, np.floating)) and not isinstance(value, bool) and (
+        value == 0.0 or (math.isfinite(value) and lo <= value <= hi))
+    if not ok:
+        raise ConfigError(f"{what} must be 0 (no smoothing) or a number in [{lo:g}, {hi:g}] s "
+                          f"(servoj lookahead_time), got {value!r}")
+    return float(value)
+
+
 @dataclass(frozen=True)
 class PhysicsConfig:
     """Simulation-only physics of the cell (MuJoCo scene, closed-loop execution).
@@ -195,8 +207,7 @@ class PhysicsConfig:
         Default patty: k = 26 kN/m, τ = 2.1 ms.
         """
         m = burger.mass if mass is None else float(mass)
-        area = math.pi * burger.diameter**2 / 4
-        tau = math.sqrt(m * burger.thickness / (self.burger_modulus * area))
+        tau = math.sqrt(m * burger.thickness / (self.burger_modulus * burger.area))
         return max(tau, 2 * self.timestep)
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import PhysicsConfig
+from flipkit.config.physics import servo_lookahead
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
@@ -56,9 +57,8 @@ def servo_physics(lookahead_s: float | None) -> dict | None:
     so that the trials' cache keys stay those of the nominal servo."""
     if lookahead_s is None:
         return None
-    value = PhysicsConfig(servo_lookahead_s=float(lookahead_s)).servo_lookahead_s  # checked
-    default = PhysicsConfig().servo_lookahead_s
-    return None if value == default else {"physics.servo_lookahead_s": value}
+    value = servo_lookahead(lookahead_s)
+    return None if value == lookahead_of(None) else {"physics.servo_lookahead_s": value}
 
 
 def lookahead_of(lookahead_s: float | None) -> float:

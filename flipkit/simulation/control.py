@@ -21,8 +21,8 @@ import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.model.robot import Robot
-from flipkit.planning.plans.servo_command import (command_lead, lookahead_command,
-                                                  position_command, segment_labels, smoothed)
+from flipkit.planning.plans.servo_command import (command_lead, servo_commands, smoothed,
+                                                  smooths)
 from flipkit.simulation.modes import FEEDFORWARD, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene
 
@@ -131,13 +131,11 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
             / physics.servo_rate_hz
         lead = command_lead(nominal) if command == "compensated" else 0.0
         sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
-        made = command == "compensated" and nominal.servo_lookahead_s > 0  # for the smoothing
         at = paused(sent + lead, t_pause, pause)  # plan times the samples act at
-        q_s, qd_s, u_s, _, *qdd_s = desired(plan, at, made, hold_u=rest)
-        q_c, qd_c = position_command(q_s, qd_s, u_s, robot.model, nominal, command)
-        if made:  # the cell sets its smoothing, so its commands are made for it
-            q_c, qd_c = lookahead_command(q_c, qd_c, qdd_s[0], sent, nominal,
-                                          segment_labels(plan, at))
+        # the cell sets its smoothing, so its commands are made for it (they need q̈)
+        q_s, qd_s, u_s, _, *qdd_s = desired(plan, at, smooths(nominal, command), hold_u=rest)
+        q_c, qd_c = servo_commands(plan, sent, at, q_s, qd_s, u_s, (qdd_s or [None])[0],
+                                   robot.model, nominal, command)
         # The servo smooths the held stream (if it does), from what it held before the
         # plan: the plan's first state (at rest), not the first command, whose torque
         # compensation and lead the smoothing has yet to reach.

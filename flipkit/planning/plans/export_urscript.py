@@ -34,8 +34,7 @@ from flipkit.fileio import write_text
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.export import evaluate, resample
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.plans.servo_command import (COMMANDS, command_lead, lookahead_command,
-                                                  position_command, segment_labels)
+from flipkit.planning.plans.servo_command import COMMANDS, command_lead, servo_commands
 from flipkit.planning.plans.verify import TOL, require_verified
 
 LOOKAHEAD_RANGE = SERVOJ_LOOKAHEAD  # s, servoj lookahead_time (URScript manual)
@@ -86,7 +85,7 @@ def check_servo_rate(rate: float) -> float:
 
 
 def servo_stream(plan: Plan, rate: float, command: str = "compensated", *,
-                 lookahead: float = 0.0, force=False):
+                 lookahead: float = SERVOJ_LOOKAHEAD_DEFAULT, force=False):
     """The samples' times t (n,) (s, t_j = j / rate) and position commands (n, 6) (rad).
 
     ``compensated`` commands are made as the simulation's position mode makes them
@@ -104,8 +103,7 @@ def servo_stream(plan: Plan, rate: float, command: str = "compensated", *,
     at = t + command_lead(nominal)  # plan times the samples act at
     q_d, qd_d, u_d, qdd_d = evaluate(plan, at, accelerations=True)
     model = Robot(cell, with_burger=False).model  # the controller's: arm and spatula
-    q_c, qd_c = position_command(q_d, qd_d, u_d, model, nominal, command)
-    return t, lookahead_command(q_c, qd_c, qdd_d, t, nominal, segment_labels(plan, at))[0]
+    return t, servo_commands(plan, t, at, q_d, qd_d, u_d, qdd_d, model, nominal, command)[0]
 
 
 def check_limits(plan: Plan, t, q) -> None:

@@ -143,5 +143,31 @@ def position_command(q_d, qd_d, u_d, controller_model, physics,
     return q_d + (u_d - gravity) / kp, qd_d.copy()
 
 
+def smooths(physics, kind: str) -> bool:
+    """Whether ``kind`` commands are made for a smoothing servo (``compensated`` ones, and
+    ``physics.servo_lookahead_s`` > 0): they then need the plan's q̈ (:func:`servo_commands`)."""
+    return kind == "compensated" and physics.servo_lookahead_s > 0
+
+
+def servo_commands(plan, t, at, q_d, qd_d, u_d, qdd, controller_model, physics,
+                   kind: str = "compensated") -> tuple[np.ndarray, np.ndarray]:
+    """The commands (q_c, q̇_c) (rad, rad/s) a servo receives for ``plan``'s samples sent at
+    ``t`` (s, n, increasing) and acting at plan times ``at`` (s, n; constant while the plan
+    pauses): :func:`position_command`, then, where the servo smooths (:func:`smooths`),
+    :func:`lookahead_command` within the plan's segments. The simulation's position mode and
+    the URScript export both send these.
+
+    Args:
+        plan: The plan (its segments' durations). q_d, qd_d, u_d, qdd: The plan at ``at``
+            (n×nq; ``qdd`` only read where the servo smooths). controller_model, physics,
+            kind: As :func:`position_command`; ``physics`` is the servo model, its
+            ``servo_lookahead_s`` the smoothing the commands are made for.
+    """
+    q_c, qd_c = position_command(q_d, qd_d, u_d, controller_model, physics, kind)
+    if smooths(physics, kind):
+        q_c, qd_c = lookahead_command(q_c, qd_c, qdd, t, physics, segment_labels(plan, at))
+    return q_c, qd_c
+
+
 __all__ = ["COMMANDS", "command_lead", "lookahead_command", "position_command",
-           "segment_labels", "smoothed"]
+           "segment_labels", "servo_commands", "smoothed", "smooths"]
