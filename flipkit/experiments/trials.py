@@ -31,6 +31,7 @@ from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.serve_trials import validate_serve
+from flipkit.experiments.slides import slide_summary
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             plan_from_text, servo_physics, trial_jobs,
@@ -164,10 +165,18 @@ def run_trial(job: dict) -> dict:
             "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
             "perturbation": draw, "tracking": errors, "mode": mode, "command": command,
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
+            "touchdown_xy": _touchdown(run, bounds["flip"][0]),
             "predicted_landing_xy": _predicted(ex.plan),
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
                        "time_s": ex.replan_time_s}
             if replan is not None else None, "physics": dict(job.get("physics") or {})}
+
+
+def _touchdown(run, flip_start: float) -> list | None:
+    """The burger's centre (x, y) (m) at its first contact with the grill after the flip's
+    start, or ``None``."""
+    k = run.touchdown(flip_start)
+    return None if k is None else [float(v) for v in run.burger_pos[k, :2]]
 
 
 def _predicted(plan) -> list | None:
@@ -183,7 +192,8 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
     ``success`` counts cumulative stages (a pickup counts only after a successful scoop, as
     in the paper's Table I); ``independent`` counts each judge's passes on its own;
     ``landings`` lists each trial's final burger position (x, y) (m), whether it flipped, the
-    executed plan's predicted landing and, with ``replan``, what was sensed.
+    executed plan's predicted landing, where the burger first touched the grill after the
+    flip's start (``touchdown_xy``) and, with ``replan``, what was sensed.
     """
     if not results:
         fails = [{"trial": i, "stage": "plan", "reason": plan_info.get("reason"),
@@ -199,6 +209,7 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "landings": [{"trial": r["trial"], "flipped": r["ok"]["flip"],
                           "xy": r.get("landing_xy"), "predicted_xy": r.get("predicted_landing_xy"),
+                          "touchdown_xy": r.get("touchdown_xy"),
                           "replan": r.get("replan")} for r in results]}
 
 
@@ -260,7 +271,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
         "trials", "success": {stage: count}, "independent": {stage: count}, "pause": the
         arm's pauses at the sense (:func:`flipkit.experiments.pauses.pause_summary`; ``None``
-        open loop)}}``.
+        open loop), "slide": how far the burgers slid after they touched the grill
+        (:func:`flipkit.experiments.slides.slide_summary`)}}``.
     """
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
@@ -294,7 +306,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
                         "independent": {s: sum(e["independent"][s] for e in entries)
                                         for s in STAGES},
                         "pause": pause_summary([land for e in entries for land in e["landings"]])
-                        if replan else None}}
+                        if replan else None,
+                        "slide": slide_summary([land for e in entries for land in e["landings"]])}}
 
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:

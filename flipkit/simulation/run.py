@@ -116,3 +116,9 @@ class BurgerRun:
     def index(self, time: float) -> int:
         """Index of the last sample at or before ``time`` (s), clipped to the run."""
         return int(np.clip(np.searchsorted(self.t, time + 1e-9) - 1, 0, len(self.t) - 1))
+
+    def touchdown(self, after: float) -> int | None:
+        """Index of the burger's first contact with the grill at or after ``after`` (s), e.g.
+        the landing of a flip that starts then; ``None`` if it never touches the grill."""
+        hits = np.flatnonzero(self.touch_grill & (self.t >= after - 1e-9))
+        return int(hits[0]) if hits.size else None

@@ -10,6 +10,7 @@ from flipkit.cli.validate import format_table
 from flipkit.errors import ConfigError
 from flipkit.config import LOCATION_SETS
 from flipkit.experiments.pauses import format_pauses
+from flipkit.experiments.slides import format_slides
 from flipkit.experiments.sweep import make_executor
 from flipkit.experiments.trials import validate_locations, validate_plan_file
 from flipkit.planning.plans.verify import load_verified
@@ -42,4 +43,6 @@ def run(args: argparse.Namespace) -> int:
           f"success {total['success']}; wrote {args.json}")
     if out.get("replan") and "pause" in total:  # a flip validation's re-plans
         print(format_pauses(total["pause"]))
+    if total.get("slide"):  # a flip validation's landings
+        print(format_slides(total["slide"]))
     return 0
