@@ -145,3 +145,27 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
     if res["ok"]["pickup"]:  # the flip itself is judged: it lands ~0.4 m from the far target
         assert not res["ok"]["flip"]
         assert res["failure"]["reason"] == "missed_spot" and res["failure"]["amount"] > 0.2
+
+
+def test_no_atlas_needs_locations(plan_file, tmp_path, capsys):
+    code = main(["validate", "--plan", str(plan_file), "--trials", "1", "--no-atlas",
+                 "--no-progress", "--json", str(tmp_path / "o.json")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "--no-atlas needs --locations" in err and len(err.splitlines()) == 1
+
+
+def test_a_location_is_planned_from_the_atlas_or_from_cold_starts(tmp_path):
+    """The atlas and cold starts solve the same NLPs; the plans are kept apart by name, and
+    the cold one took more SQP iterations (the atlas is warm-start data)."""
+    from flipkit.experiments.trials import plan_location
+    from flipkit.planning.planners.atlas import default_atlas
+    from flipkit.planning.plans.plan_file import Plan
+
+    assert default_atlas() is not None
+    job = {"location": [0.69, -0.16, 0.072], "solver": "sqp", "plans_dir": str(tmp_path)}
+    warm, cold = plan_location(job), plan_location({**job, "atlas": False})
+    assert warm["status"] == cold["status"] == "solved"
+    assert warm["path"] != cold["path"] and cold["path"].endswith("_sqp-cold.json")
+    iterations = [sum(s.solver.iterations for s in Plan.load(r["path"]).segments)
+                  for r in (warm, cold)]
+    assert iterations[0] < iterations[1]

@@ -44,6 +44,11 @@ def register(subparsers) -> None:
     parser.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
                         help="collocation solver for --locations (default auto: the SQP, then IPOPT where it fails)")
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")
+    parser.add_argument("--no-atlas", action="store_true",
+                        help="with --locations: plan from cold starts, not from the package's "
+                             "atlas; the two reach different local optima of the same NLPs, "
+                             "and comparing them shows how much a result owes to the one "
+                             "found (docs/benchmarks/2026-11-28-free-motion-probe.md)")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
@@ -111,4 +116,6 @@ def run(args: argparse.Namespace) -> int:
             check_output_dir(directory, flag, inputs=inputs)
     if args.plan is not None:
         precheck_plan(args.plan)
+        if args.no_atlas:
+            raise ConfigError("--no-atlas needs --locations: a plan file is already planned")
     return deferred("validate")(args)

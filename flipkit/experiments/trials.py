@@ -221,7 +221,7 @@ def plan_location(job: dict) -> dict:
         job: ``{"location": [3] (m), "solver": str, "plans_dir": str}``, optionally
             ``"cell": {dotted name: value}`` (keys of :data:`flipkit.config.PHYSICAL_RANGES`):
             plan for the default cell with those values, from cold starts (the package's
-            atlas serves the default cell only).
+            atlas serves the default cell only); ``"atlas": False``: from cold starts.
 
     Returns:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
@@ -229,12 +229,13 @@ def plan_location(job: dict) -> dict:
     cell = CellConfig()
     for name, value in job.get("cell", {}).items():
         cell = with_parameter(cell, name, value)
-    atlas = default_atlas() if not job.get("cell") else None
+    atlas = default_atlas() if not job.get("cell") and job.get("atlas", True) else None
     try:
         plan = plan_flip(job["location"], solver=job["solver"], cell=cell, atlas=atlas)
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
-    path = plan.to_json(Path(job["plans_dir"]) / plan_filename(job["location"], job["solver"]))
+    made_by = job["solver"] if job.get("atlas", True) else f"{job['solver']}-cold"
+    path = plan.to_json(Path(job["plans_dir"]) / plan_filename(job["location"], made_by))
     return {"status": plan.status, "reason": plan.failure, "time_s": float(plan.wall_time_s),
             "path": str(path)}
 
@@ -329,11 +330,13 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
 
 def validate_locations(locations, trials: int, solver: str = "auto", seed: int = 0, *,
                        executor=None, cache_dir=None, plans_dir=None, progress: bool = True,
-                       **kwargs) -> dict:
+                       atlas: bool = True, **kwargs) -> dict:
     """Plan every location (on the sweep, cached), then :func:`validate` the plans.
 
     Args:
         locations: Burger locations (m). solver: ``"sqp"`` or ``"ipopt"``.
+        atlas: Warm-start from the package's atlas where it serves (as ``flipkit plan flip``
+            does); ``False``: from cold starts.
         plans_dir: Where to keep the plan files; default ``cache_dir/plans``, or a temporary
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
@@ -351,7 +354,9 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
     with tempfile.TemporaryDirectory(prefix="flipkit-plans-") as tmp:
         where = Path(plans_dir or (Path(cache_dir) / "plans" if cache_dir else tmp)).resolve()
         where.mkdir(parents=True, exist_ok=True)
-        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where)} for loc in locs]
+        cold = {} if atlas else {"atlas": False}  # the key only when set: cache keys keep
+        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold}
+                for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
                           desc="plans")
         stale = [i for i, r in enumerate(infos) if r["path"] and not Path(r["path"]).is_file()]

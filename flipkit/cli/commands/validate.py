@@ -34,7 +34,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             out = validate_locations(LOCATION_SETS[args.locations], args.trials, args.solver,
                                      args.seed, executor=executor, cache_dir=args.cache,
-                                     plans_dir=args.plans, **common)
+                                     plans_dir=args.plans, atlas=not args.no_atlas,
+                                     **common)
     write_json(args.json, out)
     print(format_table(out))
     total = out["summary"]
