@@ -296,6 +296,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     for entry, (_, _, text) in zip(entries, targets):
         if text in records:
             entry["contingencies"] = contingency_summary(records[text])
+    landings = [land for e in entries for land in e["landings"]]
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "servo_lookahead_s": lookahead_of(servo_lookahead_s),
@@ -306,9 +307,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
                         "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},
                         "independent": {s: sum(e["independent"][s] for e in entries)
                                         for s in STAGES},
-                        "pause": pause_summary([land for e in entries for land in e["landings"]])
-                        if replan else None,
-                        "slide": slide_summary([land for e in entries for land in e["landings"]])}}
+                        "pause": pause_summary(landings) if replan else None,
+                        "slide": slide_summary(landings)}}
 
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
