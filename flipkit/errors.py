@@ -31,6 +31,9 @@ class InvalidChoiceError(ConfigError):
         valid = ", ".join(repr(c) for c in self.choices)
         super().__init__(f"unknown {what} {value!r}; valid choices: {valid}")
 
+    def __reduce__(self):  # raised in a sweep's worker process, it travels back pickled
+        return type(self), (self.what, self.value, self.choices)
+
 
 class UnreachableError(FlipkitError):
     """A requested spatula pose that the robot cannot reach (IK failed or outside the area)."""
@@ -57,6 +60,11 @@ class NoSolutionFound(FlipkitError):
             problem, status, group, amount, result)
         where = f"; worst constraint group {group!r} violated by {amount:.3g}" if group else ""
         super().__init__(f"no solution found ({status}){where}")
+
+    def __reduce__(self):
+        """Pickled (a worker process's error) without the NLP and the result, which hold
+        compiled models: the status, group and amount travel, and the message with them."""
+        return type(self), (None, self.status, self.group, self.amount)
 
 
 class SolverError(FlipkitError):
