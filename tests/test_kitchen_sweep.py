@@ -238,6 +238,34 @@ def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypa
         clear_cook(unflipped, CELL)
 
 
+def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monkeypatch):
+    """b2's flip segment (its toss, which follows its landing spot) passes over b1 while b1
+    still lies where it was dropped: the cook lands b2 elsewhere and plans again; a toss that
+    meets b1 from every spot tried (two) is refused."""
+    import flipkit.planning.kitchen.clearance as clearance
+
+    calls = []
+
+    def schedule(lands, moves=True):
+        calls.append(dict(lands))
+        t, f = fake_timeline()
+        t.motions = [m for m in t.motions if m.burger != "b1"]  # b1 not flipped yet
+        toss = (0.64, -0.33) if "b2" not in lands or not moves else (0.80, -0.10)
+        f[t.motions[0].plan] = blade_at(*toss, t=1.0, seg="flip")
+        fps.clear()
+        fps.update(f)
+        return t
+
+    fps = {}
+    monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
+    timeline, lands = clear_cook(schedule, CELL)
+    assert set(lands) == {"b2"} and calls[0] == {} and len(calls) == 2
+    calls.clear()
+    with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped"):
+        clear_cook(lambda lands: schedule(lands, moves=False), CELL)
+    assert len(calls) == 3 and len({tuple(c.get("b2", ())) for c in calls}) == 3
+
+
 def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():
     from flipkit.behaviors.spec import Task
     from flipkit.behaviors.transcribe import blade_floor

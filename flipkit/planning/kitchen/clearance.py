@@ -9,13 +9,15 @@ schedule: dropped, not yet lifted by their own motions), with the geometry of
 **where a flip lands its burger** (``plan_flip(..., land=...)``; by default where it was
 picked up). A burger met where it landed is landed elsewhere; a serve that meets a burger
 (or a flip whose landing does) moves its own burger's landing, which moves where the serve
-scoops from. The new spot is the one nearest the burger's drop place that keeps clear, over
+scoops from; a flip whose blade meets a burger still lying where it was dropped lands its own
+burger elsewhere, which changes the toss (up to two other spots). The new spot is the one nearest the burger's drop place that keeps clear, over
 the burger's stay on its second side, of every other motion's footprint and of every other
 burger, and from which its serve's footprint (the present one, moved with it) meets nobody.
 The cook is planned and scheduled again with the new spots and checked again. The scoop
 itself cannot be turned: the scoop subbehaviour slides the blade along +x at the burger
-(:mod:`flipkit.behaviors.targets`), so a flip that meets a burger still lying where it was
-dropped cannot be avoided this way: the cook is refused (:class:`CookConflictError`).
+(:mod:`flipkit.behaviors.targets`), so a scoop or pickup that meets a burger still lying where
+it was dropped, or a flip that still does from two other landing spots, cannot be avoided
+this way: the cook is refused (:class:`CookConflictError`).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footp
 
 MAX_ROUNDS = 4  # plan-schedule-check rounds before a cook with meetings left is refused
 LOW_SEGMENTS = ("go_to_burger", "scoop", "pickup")  # a serve's segments that move with its burger
+TOSS_SEGMENTS = ("flip", "turn_back")  # a flip's segments that change with its landing spot
 # Footprint samples tested at once against the candidate spots still in. Each test removes
 # most of them, so small chunks keep the later tests small (the five-burger cook's
 # free_landing: 2.0 s in chunks of 4, 2.9 s of 16, 2.8 s of 64, 2.3 s one sample at a time).
@@ -246,7 +249,10 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
             kind, owner = meet.motion.split(":", 1)
             if lie.landed:
                 who = lie.burger
-            elif kind == "serve" or meet.part == "landing":
+            elif kind == "serve" or meet.part == "landing" or (
+                    meet.segment in TOSS_SEGMENTS and len(tried.get(owner, ())) < 2):
+                # a flip's toss goes where it lands its burger: a toss that meets a burger
+                # still lying where it was dropped lands its own elsewhere (two spots tried)
                 who = owner
             else:
                 raise CookConflictError(
