@@ -121,7 +121,7 @@ def test_flip_plan_is_solved_continuous_and_verified(flip_file):
         np.testing.assert_allclose(a.q[-1], b.q[0], atol=1e-9)
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
     flip = plan.segments[FLIP_NAMES.index("flip")]
-    assert flip.cone_nodes == list(range(15))  # up to the release node
+    assert flip.cone_nodes == list(range(14))  # up to the node before the release node
     assert plan.segment("flip") is flip and plan.segment("carry") is None
     k = FLIP_NAMES.index("flip")
     start = sum(float(s.T) for s in plan.segments[:k])

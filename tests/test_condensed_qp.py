@@ -133,15 +133,16 @@ def test_sqp_condensed_and_full_space_agree(segments):
 
 def test_infeasible_linearisation_is_reported_not_raised():
     """The flip segment's initial guess (chained along the initial guesses, as the bench
-    warm-up does) has an infeasible linearisation inside a unit box: the compact working-set
-    solve reports it as a status and a zero step, the SQP's cue for restoration."""
+    warm-up does) has an infeasible linearisation inside a box of 0.5 (in the unit box OSQP
+    runs out of iterations before it proves it): the compact working-set solve reports it as
+    a status and a zero step, the SQP's cue for restoration."""
     models = Models(CellConfig())
     q, qd = models.bare.q_home, None
     for name in ("go_to_burger", "scoop", "pickup", "flip"):
         nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
         end = nlp.layout.nodes(nlp.x0)[-1]
         q, qd = end[0], end[1]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = _linearise(nlp, box=0.5)
     qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     sol = qp.solve(eps=1e-6, max_iter=20000)

@@ -125,7 +125,8 @@ def test_task_constraints_hold_at_fine_samples(chain, cell):
     assert band[0] - 1e-6 <= flip.p[-1, 2] <= band[1] + 1e-6
     r = int(np.argmin(np.abs(flip.t - 0.7 * flip.T)))
     land = predict_landing(flip.p[r], flip.v[r], flip.R[r], rpy_rate_matrix(flip.o[r]) @ flip.od[r],
-                           thickness=cell.burger.thickness, grill_height=hg, gravity=g,
+                           thickness=cell.burger.thickness, diameter=cell.burger.diameter,
+                           grill_height=hg, gravity=g,
                            target=BENIGN[:2])
     assert land["offset"] <= R_LAND + 1e-3 and land["tilt_deg"] >= TILT_MIN_DEG - 0.5
 

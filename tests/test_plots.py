@@ -186,7 +186,7 @@ def test_drawing_helpers_draw(guess_plan):
 
         fig, axes = plt.subplots(3, 1, sharex=True)
         out = draw.plot_forces(axes, data.contact_series(guess_plan))
-        assert out["n_nodes"] == 42 and out["n_enforced"] == 21 + 15  # flip: nodes ≤ release
+        assert out["n_nodes"] == 42 and out["n_enforced"] == 21 + 14  # flip: nodes < release
         plt.close(fig)
 
         fig, ax = plt.subplots()

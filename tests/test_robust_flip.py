@@ -15,7 +15,7 @@ from flipkit.model.scoop import GRAVITY, ScoopPath, footprint_share, overhang_sh
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import command_lead, position_command
 from flipkit.planning.plans.verify import verify_plan
-from flipkit.planning.plans.verify_flight import LANDING_TOL
+from flipkit.planning.plans.verify_flight import LANDING_TOL, TILT_MIN_DEG
 from flipkit.transcription.constraints.flight import ScenarioLanding
 from conftest import check_block_jacobian
 
@@ -142,7 +142,7 @@ def test_robust_plan_records_and_verifies_every_scenario(flip_plan, tmp_path):
     assert min(xs) < flip.landing["burger_on_blade"][0] < max(xs)
     for r in rows:
         assert r["offset"] <= r["r_land"] + LANDING_TOL["m"]  # the verification's tolerances
-        assert r["tilt_deg"] >= 150.0 - LANDING_TOL["deg"]
+        assert r["tilt_deg"] >= TILT_MIN_DEG - LANDING_TOL["deg"]
     again = Plan.load(flip_plan.to_json(tmp_path / "p.json"))
     assert again.segment("flip").landing["scenarios"] == rows
     assert verify_plan(again).ok
@@ -380,6 +380,22 @@ def test_every_scenario_is_held_by_the_planned_cone_and_pressed_before_the_relea
         assert f[-1, 2] >= RELEASE_PRESS - tol
 
 
+def test_the_burger_leaves_the_blade_at_the_release_node(flip_plan):
+    """No normal force at the release node at the burger's place, where the flight model
+    starts the flight; a plan whose release is recorded one node early (the burger still
+    pressed there) fails verify's ``release`` group."""
+    flip = flip_plan.segment("flip")
+    r = flip.release["node"]
+    f = _specific_forces(flip_plan, flip, flip.landing["burger_on_blade"])
+    assert abs(f[r, 2]) <= 1e-4 and f[r + 1, 2] < 0.0
+    report = verify_plan(flip_plan)
+    assert report.groups["release"].ok and report.groups["release"].node == r
+    early = copy.deepcopy(flip_plan)
+    early.segment("flip").release["node"] = r - 1
+    bad = verify_plan(early).groups["release"]
+    assert not bad.ok and bad.violation >= 3.0 - 1e-3  # f_z ≥ RELEASE_PRESS at r − 1
+
+
 def test_flip_nlp_carries_the_release_blocks():
     """The flip NLP has a cone per scenario and the press at r − 1; release_press=0 drops the
     press, and a task without scenarios has neither scenario cone."""
@@ -398,10 +414,12 @@ def test_flip_nlp_carries_the_release_blocks():
 
     r = SegmentOptions().release_node()
     got = names()
-    assert {"cone", "cone_scenario_0", "cone_scenario_1", "release_press"} <= set(got)
+    assert {"cone", "cone_scenario_0", "cone_scenario_1", "release_press", "release"} <= set(got)
     nlp = transcribe("flip", models, q, qd, scenarios=scen, **kw)
     press = next(b for b in nlp.blocks if b.name == "release_press")
     assert press.nodes == [r - 1]
+    release = next(b for b in nlp.blocks if b.name == "release")
+    assert release.nodes == [r] and max(nlp.cone_nodes) == r - 1
     scenario = next(b for b in nlp.blocks if b.name == "cone_scenario_1")
     assert max(scenario.nodes) == r - 1
     assert "release_press" not in names(SegmentOptions(release_press=0.0))

@@ -22,7 +22,7 @@ def test_table1_location_plans_and_verifies(index):
         np.testing.assert_allclose(a.q[-1], b.q[0], atol=1e-9)
         np.testing.assert_allclose(a.qd[-1], b.qd[0], atol=1e-9)
     flip = plan.segments[FLIP_NAMES.index("flip")]
-    assert flip.cone_nodes == list(range(15))  # the paper's 0.6 N, extended to the release
+    assert flip.cone_nodes == list(range(14))  # the paper's 0.6 N, extended to before the release
     assert flip.landing["offset"] <= flip.landing["r_land"] + 1e-6
     assert all(s.solver.name in ("sqp", "ipopt") for s in plan.segments)
     _scoop_brakes_within_friction_under_the_burger(plan)

@@ -13,7 +13,7 @@ poses and rest, the position/velocity/acceleration box and pitch range (eq. 4), 
 edges above the grill (the scoop's press included), the scoop's tip band, lateral band and
 attitude band, the flip's end-normal box, x-axis box at every sample, end-height band, cone
 up to the release at 0.7 T and the ballistic landing within r_land of the pickup spot, top
-face ≥ 150° from up — and a duration free within the same bounds
+face ≥ TILT_MIN_DEG (175°) from up — and a duration free within the same bounds
 (the specs' ``duration``). Not kept: the flip's flight clearance and the
 arm's space limits (joint-space quantities the task-space method cannot see).
 
@@ -139,7 +139,9 @@ class Task:
             o = z[6:9]
             x[:6, k], x[9:, k] = z[:6], rpy_rate_matrix(o) @ z[9:]
             Rs[:, 3 * k: 3 * k + 3] = rpy_matrix(o)
-        par = landing_parameters(self.cell.burger.thickness, self.cell.grill.height, self.g)
+        bg = self.cell.burger
+        par = landing_parameters(bg.thickness, self.cell.grill.height, self.g,
+                                 diameter=bg.diameter)
         y = np.asarray(_mapped_landing(len(Z))(x, Rs, par)[0])  # (5, k)
         return np.vstack([y[3], y[4], np.clip(y[1], -1.0, 1.0)])
 

@@ -1,9 +1,10 @@
 """Flip (26) and turn back (27), and the pickup-and-flip behaviour.
 
 The flip keeps the burger in contact up to the release node r = ⌈release_fraction · N⌉ (the
-paper's cone on i ≤ 0.6 N, extended to r); after it the burger flies ballistically, clear of
-the blade, and lands on the spot (:mod:`flipkit.transcription.constraints.flight`), with
-every scenario of its place on the blade. It ends moving, with room to brake, and its last
+paper's cone on i ≤ 0.6 N, extended to r − 1), where the contact force falls to zero; after
+it the burger flies ballistically, clear of the blade, and lands flat on the spot
+(:mod:`flipkit.transcription.constraints.flight`), with every scenario of its place on the
+blade. It ends moving, with room to brake, and its last
 state, coasting for the turn back's first node interval, keeps the space margin too. The
 turn back returns to q_home at rest, above any flipped burger on the grill.
 """
@@ -31,18 +32,21 @@ def release_node(ctx) -> int:
 
 
 def flip_cone(ctx) -> list[int]:
-    """Contact up to the release node (at least the paper's 0.6 N)."""
+    """Contact up to the node before the release node (at least the paper's 0.6 N): at the
+    release node the contact force is zero (:func:`release_blocks`)."""
     r = release_node(ctx)
-    return [i for i in range(ctx.layout.n_nodes) if i <= max(r, tg.FLIP_CONE_FRACTION * ctx.layout.N)]
+    return [i for i in range(ctx.layout.n_nodes) if i <= max(r - 1, tg.FLIP_CONE_FRACTION * ctx.layout.N)]
 
 
 def release_blocks(ctx) -> list:
     """A decisive release wherever the burger lies: the cone at every scenario's place on
-    the nodes before the release node r (the nominal place's is the segment's own cone), and
-    at node r − 1 the normal specific force f_z ≥ ``options.release_press`` at the nominal
-    place and at every scenario's, so the contact lets go within the last interval before r
-    (:data:`~flipkit.config.task.RELEASE_PRESS`). The press needs the ``physical`` cone (its
-    first row is f_z); the ``paper`` cone gets the scenario cones alone."""
+    the nodes before the release node r (the nominal place's is the segment's own cone), at
+    node r − 1 the normal specific force f_z ≥ ``options.release_press`` at the nominal
+    place and at every scenario's, and f_z = 0 at node r at the nominal place, so the burger
+    leaves the blade at node r, where the flight model (:class:`~flipkit.transcription.
+    constraints.flight.Landing`) starts it (:data:`~flipkit.config.task.RELEASE_PRESS`).
+    The press and the release need the ``physical`` cone (its first row is f_z); the
+    ``paper`` cone gets the scenario cones alone."""
     L, cell, task, o = ctx.layout, ctx.cell, ctx.task, ctx.options
     r = release_node(ctx)
     if r < 1:
@@ -61,6 +65,11 @@ def release_blocks(ctx) -> list:
         lo[0, 0] = press
         blocks.append(KinematicBlock("release_press", L, Cone(form, (*task.blade_point(), 0.0)),
                                      [r - 1], lo, np.inf, scale=0.1))
+    if o.cone == "physical":  # only f_z is held: the friction rows have no force to bound
+        lo, hi = np.full((1, form.rows), -np.inf), np.full((1, form.rows), np.inf)
+        lo[0, 0] = hi[0, 0] = 0.0
+        blocks.append(KinematicBlock("release", L, Cone(form, (*task.blade_point(), 0.0)),
+                                     [r], lo, hi, scale=0.1))
     return blocks
 
 
@@ -77,14 +86,14 @@ def flip_path(ctx) -> list:
         margin = np.full(L.N - r, FLIGHT_MARGIN)
         margin[0] = 0.0  # the burger has only just left the blade at node r + 1
         on_blade = task.blade_point()
-        blocks += [Landing(L, r, spot, o.r_land, thickness=bg.thickness, grill_height=hg,
-                           gravity=cell.gravity, on_blade=on_blade),
+        blocks += [Landing(L, r, spot, o.r_land, thickness=bg.thickness, diameter=bg.diameter,
+                           grill_height=hg, gravity=cell.gravity, on_blade=on_blade),
                    FlightClearance(L, r, margin, thickness=bg.thickness, diameter=bg.diameter,
                                    gravity=cell.gravity, on_blade=on_blade)]
         if len(task.scenarios):
             blocks.append(ScenarioLanding(L, r, spot, o.r_scenario, task.scenarios,
-                                          thickness=bg.thickness, grill_height=hg,
-                                          gravity=cell.gravity))
+                                          thickness=bg.thickness, diameter=bg.diameter,
+                                          grill_height=hg, gravity=cell.gravity))
         blocks += release_blocks(ctx)
     (lo_n, hi_n), (lo_x, hi_x), band = tg.FLIP_NORMAL_BOUNDS, tg.FLIP_XAXIS_BOUNDS, tg.FLIP_HEIGHT_BAND
     return blocks + [

@@ -3,11 +3,19 @@
 flipkit's addition to the paper's flip (eq. 26), which names no landing. The burger rides the
 blade while the contact force presses it onto the blade; at the release node it leaves with
 the rigid-body state of its centre — half a burger thickness above the blade centre on the
-carrying face — and flies ballistically: gravity acts on the centre, and the burger turns at
-the blade's angular velocity at release, constant (no torque acts on it in flight; the
-gyroscopic precession of a disc turning about a principal axis is zero). It lands when its
+carrying face — and flies ballistically: gravity acts on the centre, and no torque acts on
+the burger, which leaves with the blade's angular velocity ω at release. It lands when its
 centre is half a thickness above the grill, which is where a burger lying on its other side
 has its centre.
+
+The burger is a solid disc (radius r, thickness h): its moment of inertia about its axis is
+I_a = m r²/2 and about a diameter I_t = m (3r² + h²)/12, κ = I_a/I_t = 6r²/(3r² + h²) (1.94
+for the default patty). In torque-free motion its angular momentum L = I_t ω + (I_a − I_t)
+(ω·n) n is constant and so is ω·n (Euler's equations of a symmetric body), so ω = L/I_t −
+(κ − 1)(ω·n) n and ṅ = ω × n = (L/I_t) × n: the axis n turns about the fixed direction of L
+at the constant rate |L|/I_t, not about ω. ω is along a principal axis only when the blade
+does not turn about its own normal at release; a flip's ω·n of about 0.5 rad/s over 6 rad/s
+turns the landed face 2-7° from where a rotation about ω would put it.
 
 Release state at the blade pose (p, R), velocity v and angular velocity ω (world frame), the
 burger's centre over the blade point b = (b_x, b_y, 0) (the blade centre unless the burger
@@ -17,7 +25,7 @@ was measured elsewhere on the blade, e.g. after a scoop that dragged it forward)
 
 Flight, with τ the time since release and g = |gravity| along −z:
 
-    c(τ) = c₀ + ċ₀ τ − ½ g τ² ẑ,   n(τ) = Rot(ω τ) n₀   (Rodrigues)
+    c(τ) = c₀ + ċ₀ τ − ½ g τ² ẑ,   n(τ) = Rot(Ω τ) n₀  (Rodrigues),   Ω = L/I_t = ω + (κ − 1)(ω·n₀) n₀
     t_f = (ċ₀_z + √(ċ₀_z² + 2 g (c₀_z − z_land))) / g,   z_land = h_g + h/2
 
 Everything is one CasADi SX graph (exact first derivatives by algorithmic differentiation):
@@ -36,9 +44,9 @@ import math
 import casadi as ca
 import numpy as np
 
+from flipkit.config.task import TILT_MIN_DEG  # top-face normal this far from +z at landing
 from flipkit.errors import ConfigError
 
-TILT_MIN_DEG = 150.0  # top-face normal at least this far from world +z at landing
 _SMOOTH = 1e-6  # ε in √(x + ε): keeps |ω| and the disc's extent differentiable at 0
 
 
@@ -56,6 +64,17 @@ def _release(p, v, R, w, delta, h, bx, by):
     return p + arm, v + ca.cross(w, arm), n0
 
 
+def spin_ratio(radius, thickness):
+    """κ = I_a/I_t of a solid disc: its moment of inertia about its axis over that about a
+    diameter (module docstring); works on numbers and on CasADi expressions."""
+    return 6 * radius**2 / (3 * radius**2 + thickness**2)
+
+
+def _axis_rate(w, n0, radius, thickness):
+    """Ω = L/I_t = ω + (κ − 1)(ω·n₀) n₀ (SX): the free disc's axis n turns about Ω."""
+    return w + (spin_ratio(radius, thickness) - 1) * ca.dot(w, n0) * n0
+
+
 def _rotate(n, w, tau):
     """Rot(ω τ) n by Rodrigues' formula, smooth at ω = 0 (SX)."""
     a = ca.sqrt(ca.dot(w, w) + _SMOOTH**2)
@@ -68,18 +87,18 @@ def landing_function() -> ca.Function:
     """CasADi function ``(x, R, par) → (y, dy/dx)``.
 
     ``x`` = (p, v, δ, ω) (12), ``R`` the 3×3 blade rotation, ``par`` = (h, g, z_land, target x,
-    target y, bx, by) with (bx, by) where the burger's centre sits on the blade (blade frame,
-    m). ``y`` = (distance of the landing point from the target (m), z of the top-face normal
+    target y, bx, by, r) with (bx, by) where the burger's centre sits on the blade (blade frame,
+    m) and r the burger's radius (m). ``y`` = (distance of the landing point from the target (m), z of the top-face normal
     at landing (cos of its angle from +z), time of flight (s), landing x, landing y).
     """
-    x, R, par = ca.SX.sym("x", 12), ca.SX.sym("R", 3, 3), ca.SX.sym("par", 7)
+    x, R, par = ca.SX.sym("x", 12), ca.SX.sym("R", 3, 3), ca.SX.sym("par", 8)
     p, v, delta, w = x[0:3], x[3:6], x[6:9], x[9:12]
     h, g, z_land = par[0], par[1], par[2]
     c0, cd, n0 = _release(p, v, R, w, delta, h, par[5], par[6])
     tf = (cd[2] + ca.sqrt(cd[2] ** 2 + 2 * g * (c0[2] - z_land))) / g
     land = c0[0:2] + cd[0:2] * tf
     dist = ca.sqrt(ca.sumsqr(land - par[3:5]) + _SMOOTH**2)
-    nz = _rotate(n0, w, tf)[2]
+    nz = _rotate(n0, _axis_rate(w, n0, par[7], h), tf)[2]
     y = ca.vertcat(dist, nz, tf, land)
     return ca.Function("landing", [x, R, par], [y, ca.jacobian(y, x)])
 
@@ -101,7 +120,7 @@ def clearance_function() -> ca.Function:
     c0, cd, n0 = _release(x[0:3], x[3:6], Rr, x[9:12], x[6:9], h, par[3], par[4])
     tau = x[12]
     c = c0 + cd * tau + ca.vertcat(0, 0, -g / 2 * tau**2)
-    n = _rotate(n0, x[9:12], tau)
+    n = _rotate(n0, _axis_rate(x[9:12], n0, rad, h), tau)
     ni = ((ca.SX.eye(3) + _skew(x[16:19])) @ Ri)[:, 2]
     cos = ca.dot(n, ni)
     extent = rad * ca.sqrt(1 - cos**2 + _SMOOTH) + h / 2 * ca.sqrt(cos**2 + _SMOOTH)
@@ -118,23 +137,25 @@ def gravity_magnitude(gravity) -> float:
 
 
 def landing_parameters(thickness: float, grill_height: float, gravity, target=(0.0, 0.0),
-                       on_blade=(0.0, 0.0)) -> list:
+                       on_blade=(0.0, 0.0), *, diameter: float) -> list:
     """The ``par`` input of :func:`landing_function`: (h, g, z_land = h_g + h/2, target x,
-    target y, bx, by) (SI; ``gravity`` the vector, along −z)."""
+    target y, bx, by, r = diameter/2) (SI; ``gravity`` the vector, along −z)."""
     return [float(thickness), gravity_magnitude(gravity), grill_height + thickness / 2,
-            *np.asarray(target, float)[:2], *np.asarray(on_blade, float)[:2]]
+            *np.asarray(target, float)[:2], *np.asarray(on_blade, float)[:2], diameter / 2]
 
 
-def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravity,
-                    target=(0.0, 0.0), on_blade=(0.0, 0.0)) -> dict:
-    """Landing of a burger released from the blade state (p, R, v, ω) (world, SI), its
-    centre over the blade point ``on_blade`` (x, y) (blade frame, m).
+def predict_landing(p, v, R, w, *, thickness: float, diameter: float, grill_height: float,
+                    gravity, target=(0.0, 0.0), on_blade=(0.0, 0.0)) -> dict:
+    """Landing of a burger (``thickness``, ``diameter``, m) released from the blade state
+    (p, R, v, ω) (world, SI), its centre over the blade point ``on_blade`` (x, y) (blade
+    frame, m).
 
     Returns:
         ``point`` (x, y, z of the centre at landing, m), ``offset`` (distance from ``target``,
         m), ``tilt_deg`` (angle of the top-face normal from +z, deg), ``time_of_flight`` (s).
     """
-    par = landing_parameters(thickness, grill_height, gravity, target, on_blade)
+    par = landing_parameters(thickness, grill_height, gravity, target, on_blade,
+                             diameter=diameter)
     z_land = par[2]
     x = np.concatenate([p, v, np.zeros(3), w])
     y = np.asarray(landing_function()(x, np.asarray(R, float), par)[0])
@@ -145,4 +166,4 @@ def predict_landing(p, v, R, w, *, thickness: float, grill_height: float, gravit
 
 
 __all__ = ["TILT_MIN_DEG", "landing_function", "landing_parameters", "clearance_function", "gravity_magnitude",
-           "predict_landing"]
+           "predict_landing", "spin_ratio"]

@@ -149,7 +149,7 @@ def _burger_poses(plan, cell, robot, t, q, bounds, flight, placed):
             fl = flight[1]
             tau = min(ti - flight[0], fl["time_of_flight"])
             c = fl["c0"] + fl["v0"] * tau + 0.5 * np.asarray(cell.gravity) * tau**2
-            out[i] = _pose(Rotation.from_rotvec(fl["w"] * tau).as_matrix() @ fl["R0"], c)
+            out[i] = _pose(fl["attitude"](tau), c)
         elif carried and k in carried and ti <= ends[carried[-1]]:
             out[i] = robot.placement(qi).homogeneous @ offset
         elif carried and k > carried[-1] and placed is not None:

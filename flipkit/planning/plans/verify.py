@@ -30,7 +30,7 @@ behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip 
                    (in the blade's start frame, attitude band)
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
 cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
-                   (flip: nodes ≤ max(0.6 N, release node); carry: all;
+                   (flip: nodes ≤ max(0.6 N, release node − 1); carry: all;
                    place: nodes ≤ 0.7 N)
 grill_clearance    the blade's four corners' heights ≥ the segment's floor (m):  tol
                    h_g, pressed SCOOP_PRESS into it on scoop and pickup,
@@ -38,8 +38,10 @@ grill_clearance    the blade's four corners' heights ≥ the segment's floor (m)
 placing            serve: the table spot on the table, and the rest point        1 mm
                    predicted from the place's end pose (FK) at the spot
                    (:func:`flipkit.behaviors.serve.predicted_rest`)
+release            flip: normal specific force zero at the release node, at the     10·tol
+                   burger's recorded place (m/s²)
 landing            flip: landing recomputed (:mod:`flipkit.planning.plans.verify_flight`):    0.1 mm,
-                   within r_land, tilt ≥ 150°, and equal to the recorded one   0.01°, 0.1 ms
+                   within r_land, tilt ≥ 175°, and equal to the recorded one   0.01°, 0.1 ms
 flight_clearance   flip: coal distance blade–flying burger ≥ 0 after release   0.1 mm
 arm_clearance      every link (URDF collision hull), the handle and the blade  tol
                    keep cell.space.margin (2 cm) from grill, table and walls,
@@ -78,7 +80,7 @@ from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.model.contact import make_cone
+from flipkit.model.contact import make_cone, specific_force
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
@@ -196,13 +198,18 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     release = seg.release["node"] if seg.release else 0
     required = {"translate": range(N + 1), "pickup": range(N + 1),
                 "scoop": tg.scoop_cone_nodes(cell, N),
-                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release)],
+                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release - 1)],
                 "carry": range(N + 1),
                 "place": [i for i in range(N + 1) if i <= sv.PLACE_CONE_FRACTION * N + 1e-9]}
     for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
         # the flip's cone holds where the burger lies on the blade
         st = at_burger[0].take(i) if at_burger else states[i]
         add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
+    if seg.name == "flip" and seg.release and seg.landing and plan.cone == "physical":
+        # the burger leaves the blade at the release node: no normal force there
+        st = at_burger[0].take(release) if at_burger else states[release]
+        f = specific_force(st.R, st.a, cell.gravity)
+        add("release", k, abs(f[2]), 10 * tol, release)
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
 
 

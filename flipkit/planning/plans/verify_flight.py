@@ -3,15 +3,16 @@
 Nothing here uses :mod:`flipkit.model.flight` or the NLP's blocks. The release state comes from
 pinocchio (:class:`~flipkit.model.robot.Robot` rebuilt from the plan file) at the recorded release
 node; the flight is integrated numerically (``scipy.integrate.solve_ivp`` on the centre's
-ballistic ODE with a ground event, the attitude as ``Rotation.from_rotvec(ω τ)`` applied to
-the blade's attitude at release); the blade–burger clearance after the release is a distance
+ballistic ODE with a ground event, together with the attitude of a free solid disc, Ṙ = [ω]× R
+with ω = R I⁻¹ Rᵀ L and the angular momentum L fixed by the blade's ω at release); the
+blade–burger clearance after the release is a distance
 query between the blade (a box of the spatula's length, width and thickness under its
 carrying face) and the burger (a cylinder) with coal, the collision library shipped with
 pinocchio.
 
-Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt short
-of :data:`TILT_MIN_DEG` (deg), and the recorded prediction against the recomputed one (point
-m, tilt deg, time of flight s; tolerances :data:`LANDING_TOL`).
+Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt
+short of :data:`~flipkit.config.task.TILT_MIN_DEG` (deg), and the recorded prediction against
+the recomputed one (point m, tilt deg, time of flight s; tolerances :data:`LANDING_TOL`).
 Group ``landing_scenarios`` (robust flips): the same rows for every recorded scenario of the
 burger's place on the blade, each against its own ``r_land``. Group
 ``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes
@@ -25,12 +26,23 @@ import math
 import coal
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.spatial.transform import Rotation
 
+from flipkit.config.task import TILT_MIN_DEG  # the task's bound: the check is this module's own
 from flipkit.model.collision import pin_box_support
 
-TILT_MIN_DEG = 150.0  # the landed top face's normal at least this far from +z
 LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
+
+
+def _disc_inertia(cell) -> np.ndarray:
+    """Principal moments (per unit mass, m²) of the burger as a solid disc, axis last."""
+    r, h = cell.burger.diameter / 2, cell.burger.thickness
+    return np.array([(3 * r * r + h * h) / 12, (3 * r * r + h * h) / 12, r * r / 2])
+
+
+def _attitude(R: np.ndarray) -> np.ndarray:
+    """The rotation nearest to the integrated 3×3 R (its polar factor)."""
+    u, _, vt = np.linalg.svd(R)
+    return u @ vt
 
 
 def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
@@ -41,7 +53,8 @@ def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
 
     Returns:
         ``c0``, ``v0`` (centre and its velocity at release, m, m/s), ``w`` (rad/s), ``R0``
-        (burger attitude at release), ``point`` (m), ``tilt_deg``, ``time_of_flight`` (s).
+        (burger attitude at release), ``point`` (m), ``tilt_deg``, ``time_of_flight`` (s),
+        ``attitude`` (a function of the time since release, s: the burger's rotation).
     """
     if not seg.release:
         return None
@@ -56,19 +69,28 @@ def recompute_landing(robot, seg, cell, on_blade=None) -> dict | None:
     c0, v0 = st.p + arm, st.v + np.cross(w, arm)
     z_land = cell.grill.height + h / 2
 
+    inertia = _disc_inertia(cell)  # the burger's axes are the blade's at release
+    L = st.R @ (inertia * (st.R.T @ w))  # angular momentum per unit mass, fixed in flight
+
+    def flight(_, y):
+        R = y[6:].reshape(3, 3)
+        omega = R @ ((R.T @ L) / inertia)
+        return np.concatenate([y[3:6], g, np.cross(omega, R.T).T.ravel()])
+
     def ground(_, y):
         return y[2] - z_land
 
     ground.terminal, ground.direction = True, -1
-    sol = solve_ivp(lambda _, y: np.concatenate([y[3:], g]), (0.0, 10.0),
-                    np.concatenate([c0, v0]), events=ground, rtol=1e-10, atol=1e-12)
+    sol = solve_ivp(flight, (0.0, 10.0), np.concatenate([c0, v0, st.R.ravel()]), events=ground,
+                    rtol=1e-10, atol=1e-12, dense_output=True, method="DOP853")
     if not sol.t_events[0].size:
         return None
     tf = float(sol.t_events[0][0])
-    n = Rotation.from_rotvec(w * tf).apply(st.R[:, 2])
+    n = _attitude(sol.y_events[0][0][6:].reshape(3, 3))[:, 2]
     return {"c0": c0, "v0": v0, "w": w, "R0": st.R, "point": sol.y_events[0][0][:3],
             "tilt_deg": math.degrees(math.acos(float(np.clip(n[2], -1.0, 1.0)))),
-            "time_of_flight": tf}
+            "time_of_flight": tf,
+            "attitude": lambda tau: _attitude(sol.sol(min(tau, tf))[6:].reshape(3, 3))}
 
 
 def blade_burger_distance(blade_pose, burger_pose, cell) -> float:
@@ -116,6 +138,6 @@ def check_flight(report, k, seg, robot, cell, states) -> None:
     for i in range(r + 1, seg.N + 1):
         tau = seg.t[i] - seg.t[r]
         c = pred["c0"] + pred["v0"] * tau + 0.5 * np.asarray(cell.gravity) * tau**2
-        Rc = Rotation.from_rotvec(pred["w"] * tau).as_matrix() @ pred["R0"]
+        Rc = pred["attitude"](tau)
         d = blade_burger_distance((states[i].p, states[i].R), (c, Rc), cell)
         add("flight_clearance", k, [max(-d, 0.0)], tol["m"], i)

@@ -16,7 +16,7 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
           "interpolant": "rad/s | rad/s²",
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
-          "cone": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
+          "cone": "m/s²", "release": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
           "landing_scenarios": "m | deg | s", "flight_clearance": "m", "placing": "m",
           "arm_clearance": "m", "orientation": "rad",
           "singularity": "rad", "completeness": "segments"}

@@ -2,12 +2,12 @@
 
 Design choice: the release is a fixed node r of the flip segment (default ⌈0.7 N⌉, so that
 the burger is on the blade for 70 % of the flip, above the paper's 60 % success threshold).
-Contact is imposed up to the release — the friction cone holds on nodes 0..r, so the contact
-force presses the burger onto the blade — and separation after it: on nodes r+1..N the
-burger, flying ballistically from its state at node r (:mod:`flipkit.model.flight`), stays on the
-carrying side of the blade's plane (:class:`FlightClearance`). Since the blade must fall away
-from the ballistic burger faster than gravity right after node r, the contact force vanishes
-between nodes r and r+1: the release. :class:`Landing` bounds where and how the burger comes
+Contact is imposed up to the release — the friction cone holds on nodes 0..r−1, so the
+contact force presses the burger onto the blade, and the normal force is zero at node r
+(:func:`flipkit.behaviors.flip.release_blocks`): the burger leaves the blade there, where its
+flight starts — and separation after it: on nodes r+1..N the burger, flying ballistically
+from its state at node r (:mod:`flipkit.model.flight`), stays on the carrying side of the
+blade's plane (:class:`FlightClearance`). :class:`Landing` bounds where and how the burger comes
 down. The release time is then t_r = r T / N, a variable through T.
 """
 
@@ -61,27 +61,27 @@ def _predictions(ev, robot, r: int, pars) -> list[dict]:
     """:func:`~flipkit.model.flight.predict_landing` of the release at node r, per ``pars``."""
     st = ev.state(r)
     w, _ = robot.angular_velocity_jacobian(*ev.node(r)[:2])
-    return [predict_landing(st.p, st.v, st.R, w, thickness=par[0],
+    return [predict_landing(st.p, st.v, st.R, w, thickness=par[0], diameter=2 * par[7],
                             grill_height=par[2] - par[0] / 2, gravity=(0.0, 0.0, -par[1]),
                             target=par[3:5], on_blade=par[5:7]) for par in pars]
 
 
 class Landing(Block):
     """Landing of the burger released at node r: within ``r_land`` of ``target`` (x, y) and
-    upside down (top-face normal ≥ :data:`~flipkit.model.flight.TILT_MIN_DEG` from +z).
+    upside down (top-face normal ≥ :data:`~flipkit.config.task.TILT_MIN_DEG` from +z).
 
     Rows: landing distance from the target (m) ≤ r_land; z of the landed top-face normal ≤
-    cos(150°).
+    cos(TILT_MIN_DEG).
 
     Args:
         layout: Variable layout. release: Release node r.
         target: Landing spot (x, y) (m). r_land: Allowed distance (m).
-        thickness: Burger thickness h (m). grill_height: h_g (m). gravity: (3,) m/s².
+        thickness, diameter: Burger size (m). grill_height: h_g (m). gravity: (3,) m/s².
         on_blade: Where the burger's centre sits on the blade (x, y), blade frame (m).
     """
 
     def __init__(self, layout, release: int, target, r_land: float, *, thickness: float,
-                 grill_height: float, gravity, on_blade=(0.0, 0.0)):
+                 diameter: float, grill_height: float, gravity, on_blade=(0.0, 0.0)):
         super().__init__("landing", layout)
         if not (math.isfinite(r_land) and r_land > 0):
             raise ConfigError(f"r_land must be a positive distance (m), got {r_land!r}")
@@ -89,7 +89,8 @@ class Landing(Block):
             raise ConfigError(f"release node must be inside the segment, got {release}")
         self.release = int(release)
         self.on_blade = [float(v) for v in np.asarray(on_blade, float)[:2]]
-        self.par = landing_parameters(thickness, grill_height, gravity, target, self.on_blade)
+        self.par = landing_parameters(thickness, grill_height, gravity, target, self.on_blade,
+                                      diameter=diameter)
         self._add(0, 2, np.concatenate([layout.iq(release), layout.iqd(release)]))
         self.m = 2
         self._finish([-np.inf, -np.inf], [r_land, math.cos(math.radians(TILT_MIN_DEG))],
@@ -117,17 +118,17 @@ class ScenarioLanding(Block):
     make one joint trajectory land every scenario of that spread on the grill spot.
 
     Rows per scenario: landing distance from the target (m) ≤ r_land; z of the landed
-    top-face normal ≤ cos(150°).
+    top-face normal ≤ cos(TILT_MIN_DEG).
 
     Args:
         layout: Variable layout. release: Release node r. target: Landing spot (x, y) (m).
         r_land: Allowed distance of every scenario's landing (m).
         scenarios: Places of the burger's centre on the blade (x, y), blade frame (m), K ≥ 1.
-        thickness, grill_height, gravity: As :class:`Landing`.
+        thickness, diameter, grill_height, gravity: As :class:`Landing`.
     """
 
     def __init__(self, layout, release: int, target, r_land: float, scenarios, *,
-                 thickness: float, grill_height: float, gravity):
+                 thickness: float, diameter: float, grill_height: float, gravity):
         super().__init__("landing_scenarios", layout)
         pts = np.asarray(scenarios, float).reshape(-1, 2)
         if not (math.isfinite(r_land) and r_land > 0):
@@ -138,8 +139,8 @@ class ScenarioLanding(Block):
             raise ConfigError(f"release node must be inside the segment, got {release}")
         self.release = int(release)
         self.scenarios = [[float(a), float(b)] for a, b in pts]
-        self.pars = [landing_parameters(thickness, grill_height, gravity, target, ob)
-                     for ob in self.scenarios]
+        self.pars = [landing_parameters(thickness, grill_height, gravity, target, ob,
+                                        diameter=diameter) for ob in self.scenarios]
         cols = np.concatenate([layout.iq(release), layout.iqd(release)])
         for k in range(len(self.scenarios)):
             self._add(2 * k, 2, cols)
