@@ -25,7 +25,8 @@ was measured elsewhere on the blade, e.g. after a scoop that dragged it forward)
 
 Flight, with τ the time since release and g = |gravity| along −z:
 
-    c(τ) = c₀ + ċ₀ τ − ½ g τ² ẑ,   n(τ) = Rot(Ω τ) n₀  (Rodrigues),   Ω = L/I_t = ω + (κ − 1)(ω·n₀) n₀
+    c(τ) = c₀ + ċ₀ τ − ½ g τ² ẑ,   n(τ) = Rot(Ω τ) n₀  (Rodrigues),
+    Ω = L/I_t = ω + (κ − 1)(ω·n₀) n₀
     t_f = (ċ₀_z + √(ċ₀_z² + 2 g (c₀_z − z_land))) / g,   z_land = h_g + h/2
 
 Everything is one CasADi SX graph (exact first derivatives by algorithmic differentiation):
@@ -88,8 +89,9 @@ def landing_function() -> ca.Function:
 
     ``x`` = (p, v, δ, ω) (12), ``R`` the 3×3 blade rotation, ``par`` = (h, g, z_land, target x,
     target y, bx, by, r) with (bx, by) where the burger's centre sits on the blade (blade frame,
-    m) and r the burger's radius (m). ``y`` = (distance of the landing point from the target (m), z of the top-face normal
-    at landing (cos of its angle from +z), time of flight (s), landing x, landing y).
+    m) and r the burger's radius (m). ``y`` = (distance of the landing point from the target
+    (m), z of the top-face normal at landing (cos of its angle from +z), time of flight (s),
+    landing x, landing y).
     """
     x, R, par = ca.SX.sym("x", 12), ca.SX.sym("R", 3, 3), ca.SX.sym("par", 8)
     p, v, delta, w = x[0:3], x[3:6], x[6:9], x[9:12]

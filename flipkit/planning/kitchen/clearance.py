@@ -9,10 +9,11 @@ schedule: dropped, not yet lifted by their own motions), with the geometry of
 **where a flip lands its burger** (``plan_flip(..., land=...)``; by default where it was
 picked up). A burger met where it landed is landed elsewhere; a serve that meets a burger
 (or a flip whose landing does) moves its own burger's landing, which moves where the serve
-scoops from; a flip whose blade meets a burger still lying where it was dropped lands its own
-burger elsewhere, which changes the toss (up to two other spots). The new spot is the one nearest the burger's drop place that keeps clear, over
-the burger's stay on its second side, of every other motion's footprint and of every other
-burger, and from which its serve's footprint (the present one, moved with it) meets nobody.
+scoops from; a flip whose toss meets a burger still lying where it was dropped lands its own
+burger elsewhere, which changes the toss (up to two other spots). The new spot is the one
+nearest the burger's drop place that keeps clear, over the burger's stay on its second side,
+of every other motion's footprint and of every other burger, and from which its serve's
+footprint (the present one, moved with it) meets nobody.
 The cook is planned and scheduled again with the new spots and checked again. The scoop
 itself cannot be turned: the scoop subbehaviour slides the blade along +x at the burger
 (:mod:`flipkit.behaviors.targets`), so a scoop or pickup that meets a burger still lying where
