@@ -8,8 +8,8 @@ from flipkit.experiments.slides import format_slides, slide_summary
 from flipkit.simulation.run import BurgerRun
 
 
-def _landing(rest, touchdown):
-    return {"xy": rest, "touchdown_xy": touchdown, "flipped": True}
+def _landing(rest, touchdown, tilt=None):
+    return {"xy": rest, "touchdown_xy": touchdown, "flipped": True, "touchdown_tilt_deg": tilt}
 
 
 def test_the_summary_measures_rest_minus_touchdown_and_skips_trials_without_one():
@@ -23,7 +23,11 @@ def test_the_summary_measures_rest_minus_touchdown_and_skips_trials_without_one(
     assert slide_summary([_landing([0.6, 0.0], None)]) is None and slide_summary([]) is None
     line = format_slides(out)
     assert "3 trials" in line and "max 5.0 cm" in line and "1 over 2 cm" in line
+    assert out["tilt_median_deg"] is None and "flat" not in line  # records without tilts
     assert format_slides(None) == ""
+    tilted = slide_summary([_landing([0.7, 0.0], [0.7, 0.0], t) for t in (2.0, 3.0, 9.0)])
+    assert tilted["tilt_median_deg"] == 3.0 and tilted["tilt_max_deg"] == 9.0
+    assert "3.0° from flat (median), 9.0° at most" in format_slides(tilted)
 
 
 def test_touchdown_is_the_first_grill_contact_from_the_given_time():
@@ -38,6 +42,13 @@ def test_touchdown_is_the_first_grill_contact_from_the_given_time():
                     blade_width=0.12, grill_height=0.057)
     assert run.touchdown(0.3) == 6 and run.touchdown(0.0) == 1 and run.touchdown(0.6) == 6
     assert run.touchdown(0.75) is None
+    from flipkit.experiments.trials import _touchdown_tilt
+
+    a = np.pi - np.radians(10.0)  # turned over about x, 10° short of flat
+    run.burger_rot[6] = [[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]]
+    assert _touchdown_tilt(run, 0.3) == pytest.approx(10.0)
+    assert _touchdown_tilt(run, 0.0) == pytest.approx(180.0)  # index 1: still face up
+    assert _touchdown_tilt(run, 0.75) is None
 
 
 def test_a_trial_records_where_the_flipped_burger_touched_down(flip_plan_file):
@@ -49,7 +60,9 @@ def test_a_trial_records_where_the_flipped_burger_touched_down(flip_plan_file):
     predicted = np.array(out["predicted_landing_xy"])
     assert np.linalg.norm(touch - predicted) < 0.05  # the flight lands near its prediction
     assert np.linalg.norm(rest - touch) < 0.05
+    assert 0.0 <= out["touchdown_tilt_deg"] <= 10.0  # the flip plans it within 5° of flat
     entry = location_entry((0.69, -0.16, 0.072), 1, [out], {"status": "solved"})
     assert entry["landings"][0]["touchdown_xy"] == out["touchdown_xy"]
+    assert entry["landings"][0]["touchdown_tilt_deg"] == out["touchdown_tilt_deg"]
     assert slide_summary(entry["landings"])["max_m"] == pytest.approx(
         np.linalg.norm(rest - touch))

@@ -166,6 +166,7 @@ def run_trial(job: dict) -> dict:
             "perturbation": draw, "tracking": errors, "mode": mode, "command": command,
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
             "touchdown_xy": _touchdown(run, bounds["flip"][0]),
+            "touchdown_tilt_deg": _touchdown_tilt(run, bounds["flip"][0]),
             "predicted_landing_xy": _predicted(ex.plan),
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
                        "time_s": ex.replan_time_s}
@@ -177,6 +178,16 @@ def _touchdown(run, flip_start: float) -> list | None:
     start, or ``None``."""
     k = run.touchdown(flip_start)
     return None if k is None else [float(v) for v in run.burger_pos[k, :2]]
+
+
+def _touchdown_tilt(run, flip_start: float) -> float | None:
+    """The angle (deg) between the burger's top face's normal and straight down at its first
+    contact with the grill after the flip's start (the patty's middle strip, whose pose is the
+    burger's), or ``None``: 0 for a burger that lands flat and upside down."""
+    k = run.touchdown(flip_start)
+    if k is None:
+        return None
+    return float(np.degrees(np.arccos(np.clip(-run.burger_rot[k][2, 2], -1.0, 1.0))))
 
 
 def _predicted(plan) -> list | None:
@@ -193,7 +204,8 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
     in the paper's Table I); ``independent`` counts each judge's passes on its own;
     ``landings`` lists each trial's final burger position (x, y) (m), whether it flipped, the
     executed plan's predicted landing, where the burger first touched the grill after the
-    flip's start (``touchdown_xy``) and, with ``replan``, what was sensed.
+    flip's start (``touchdown_xy``) and how far from flat (``touchdown_tilt_deg``) and, with
+    ``replan``, what was sensed.
     """
     if not results:
         fails = [{"trial": i, "stage": "plan", "reason": plan_info.get("reason"),
@@ -210,6 +222,7 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
             "landings": [{"trial": r["trial"], "flipped": r["ok"]["flip"],
                           "xy": r.get("landing_xy"), "predicted_xy": r.get("predicted_landing_xy"),
                           "touchdown_xy": r.get("touchdown_xy"),
+                          "touchdown_tilt_deg": r.get("touchdown_tilt_deg"),
                           "replan": r.get("replan")} for r in results]}
 
 
