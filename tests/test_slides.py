@@ -42,13 +42,13 @@ def test_touchdown_is_the_first_grill_contact_from_the_given_time():
                     blade_width=0.12, grill_height=0.057)
     assert run.touchdown(0.3) == 6 and run.touchdown(0.0) == 1 and run.touchdown(0.6) == 6
     assert run.touchdown(0.75) is None
-    from flipkit.experiments.trials import _touchdown_tilt
+    from flipkit.experiments.trials import _touchdown
 
     a = np.pi - np.radians(10.0)  # turned over about x, 10° short of flat
     run.burger_rot[6] = [[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]]
-    assert _touchdown_tilt(run, 0.3) == pytest.approx(10.0)
-    assert _touchdown_tilt(run, 0.0) == pytest.approx(180.0)  # index 1: still face up
-    assert _touchdown_tilt(run, 0.75) is None
+    assert _touchdown(run, 0.3)[1] == pytest.approx(10.0)
+    assert _touchdown(run, 0.0)[1] == pytest.approx(180.0)  # index 1: still face up
+    assert _touchdown(run, 0.75) == (None, None)
 
 
 def test_a_trial_records_where_the_flipped_burger_touched_down(flip_plan_file):

@@ -156,6 +156,7 @@ def run_trial(job: dict) -> dict:
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
                       replan=replan, command=command, servo=servo)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
+    touch_xy, touch_tilt = _touchdown(run, bounds["flip"][0])
     scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
     flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
     ok = {"scoop": scoop.ok}
@@ -165,29 +166,23 @@ def run_trial(job: dict) -> dict:
             "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
             "perturbation": draw, "tracking": errors, "mode": mode, "command": command,
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
-            "touchdown_xy": _touchdown(run, bounds["flip"][0]),
-            "touchdown_tilt_deg": _touchdown_tilt(run, bounds["flip"][0]),
+            "touchdown_xy": touch_xy, "touchdown_tilt_deg": touch_tilt,
             "predicted_landing_xy": _predicted(ex.plan),
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
                        "time_s": ex.replan_time_s}
             if replan is not None else None, "physics": dict(job.get("physics") or {})}
 
 
-def _touchdown(run, flip_start: float) -> list | None:
-    """The burger's centre (x, y) (m) at its first contact with the grill after the flip's
-    start, or ``None``."""
-    k = run.touchdown(flip_start)
-    return None if k is None else [float(v) for v in run.burger_pos[k, :2]]
-
-
-def _touchdown_tilt(run, flip_start: float) -> float | None:
-    """The angle (deg) between the burger's top face's normal and straight down at its first
-    contact with the grill after the flip's start (the patty's middle strip, whose pose is the
-    burger's), or ``None``: 0 for a burger that lands flat and upside down."""
+def _touchdown(run, flip_start: float) -> tuple[list | None, float | None]:
+    """At the burger's first contact with the grill after the flip's start: its centre (x, y)
+    (m), and the angle (deg) between its top face's normal and straight down (the patty's
+    middle strip, whose pose is the burger's; 0 for a burger that lands flat and upside
+    down); ``(None, None)`` if it never touches."""
     k = run.touchdown(flip_start)
     if k is None:
-        return None
-    return float(np.degrees(np.arccos(np.clip(-run.burger_rot[k][2, 2], -1.0, 1.0))))
+        return None, None
+    tilt = float(np.degrees(np.arccos(np.clip(-run.burger_rot[k][2, 2], -1.0, 1.0))))
+    return [float(v) for v in run.burger_pos[k, :2]], tilt
 
 
 def _predicted(plan) -> list | None:
