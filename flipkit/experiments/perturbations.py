@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flipkit.config import SensingUncertainty
 from flipkit.errors import ConfigError
 
 
@@ -23,18 +24,15 @@ class Perturbations:
         mass_scale: Range (lo, hi) of the uniform factor on the burger mass, in MuJoCo and in
             the arm's payload (not in the feed-forward). Default (0.9, 1.1).
         sensing_sigma: Standard deviation (m) of the camera's error on the burger's place on
-            the blade, per axis (sense-plan-act only). An active-stereo depth camera (Intel
-            RealSense D400 series datasheet: depth RMS error < 2 % at 2 m) 0.6 m above the
-            blade errs by up to 1.2 cm in depth; seen from above, the burger's (x, y) comes
-            from the image, and a depth error of 1.2 cm moves a point 25° off the optical axis
-            by 5.6 mm sideways. Default 5 mm (ours, from that geometry).
+            the blade, per axis (sense-plan-act only). Default the error re-plans plan for,
+            5 mm (:class:`~flipkit.config.SensingUncertainty`, with its source).
     """
 
     position_sigma: float = 0.005
     grill_offset: float = 0.002
     mu_scale: tuple = (0.8, 1.2)
     mass_scale: tuple = (0.9, 1.1)
-    sensing_sigma: float = 0.005
+    sensing_sigma: float = SensingUncertainty().sigma
 
     def __post_init__(self):
         for name in ("position_sigma", "grill_offset", "sensing_sigma"):

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from flipkit.config import CellConfig
+from flipkit.config import CellConfig, SensingUncertainty
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.servo_command import COMMANDS
@@ -63,8 +63,8 @@ from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger
 REST_SPEED = 1e-3  # m/s (burger centres) and rad/s (arm joints): "at rest" before a skip
 MAX_SETTLE_S = 5.0  # s after a motion's end: the longest the cell is stepped to come to rest
 # m per axis: the camera's error on a burger's place, as sense-plan-act's on the blade
-# (flipkit.experiments.perturbations.Perturbations.sensing_sigma, with its source)
-SENSING_SIGMA = 0.005
+# (flipkit.config.SensingUncertainty, with its source)
+SENSING_SIGMA = SensingUncertainty().sigma
 
 
 class CookNotSimulatedError(ConfigError):

@@ -8,12 +8,14 @@ holds. Such places lie beyond the scenario set: in the tails of the placement an
 errors, and where the scoop's unmodelled drift takes the burger, further along the blade or
 to its side (``docs/robust-flips.md`` §4). :class:`Contingencies` solves the flips for four
 such places before they are needed, which a cell can do while the arm goes to the burger
-and scoops (1.35 s). At the measurement it hands out the one whose own release and flight
-land the measured place within the plan's promise: a check of milliseconds instead of a
-solve.
+and scoops (1.35 s). At the measurement it hands out the one that keeps its promise for the
+measured place (its scenarios' hull holds the place, or its own release and flight land it
+within its promise): a check of milliseconds instead of a solve.
 
 Every contingency is a re-plan as :func:`replan_flip` makes it (go to burger, scoop and
-pickup kept), solved and verified; a place that none of them lands is solved as before.
+pickup kept), solved and verified. Like every re-plan it is robust to the camera's error: it
+lands the places 1 cm around its own, so it covers a patch of the blade, not a point. A place
+that none of them covers is solved as before.
 
 A contingency may not be ready when the camera looks: the preparation starts with the plan,
 and its solves can outlast the 1.35 s of motion before the sense. The object records when
@@ -34,7 +36,7 @@ import numpy as np
 from flipkit.errors import ConfigError
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import check_replan
-from flipkit.planning.planners.planner import keeps_promise, landing_miss, promise, replan_flip
+from flipkit.planning.planners.planner import keeps_promise, replan_flip
 from flipkit.planning.plans.plan_file import Plan
 
 # m: how far past the scenario set's extremes the contingency places lie: along the blade,
@@ -126,9 +128,10 @@ class Contingencies:
         return max(0.0, self.ready_s[k] - self.sense_s)
 
     def lookup(self, on_blade) -> Plan | None:
-        """The contingency, nearest place first, whose own release and flight land a burger
-        at ``on_blade`` (x, y) (m) within the plan's promise (:func:`promise`); ``None``
-        when none does.
+        """The contingency, nearest place first, that keeps its promise for a burger at
+        ``on_blade`` (x, y) (m) as the plan would (:func:`keeps_promise`: the place lies in
+        its scenarios' hull, or its own release and flight land it within its promise);
+        ``None`` when none does.
 
         Raises:
             ConfigError: ``on_blade`` is off the blade.
@@ -139,11 +142,9 @@ class Contingencies:
 
     def _lookup(self, xy, models) -> int | None:
         """The index in :attr:`flips` that :meth:`lookup` hands out for a checked place."""
-        radius = promise(self.plan)
         for k in sorted(range(len(self.flips)),
                         key=lambda i: float(np.hypot(*np.subtract(self.flips[i][0], xy)))):
-            flip = self.flips[k][1].segment("flip")
-            if landing_miss(flip, xy, models) <= radius:
+            if keeps_promise(self.flips[k][1], xy, models):
                 return k
         return None
 

@@ -29,7 +29,7 @@ from flipkit.behaviors import targets as tg
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import flat_pose
-from flipkit.config import CellConfig
+from flipkit.config import CellConfig, SensingUncertainty
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
@@ -196,8 +196,19 @@ def keeps_promise(plan: Plan, on_blade, models) -> bool:
             or landing_miss(flip, on_blade, models) <= promise(plan))
 
 
+def sensed_scenarios(cell: CellConfig, on_blade,
+                     sensing: SensingUncertainty = SensingUncertainty()) -> tuple:
+    """The places a burger measured at ``on_blade`` (x, y) (m, blade frame) may lie at:
+    ``sensing.reach`` from it along the blade and across it, clipped to the blade."""
+    x, y = (float(v) for v in on_blade)
+    d = sensing.reach
+    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    return tuple(np.clip(p, -half, half) for p in ((x - d, y), (x + d, y), (x, y - d), (x, y + d)))
+
+
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
-                options: SegmentOptions = SegmentOptions(), keep: bool = True) -> Plan:
+                options: SegmentOptions = SegmentOptions(), keep: bool = True,
+                sensing: SensingUncertainty = SensingUncertainty()) -> Plan:
     """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
     ``on_blade`` on the blade after the scoop (sense, plan, act).
 
@@ -208,7 +219,9 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     with the release state of a burger at ``on_blade``, to the plan's landing target, then the
     turn back from its end, each SQP started from the plan's own solution of that segment (the
     burger moved by centimetres on the blade: the old flip is close to the new one); the result
-    is checked like any plan.
+    is checked like any plan. The measurement errs, so a robust plan's new flip is robust too
+    (unless ``options.robust`` is off): it also lands the places ``sensing.reach`` (1 cm) from
+    the measured one within ``r_scenario`` (:func:`sensed_scenarios`).
 
     A robust plan promises a landing within ``r_scenario`` of the spot for every scenario of
     the burger's place. The plan is returned as it is, with no solve, when the measured place
@@ -222,6 +235,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
             (m). solver, options: As :func:`plan_flip` (``r_land`` from the plan's landing).
         keep: Return ``plan`` itself where it already lands the measured place (default);
             ``False`` always solves.
+        sensing: The camera's error that the re-plan's scenarios span.
 
     Raises:
         ConfigError: ``plan`` is not a solved flip plan, or ``on_blade`` is off the blade.
@@ -235,13 +249,15 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         return plan
     done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
     before = {s.name: s for s in plan.segments}
+    robust = options.robust and bool(flip.landing.get("scenarios"))
 
     def own(name, nlp, q, qd):  # the plan's own segment as the warm start
         s = before[name]
         return nlp.layout.pack(s.q, s.qd, s.qdd, s.u, s.alpha, s.T)
 
     task = Task(location=np.asarray(plan.burger["location"], float),
-                land=np.asarray(flip.landing["target"]), on_blade=on_blade)
+                land=np.asarray(flip.landing["target"]), on_blade=on_blade,
+                scenarios=sensed_scenarios(cell, on_blade, sensing) if robust else ())
     return planner.chain("flip", task, done[-1].q[-1], done[-1].qd[-1], done=done, guess=own,
                          t0=t0)
 
@@ -335,4 +351,4 @@ def format_summary(rows) -> str:
 
 __all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "keeps_promise",
            "landing_miss", "plan_batch", "plan_flip", "plan_translate", "promise", "replan_flip",
-           "summary_table"]
+           "sensed_scenarios", "summary_table"]
