@@ -72,8 +72,9 @@ def test_transcribing_without_the_task_it_needs_is_one_line(name, message):
 def test_floors_follow_the_spec():
     hg, N = CELL.grill.height, 20
     assert np.all(blade_floor("translate", CELL, N) == hg)
-    arrival = blade_floor("go_to_burger", CELL, N)
-    assert np.all(arrival[:-1] == hg) and arrival[-1] < hg  # pressed in at the scoop's start
+    arrival = blade_floor("go_to_burger", CELL, N)  # above the tallest burger, then down
+    assert np.all(arrival[:16] > hg + 0.019) and np.all(arrival[16:18] == hg)
+    assert np.all(arrival[18:] < hg)  # pressed in over the slide to the scoop's start
     assert np.all(blade_floor("turn_back", CELL, N) > hg + CELL.burger.thickness)
 
 

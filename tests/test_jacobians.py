@@ -140,7 +140,7 @@ def flip_nlp():
 
 
 @pytest.mark.parametrize("quantity", ["position", "height", "rpy", "pitch", "normal", "xaxis",
-                                      "tip_height", "blade_heights", "velocity",
+                                      "tip_height", "tip_position", "blade_heights", "velocity",
                                       "acceleration", "cone_centre", "cone_point",
                                       "paper_cone_point"])
 def test_kinematic_block_over_nodes_jacobian(flip_nlp, cell, quantity):

@@ -267,6 +267,7 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
 
 
 def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():
+    from flipkit.behaviors.approach import descent_node
     from flipkit.behaviors.spec import Task
     from flipkit.behaviors.transcribe import blade_floor
     from flipkit.errors import ConfigError
@@ -275,7 +276,9 @@ def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():
     N, h = 20, approach_height(CELL)
     plain = blade_floor("go_to_burger", CELL, N)
     raised = blade_floor("go_to_burger", CELL, N, Task(approach_height=h))
-    assert np.allclose(raised[:N - 1], H + h) and np.array_equal(raised[N - 1:], plain[N - 1:])
+    d = descent_node(N)  # raised until the descent, the approach's own floor after it
+    assert np.allclose(raised[:d], np.maximum(H + h, plain[:d]))
+    assert np.all(raised[:d] >= H + h) and np.array_equal(raised[d:], plain[d:])
     assert np.array_equal(blade_floor("go_to_burger", CELL, N, Task()), plain)
     for other in ("scoop", "pickup", "turn_back"):  # only the approach is raised
         assert np.array_equal(blade_floor(other, CELL, N, Task(approach_height=h)),

@@ -230,7 +230,12 @@ def test_the_plan_records_the_cell_it_was_made_in(models, tmp_path):
     back = Plan.load(plan.to_json(tmp_path / "p.json")).cell()
     assert back.table == cell.table and back.space == cell.space
     assert back.robot.accel_limit == 15.0 and back.grill == cell.grill and back.limits == cell.limits
+    assert back.robot.free_accel_limit == np.inf  # recorded as null: the torques alone
     doc = json.loads((tmp_path / "p.json").read_text())
+    assert doc["cell_geometry"]["free_accel_limit"] is None
+    del doc["cell_geometry"]["free_accel_limit"]  # written before the free motions' bound:
+    (tmp_path / "one.json").write_text(json.dumps(doc))  # one bound for every segment
+    assert Plan.load(tmp_path / "one.json").cell().robot.free_accel_limit == 15.0
     del doc["cell_geometry"]  # a file written before the record: today's defaults
     (tmp_path / "old.json").write_text(json.dumps(doc))
     old = Plan.load(tmp_path / "old.json").cell()
@@ -242,6 +247,9 @@ def test_the_plan_records_the_cell_it_was_made_in(models, tmp_path):
     (lambda g: g["table"].pop("x_range"), "cell_geometry.table"),
     (lambda g: g["space"]["walls"][0].update(lower=[0, 0]), "cell_geometry.space"),
     (lambda g: g.update(accel_limit="fast"), "cell_geometry.accel_limit"),
+    (lambda g: g.update(free_accel_limit=-1.0), "cell_geometry.free_accel_limit"),
+    (lambda g: g.update(free_accel_limit=True), "cell_geometry.free_accel_limit"),
+    (lambda g: g.update(jerk_limit=1.0), "cell_geometry: expected the keys"),
     (lambda g: g["grill"].update(height=0.08), "cell_geometry.grill.height"),
     (lambda g: g.pop("limits"), "cell_geometry: expected the keys"),
 ])
@@ -252,3 +260,47 @@ def test_a_malformed_cell_record_is_refused_in_one_line(models, tmp_path, edit, 
     with pytest.raises(PlanFileError, match=key) as info:
         Plan.load(tmp_path / "bad.json")
     assert "\n" not in str(info.value)
+
+
+def test_free_motions_are_bounded_by_the_torques_alone(models):
+    """Go to burger and turn back get the free motions' acceleration bound (none by default);
+    the segments that carry or touch the burger keep the planner's 20 rad/s²."""
+    from flipkit.behaviors.spec import Subbehavior
+
+    q = models.cell.robot.q_home
+    free = {name: spec.free_motion for name, spec in SUBBEHAVIORS.items()}
+    assert {n for n, f in free.items() if f} == {"go_to_burger", "turn_back"}
+    for name in ("go_to_burger", "scoop"):
+        nlp = transcribe(name, models, q, location=(0.69, -0.16, 0.072))
+        qdd = nlp.x_ub[nlp.layout.iqdd(3)]
+        limits = next(b for b in nlp.blocks if b.name == "interpolant_limits")
+        expected = np.inf if free[name] else models.cell.robot.accel_limit
+        np.testing.assert_array_equal(qdd, expected)
+        np.testing.assert_array_equal(limits.hi[:6], expected)
+    with pytest.raises(ConfigError, match="free motion"):
+        Subbehavior("held", (0.2, 0.5), carries_burger=True, free_motion=True, end="rest",
+                    guess=lambda *a: None)
+    for bad in (0.0, -1.0, float("nan"), "fast"):
+        with pytest.raises(ConfigError, match="free_accel_limit"):
+            CellConfig().robot.__class__(free_accel_limit=bad)
+
+
+def test_verify_holds_each_segment_to_its_own_acceleration_bound(flip_plan, tmp_path):
+    """A flip plan's free motions accelerate beyond the planner's 20 rad/s²: verify passes them
+    under the recorded bound (none), and fails them where the record bounds them (a file
+    without the record: the planner's bound for every segment)."""
+    from flipkit.planning.plans.verify import verify_plan
+
+    go = flip_plan.segment("go_to_burger")
+    assert np.abs(go.qdd).max() > flip_plan.cell().robot.accel_limit
+    assert verify_plan(flip_plan).ok
+    doc = json.loads(flip_plan.to_json(tmp_path / "p.json").read_text())
+    for record in (30.0, "absent"):
+        if record == "absent":
+            del doc["cell_geometry"]["free_accel_limit"]
+        else:
+            doc["cell_geometry"]["free_accel_limit"] = record
+        (tmp_path / "b.json").write_text(json.dumps(doc))
+        report = verify_plan(Plan.load(tmp_path / "b.json"))
+        worst = report.groups["qdd_limits"]
+        assert not worst.ok and report.segments[worst.segment] in ("go_to_burger", "turn_back")

@@ -54,10 +54,11 @@ def test_coasting_row_is_the_distance_ahead_with_its_jacobian(models):
 
 
 def test_only_the_flip_has_the_coasting_row(models):
-    """At the flip's last node, with the turn back's first node interval at its longest; not
-    in the turn back, nor without the arm clearance (the exact-derivative solvers' problem)."""
+    """At the flip's last node, with the turn back's first node interval at its longest (its
+    bound stretched); not in the turn back, nor without the arm clearance (the
+    exact-derivative solvers' problem)."""
     from flipkit.behaviors import targets as tg
-    from flipkit.behaviors.options import SegmentOptions
+    from flipkit.behaviors.options import T_STRETCH, SegmentOptions
     from flipkit.model.ik import solve_pose
 
     robot = models.bare
@@ -66,7 +67,8 @@ def test_only_the_flip_has_the_coasting_row(models):
     flip = transcribe("flip", models, q, location=FAR_GRILL)
     rows = [b for b in flip.blocks if b.name == "coasting_clearance"]
     assert len(rows) == 1 and rows[0].node == flip.layout.N
-    assert rows[0].tau == pytest.approx(SUBBEHAVIORS["turn_back"].duration[1] / flip.layout.N)
+    assert rows[0].tau == pytest.approx(
+        T_STRETCH * SUBBEHAVIORS["turn_back"].duration[1] / flip.layout.N)
     back = transcribe("turn_back", models, q, location=FAR_GRILL)
     bare = transcribe("flip", models, q, location=FAR_GRILL,
                          options=SegmentOptions(arm_clearance=False))

@@ -14,7 +14,8 @@ The checks run in this order and the first one that fails is the verdict:
    It runs before the rate checks: a jump of 0.2 rad in one 5 ms sample is a 40 rad/s
    finite difference, so it would otherwise always be reported as an over-speed.
 4. ``joint_velocity`` / ``joint_acceleration`` — finite differences of q (second order,
-   ``np.gradient``) above qd_max / qdd_max.
+   ``np.gradient``) above qd_max / the segment's acceleration bound (``Robot.qdd_bound``:
+   none for the free motions, go to burger and turn back).
 5. ``torque`` — RNEA along (q, q̇, q̈) with the segment's payload above u_max.
 6. ``below_grill`` — a blade edge (tip, heel, sides) lower than h_g − 1 mm (in go-to-burger,
    scoop and pickup, which end, run or start with the blade pressed into the grill,
@@ -39,6 +40,7 @@ import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.baseline.ee_opt import sample_times
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
@@ -178,7 +180,8 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
     qdd = np.gradient(qd, t, axis=0, edge_order=2)
     u = np.array([robot.inverse_dynamics(q[k], qd[k], qdd[k]) for k in range(n)])
     v_ratio, vk, vj = _worst_ratio(qd, robot.qd_max)
-    a_ratio, ak, aj = _worst_ratio(qdd, robot.qdd_max)
+    qdd_max = robot.qdd_bound(name in SUBBEHAVIORS and SUBBEHAVIORS[name].free_motion)
+    a_ratio, ak, aj = _worst_ratio(qdd, qdd_max)
     u_ratio, uk, uj = _worst_ratio(u, robot.u_max)
     # the scoop commands the tip SCOOP_PRESS into the grill (±SCOOP_TIP_BAND), for both methods'
     # plans alike: the blade may go that deep where it is pressed (behaviors.transcribe.blade_floor:
@@ -193,8 +196,8 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
                 "sigma_min": float(sigma.min())}
 
     def fail(reason, amount, limit, detail):
-        scale = (time_scaling(robot, t, q, th.rate_tolerance) if CLASSES[reason] == "dynamic"
-                 else float("nan"))
+        scale = (time_scaling(robot, t, q, th.rate_tolerance, qdd_max=qdd_max)
+                 if CLASSES[reason] == "dynamic" else float("nan"))
         return SegmentVerdict(name, "failed", reason, float(amount), float(limit), detail,
                               ee_time_s, ik_time_s, measures, scale)
 
@@ -227,7 +230,7 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
                     f"joint {j + 1} between t={t[k]:.3f} s and t={t[k + 1]:.3f} s")
     for reason, ratio, k, j, values, bound in (
             ("joint_velocity", v_ratio, vk, vj, qd, robot.qd_max),
-            ("joint_acceleration", a_ratio, ak, aj, qdd, robot.qdd_max),
+            ("joint_acceleration", a_ratio, ak, aj, qdd, qdd_max),
             ("torque", u_ratio, uk, uj, u, robot.u_max)):
         if ratio > 1 + th.rate_tolerance:
             return fail(reason, abs(values[k, j]), bound[j],
@@ -242,25 +245,29 @@ def classify_segment(name: str, robot: Robot, t, q, p_ref, R_ref, *,
                           measures=measures)
 
 
-def _rate_ratio(robot: Robot, t, q, s: float) -> float:
-    """Largest velocity, acceleration or torque ratio of the path q(t) run s times slower."""
+def _rate_ratio(robot: Robot, t, q, s: float, qdd_max) -> float:
+    """Largest velocity, acceleration (bound ``qdd_max``) or torque ratio of the path q(t) run
+    s times slower."""
     qd = np.gradient(q, t, axis=0, edge_order=2) / s
     qdd = np.gradient(np.gradient(q, t, axis=0, edge_order=2), t, axis=0, edge_order=2) / s**2
     u = np.array([robot.inverse_dynamics(q[k], qd[k], qdd[k]) for k in range(len(t))])
-    return max(_worst_ratio(qd, robot.qd_max)[0], _worst_ratio(qdd, robot.qdd_max)[0],
+    return max(_worst_ratio(qd, robot.qd_max)[0], _worst_ratio(qdd, qdd_max)[0],
                _worst_ratio(u, robot.u_max)[0])
 
 
-def time_scaling(robot: Robot, t, q, tolerance: float = 1e-6, steps: int = 20) -> float:
+def time_scaling(robot: Robot, t, q, tolerance: float = 1e-6, steps: int = 20, *,
+                 qdd_max=None) -> float:
     """The smallest uniform slow-down factor s ∈ [1, :data:`MAX_TIME_SCALING`] with which the
-    path passes the velocity, acceleration and torque limits (bisection, ``steps`` halvings);
-    ``inf`` if even s = MAX_TIME_SCALING does not."""
-    if _rate_ratio(robot, t, q, MAX_TIME_SCALING) > 1 + tolerance:
+    path passes the velocity, acceleration (``qdd_max``, default ``robot.qdd_max``) and torque
+    limits (bisection, ``steps`` halvings); ``inf`` if even s = MAX_TIME_SCALING does not."""
+    qdd_max = robot.qdd_max if qdd_max is None else qdd_max
+    if _rate_ratio(robot, t, q, MAX_TIME_SCALING, qdd_max) > 1 + tolerance:
         return float("inf")
     lo, hi = 1.0, MAX_TIME_SCALING
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if _rate_ratio(robot, t, q, mid) <= 1 + tolerance else (mid, hi)
+        lo, hi = ((lo, mid) if _rate_ratio(robot, t, q, mid, qdd_max) <= 1 + tolerance
+                  else (mid, hi))
     return hi
 
 

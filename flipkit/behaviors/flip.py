@@ -109,8 +109,8 @@ def above_burger(cell: CellConfig, N: int) -> np.ndarray:
 
 
 TURN_BACK = Subbehavior(
-    "turn_back", duration=(0.4, 1.2), carries_burger=False, end="home", floor=above_burger,
-    guess=turn_back_guess, doc="eq. (27): back to q_home at rest")
+    "turn_back", duration=(0.4, 0.75), carries_burger=False, free_motion=True, end="home",
+    floor=above_burger, guess=turn_back_guess, doc="eq. (27): back to q_home at rest")
 FLIP = Subbehavior(
     "flip", duration=(0.2, 0.9), carries_burger=True, end="moving", needs=("location",),
     exempt=tool_leaves_grill, path=flip_path, cone=flip_cone, cone_on_blade=True,

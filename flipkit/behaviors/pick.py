@@ -16,6 +16,7 @@ import numpy as np
 
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.clearance import tool_at_grill
+from flipkit.behaviors.approach import approach_guess, approach_path, arrival_floor
 from flipkit.behaviors.guesses import task_path_guess
 from flipkit.behaviors.options import (SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND, SCOOP_PRESS,
                                        SCOOP_TIP_BAND)
@@ -28,13 +29,6 @@ from flipkit.transcription.constraints import KinematicBlock
 def pressed_floor(cell: CellConfig, N: int) -> np.ndarray:
     """The blade pressed SCOOP_PRESS into the grill, less the tip's band, at every node (m)."""
     return np.full(N + 1, cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND)
-
-
-def arrival_floor(cell: CellConfig, N: int) -> np.ndarray:
-    """Above the grill, and pressed into it at the last node (the scoop's start pose) (m)."""
-    floor = np.full(N + 1, cell.grill.height)
-    floor[-1] = cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND
-    return floor
 
 
 def scoop_path(ctx) -> list:
@@ -99,9 +93,10 @@ def predict_on_blade(segment, task: Task, models, options) -> Task:
 
 
 GO_TO_BURGER = Subbehavior(
-    "go_to_burger", duration=(0.3, 0.75), carries_burger=False, end="rest",
+    "go_to_burger", duration=(0.3, 0.5), carries_burger=False, free_motion=True, end="rest",
     needs=("location",), floor=arrival_floor, approach=True, pressed=True, exempt=tool_at_grill,
-    end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location), guess=task_path_guess,
+    path=approach_path, end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location),
+    guess=approach_guess,
     doc="eq. (22): to the scoop's start, tip pressed into the grill before the burger")
 SCOOP = Subbehavior(
     "scoop", duration=(0.2, 0.6), carries_burger=False, end="rest", needs=("location",),

@@ -39,8 +39,8 @@ class Task:
         scenarios: Flip: other places (x, y) (m, blade frame) the burger may lie on the blade,
             each to land within ``r_scenario`` of the spot.
         approach_height: Height (m) above the grill that the blade's edges keep on a
-            segment that comes down to the grill (``Subbehavior.approach``) until its last
-            two nodes, e.g. above other burgers lying on the grill; ``None``: the segment's
+            segment that comes down to the grill (``Subbehavior.approach``) until its
+            descent, e.g. above other burgers lying on the grill; ``None``: the segment's
             own floor.
     """
 
@@ -108,12 +108,16 @@ class Subbehavior:
         duration: (T_min, T_max) (s). The cost Σu² drives T to T_max, so the chain of a
             behaviour executes in about the sum of its upper bounds.
         carries_burger: The spatula carries the burger (the loaded dynamics model).
+        free_motion: It neither carries nor touches the burger, so the arm's torque limits
+            alone bound its joint accelerations (``RobotConfig.free_accel_limit``), not the
+            planner's bound (``RobotConfig.accel_limit``).
         end: One of :data:`END_CONDITIONS`: ``rest``, ``home`` (q_home at rest) or
             ``moving`` (the next segment must have room to brake).
         needs: :class:`Task` fields it cannot do without (:data:`TASK_FIELDS`).
         floor: ``floor(cell, N) -> (N+1,)``: lowest height (m) of the blade's edges per node.
-        approach: It comes down to the grill only at its end: ``task.approach_height``
-            raises its floor on all nodes but the last two.
+        approach: It comes down to the grill only at its end (the go to burger's descent
+            and slide, :mod:`flipkit.behaviors.approach`): ``task.approach_height`` raises
+            its floor on the nodes before the descent.
         pressed: The blade centre may go below the grill by the scoop's press.
         exempt: ``exempt(node, N) -> frozenset`` of (shape, box) pairs not held to the
             space margin at ``node`` (the tool end where it works on the grill or table).
@@ -136,6 +140,7 @@ class Subbehavior:
     carries_burger: bool
     end: str
     guess: Callable
+    free_motion: bool = False
     needs: tuple[str, ...] = ()
     floor: Callable | None = None
     approach: bool = False
@@ -159,6 +164,8 @@ class Subbehavior:
         if self.end not in END_CONDITIONS:
             raise ConfigError(f"{self.name}: end must be one of {', '.join(END_CONDITIONS)}, "
                               f"got {self.end!r}")
+        if self.free_motion and self.carries_burger:
+            raise ConfigError(f"{self.name}: a free motion cannot carry the burger")
         unknown = set(self.needs) - set(TASK_FIELDS)
         if unknown:
             raise ConfigError(f"{self.name}: needs unknown task fields {sorted(unknown)}; "

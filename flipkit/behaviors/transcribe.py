@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from flipkit.behaviors import targets as tg
+from flipkit.behaviors.approach import descent_node
 from flipkit.behaviors.library import subbehavior
 from flipkit.behaviors.models import Models
 from flipkit.behaviors.options import (BRAKING_FRACTION, SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH,
@@ -85,20 +86,22 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
     if options.stretch:
         T_hi *= T_STRETCH
     x0 = spec.guess(ctx, T_hi, pose)
-    lb, ub, scale = _bounds(L, robot, q_lo, q_hi, T_lo, T_hi)
+    lb, ub, scale = _bounds(L, robot, q_lo, q_hi, T_lo, T_hi, robot.qdd_bound(spec.free_motion))
     return NLP(spec.name, L, robot, blocks, lb, ub, scale, x0, cone_nodes)
 
 
 def blade_floor(spec: Subbehavior | str, cell, N: int, task=None) -> np.ndarray:
     """Lowest height (m) of the blade's four corners at nodes 0..N: the spec's
     floor, the grill's surface by default; on an approach (``spec.approach``) at least
-    ``task.approach_height`` above the grill on nodes 0..N−2 when the task sets one."""
+    ``task.approach_height`` above the grill until its descent
+    (:func:`~flipkit.behaviors.approach.descent_node`) when the task sets one."""
     spec = subbehavior(spec) if isinstance(spec, str) else spec
     floor = (np.full(N + 1, cell.grill.height) if spec.floor is None
              else np.array(spec.floor(cell, N), float))
     height = None if task is None else task.approach_height
     if spec.approach and height is not None:
-        floor[:N - 1] = np.maximum(floor[:N - 1], cell.grill.height + float(height))
+        d = descent_node(N)
+        floor[:d] = np.maximum(floor[:d], cell.grill.height + float(height))
     return floor
 
 
@@ -114,7 +117,7 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
     blade = {"length": cell.spatula.length, "width": cell.spatula.width}
     blocks = [
         Dynamics(L, robot.u_max / 10), HermiteSimpson(L), BezierOutput(L, o.epsilon),
-        InterpolantLimits(L, robot.qd_max, robot.qdd_max),
+        InterpolantLimits(L, robot.qd_max, robot.qdd_bound(spec.free_motion)),
         FixedValues("start_state", L, np.concatenate([L.iq(0), L.iqd(0)]),
                     np.concatenate([ctx.q_start, ctx.qd_start])),
         KinematicBlock("task_position", L, "position", moving, p_floor, lim.p_max),
@@ -130,7 +133,8 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
         blocks.append(ArmClearance(L, models.shapes, moving, lambda i: spec.exempt(i, L.N),
                                    margins))
         if spec.coast_into is not None:
-            coast = subbehavior(spec.coast_into).duration[1] / L.N
+            # the next segment's first node interval at its longest (its bound stretched)
+            coast = T_STRETCH * subbehavior(spec.coast_into).duration[1] / L.N
             blocks.append(CoastingClearance(L, models.shapes, L.N, coast,
                                             spec.exempt(L.N, L.N), cell.space.margin))
     # Orientation limits (Constraint 1, eq. 4): the pitch; roll and yaw are free.
@@ -138,12 +142,12 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
     return blocks
 
 
-def _bounds(L: Layout, robot, q_lo, q_hi, T_lo: float, T_hi: float):
-    """Variable bounds and scales: joint limits per node, the Bezier coefficients ±1 rad
-    beyond the joint range, the duration."""
+def _bounds(L: Layout, robot, q_lo, q_hi, T_lo: float, T_hi: float, qdd_max):
+    """Variable bounds and scales: joint limits per node (accelerations within ``qdd_max``,
+    rad/s²), the Bezier coefficients ±1 rad beyond the joint range, the duration."""
     lb, ub, scale = (np.empty(L.n) for _ in range(3))
     per_node = [(q_lo, q_hi, 1.0), (-robot.qd_max, robot.qd_max, 1.0),
-                (-robot.qdd_max, robot.qdd_max, 10.0), (-robot.u_max, robot.u_max, robot.u_max / 10)]
+                (-qdd_max, qdd_max, 10.0), (-robot.u_max, robot.u_max, robot.u_max / 10)]
     for i in range(L.n_nodes):
         for f, (lo, hi, s) in zip((L.iq, L.iqd, L.iqdd, L.iu), per_node):
             lb[f(i)], ub[f(i)], scale[f(i)] = lo, hi, s

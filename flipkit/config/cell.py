@@ -40,8 +40,15 @@ class RobotConfig:
         q_home: Home configuration (rad): spatula flat and level, radially in front of the
             above the grill at (0.62, -0.20, 0.30) m, o = 0, elbow up (our choice; found by
             IK, checked in tests/test_config.py).
-        accel_limit: Joint acceleration bound (rad/s²), same for every joint (the URDF has
-            none; UR10 datasheet order of magnitude).
+        accel_limit: Joint acceleration bound (rad/s²), same for every joint, of the
+            subbehaviours that carry or touch the burger. The planner's choice: the URDF has
+            none, and Universal Robots state that the arms have no inherent acceleration limit,
+            only torque limits (Universal_Robots_ROS2_Driver, ``ur_moveit_config/config/
+            joint_limits.yaml``). It keeps the flips' tosses short (docs/robust-flips.md §5).
+        free_accel_limit: The same bound for the free motions (subbehaviours with
+            ``free_motion``: go to burger, turn back), which neither carry nor touch the
+            burger: ``inf`` by default, the URDF's torque limits alone bound them, as the arm's
+            maker states.
     """
 
     urdf: str | None = None
@@ -49,6 +56,7 @@ class RobotConfig:
     base_in_world: tuple = field(default_factory=_identity)
     q_home: tuple = (-0.988933, -1.792774, 2.362261, -0.569486, 0.581863, 1.570796)
     accel_limit: float = 20.0
+    free_accel_limit: float = math.inf
 
     def __post_init__(self):
         if self.urdf is not None:
@@ -59,6 +67,9 @@ class RobotConfig:
             raise ConfigError("base_in_world must be a rigid 4x4 transform")
         finite("q_home", self.q_home)
         positive("accel_limit", self.accel_limit)
+        if not (isinstance(self.free_accel_limit, (int, float)) and self.free_accel_limit > 0):
+            raise ConfigError(f"free_accel_limit must be a positive number or inf, got "
+                              f"{self.free_accel_limit!r}")
 
     @property
     def urdf_path(self) -> str:

@@ -29,6 +29,17 @@ SCOOP_TIP_BAND = 0.0005  # m, the tip's band about h_g − SCOOP_PRESS: never ab
 # standard deviations of the burger's placement (5 mm, the Table I trials' placement error),
 # so that the blade does not land on the burger's rim.
 SCOOP_START_MARGIN = 0.015  # m
+# The go to burger's approach (flipkit.behaviors.approach): the blade's corners stay
+# APPROACH_CLEARANCE above the tallest burger of the sourced range until its last
+# APPROACH_FRACTION of node intervals (the descent). Over the descent the tip stays behind the
+# near rim of the largest burger of the range put 2 placement standard deviations toward the
+# arm, and over the last APPROACH_SLIDE_FRACTION (the slide) it is pressed into the grill, as
+# the scoop is, and at most APPROACH_LOW above it: it meets any burger at its foot and pushes
+# it along the grill instead of coming down on its rim. Ours.
+APPROACH_FRACTION = 0.2
+APPROACH_SLIDE_FRACTION = 0.1
+APPROACH_CLEARANCE = 0.005  # m
+APPROACH_LOW = 0.005  # m
 SCOOP_LATERAL_BAND = 0.01  # m, |p_y − p^b_y| during the scoop: slide straight under it
 SCOOP_ANGLE_BAND = 0.05  # rad, |o_x|, |o_z| during the scoop: no yaw or roll that pushes it
 

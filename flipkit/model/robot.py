@@ -116,6 +116,12 @@ class Robot:
         self.qd_max = model.velocityLimit.copy()
         self.u_max = model.effortLimit.copy()
         self.qdd_max = np.full(self.nq, rc.accel_limit)
+        self.qdd_free = np.full(self.nq, float(rc.free_accel_limit))
+
+    def qdd_bound(self, free_motion: bool) -> np.ndarray:
+        """Joint acceleration bound (rad/s²) of a segment: :attr:`qdd_free` for a free
+        motion (it neither carries nor touches the burger), else :attr:`qdd_max`."""
+        return self.qdd_free if free_motion else self.qdd_max
 
     def _payload(self, with_burger: bool) -> list[dict]:
         """Payload bodies in the spatula frame: the blade (thin plate) and the burger (disc)."""

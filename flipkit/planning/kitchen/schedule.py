@@ -34,7 +34,7 @@ What is optimal about it: no motion starts early, so cook times are never shorte
 the motions' windows do not collide every lateness is 0; and among motions that compete for
 the arm with equal durations and equal lead times, serving them in deadline order
 minimises the largest lateness (Jackson's rule; swapping two adjacent motions out of
-deadline order cannot lower the later one's lateness). What is not: flips (3.55–3.7 s) and
+deadline order cannot lower the later one's lateness). What is not: flips (3.0–3.4 s) and
 serves differ in duration and lead, and then another order, or a deliberate wait, can have
 a smaller largest lateness (single-machine L_max with release times is NP-hard in general);
 the greedy choice does not look ahead, trades nothing between burgers and does not minimise

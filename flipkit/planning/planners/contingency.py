@@ -8,7 +8,7 @@ holds. Such places lie beyond the scenario set: in the tails of the placement an
 errors, and where the scoop's unmodelled drift takes the burger, further along the blade or
 to its side (``docs/robust-flips.md`` §4). :class:`Contingencies` solves the flips for four
 such places before they are needed, which a cell can do while the arm goes to the burger
-and scoops (1.35 s). At the measurement it hands out the one that keeps its promise for the
+and scoops (1.1 s). At the measurement it hands out the one that keeps its promise for the
 measured place (its scenarios' hull holds the place, or its own release and flight land it
 within its promise): a check of milliseconds instead of a solve.
 
@@ -18,7 +18,7 @@ lands the places 1 cm around its own, so it covers a patch of the blade, not a p
 that none of them covers is solved as before.
 
 A contingency may not be ready when the camera looks: the preparation starts with the plan,
-and its solves can outlast the 1.35 s of motion before the sense. The object records when
+and its solves can outlast the 1.1 s of motion before the sense. The object records when
 each one became ready (``ready_s``, from the start of the preparation). Given ``sense_s``,
 the time of the sense on that clock, handing out a contingency that was not ready by then
 waits the rest of its solve, as a cell would wait for a solve under way. A plan that is

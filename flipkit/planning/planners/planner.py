@@ -125,8 +125,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
             ``options``: each segment starts from the atlas's interpolated solution (and
             from its own initial guess if that fails); ``None`` (default): cold starts.
         approach_height: Height (m) above the grill that the go to burger keeps the blade's
-            edges until its last two nodes (over other burgers lying on the grill);
-            ``None`` (default): the grill's surface.
+            edges until its descent (over other burgers lying on the grill,
+            :mod:`flipkit.behaviors.approach`); ``None`` (default): the approach's own floor.
 
     Returns:
         The plan. On a segment failure the chain stops there: the plan holds the segments

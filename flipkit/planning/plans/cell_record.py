@@ -1,8 +1,8 @@
 """The cell's geometry as a plan file records it (``cell_geometry``), and back.
 
 A plan is checked against the cell it was made in: its grill and table areas, the task-space
-limits of Constraint 1, the whole arm's clearance margin and the walls (issue 13), and the
-joint acceleration bound. The file records them so that ``flipkit verify`` and
+limits of Constraint 1, the whole arm's clearance margin and the walls, and the joint
+acceleration bounds. The file records them so that ``flipkit verify`` and
 :meth:`~flipkit.planning.plans.plan_file.Plan.cell` rebuild that cell, not today's defaults. Files
 written before this record (``cell_geometry`` absent) are read with the defaults.
 
@@ -13,7 +13,9 @@ Layout (lengths m, angles rad, velocities m/s, accelerations m/s² or rad/s²)::
       "table":  {"height", "x_range": [2], "y_range": [2]},
       "limits": {"p_min": [3], "p_max": [3], "v_max", "a_max", "pitch_range": [2]},
       "space":  {"margin", "handle_radius", "walls": [{"name", "lower": [3], "upper": [3]}]},
-      "accel_limit": joint acceleration bound
+      "accel_limit": joint acceleration bound,
+      "free_accel_limit": the free motions' bound, null for none (optional: a plan written
+                          without it was planned with ``accel_limit`` for every segment)
     }
 """
 
@@ -25,7 +27,10 @@ from flipkit.config.cell import CellConfig, GrillConfig, TableConfig, TaskLimits
 from flipkit.config.space import CellBox, SpaceConfig
 from flipkit.errors import ConfigError
 
+import math
+
 KEYS = ("grill", "table", "limits", "space", "accel_limit")
+OPTIONAL = ("free_accel_limit",)
 
 
 def _plain(value):
@@ -44,20 +49,24 @@ def cell_geometry(cell: CellConfig) -> dict:
             "limits": _plain(asdict(cell.limits)),
             "space": {"margin": sp.margin, "handle_radius": sp.handle_radius,
                       "walls": [_plain(asdict(w)) for w in sp.walls]},
-            "accel_limit": cell.robot.accel_limit}
+            "accel_limit": cell.robot.accel_limit,
+            "free_accel_limit": (None if math.isinf(cell.robot.free_accel_limit)
+                                 else cell.robot.free_accel_limit)}
 
 
 def geometry_configs(record: dict) -> dict:
     """The configs a ``cell_geometry`` record describes: ``{"grill": GrillConfig, "table":
-    TableConfig, "limits": TaskLimits, "space": SpaceConfig, "accel_limit": float}``.
+    TableConfig, "limits": TaskLimits, "space": SpaceConfig, "accel_limit": float,
+    "free_accel_limit": float}`` (``inf`` for null; ``accel_limit`` when the record has none).
 
     Raises:
         ConfigError: A key is missing or unknown, or a value is malformed (the message names
             ``cell_geometry.<key>``).
     """
-    if not isinstance(record, dict) or set(record) != set(KEYS):
+    if not isinstance(record, dict) or not set(KEYS) <= set(record) <= set(KEYS + OPTIONAL):
         got = sorted(record) if isinstance(record, dict) else type(record).__name__
-        raise ConfigError(f"cell_geometry: expected the keys {', '.join(KEYS)}, got {got}")
+        raise ConfigError(f"cell_geometry: expected the keys {', '.join(KEYS)} (and optionally "
+                          f"{', '.join(OPTIONAL)}), got {got}")
     out = {}
     for key, kind in (("grill", GrillConfig), ("table", TableConfig), ("limits", TaskLimits)):
         out[key] = _build(key, kind, record[key], lambda d: {k: _tuple(v) for k, v in d.items()})
@@ -66,6 +75,12 @@ def geometry_configs(record: dict) -> dict:
     if not isinstance(accel, (int, float)) or isinstance(accel, bool) or not accel > 0:
         raise ConfigError(f"cell_geometry.accel_limit: expected a positive number, got {accel!r}")
     out["accel_limit"] = float(accel)
+    free = record.get("free_accel_limit", accel)
+    if free is not None and (not isinstance(free, (int, float)) or isinstance(free, bool)
+                             or not (math.isfinite(free) and free > 0)):
+        raise ConfigError(f"cell_geometry.free_accel_limit: expected a positive number or "
+                          f"null, got {free!r}")
+    out["free_accel_limit"] = math.inf if free is None else float(free)
     return out
 
 

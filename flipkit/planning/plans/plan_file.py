@@ -254,7 +254,8 @@ class Plan:
         thickness2 = 12 * Ixx / m - w**2  # thin box: I_xx = m (w² + t²) / 12
         try:
             geo = {} if self.cell_geometry is None else geometry_configs(self.cell_geometry)
-            accel = {} if not geo else {"accel_limit": geo.pop("accel_limit")}
+            accel = {} if not geo else {k: geo.pop(k) for k in ("accel_limit",
+                                                                 "free_accel_limit")}
             if geo:  # grill_height is the plan's h_g (the record agreed with it when read)
                 geo["grill"] = GrillConfig(self.grill_height, geo["grill"].x_range,
                                            geo["grill"].y_range)

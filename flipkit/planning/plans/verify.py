@@ -15,8 +15,8 @@ time_grid          t_i = iT/N; T within the spec's bounds (upper × T_STRETCH) (
 dynamics           RNEA(q_i, q̇_i, q̈_i) − u_i, payload per segment (N·m)        tol·u_max/10
 defects            Hermite–Simpson interpolation and Simpson defects (rad,     tol
                    rad/s) at the odd nodes, x = (q, q̇), ẋ = (q̇, q̈)
-q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit         tol, tol,
-                                                                               10·tol,
+q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit (free    tol, tol,
+                   motions: the cell's free_accel_limit, none by default)      10·tol,
                                                                                tol·u_max/10
 interpolant        q̇ and q̈ limits between the nodes, on the cubic Hermite        100·tol,
                    interpolant of (q, q̇) the controller follows: exact extremes  1000·tol
@@ -24,7 +24,9 @@ interpolant        q̇ and q̈ limits between the nodes, on the cubic Hermite   
 endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded;
                    serve: carry and place end poses from the recorded spot
-behavior_path      scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip   tol
+behavior_path      go to burger: the tip behind the rim over the descent, then  tol
+                   low and not past the scoop's start (behaviors.approach);
+                   scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip
                    normal, x axis, height band; place: tip at its final
                    point ± PIVOT_BAND from node 0.7 N; return_home withdrawal
                    (in the blade's start frame, attitude band)
@@ -75,8 +77,10 @@ from dataclasses import replace
 import numpy as np
 
 
+from flipkit.behaviors.approach import approach_limits, descent_node, slide_node
 from flipkit.behaviors.library import FLIP_NAMES, SERVE_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH
+from flipkit.config.task import APPROACH_LOW
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
@@ -162,6 +166,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     N, T, add = seg.N, seg.T, report.add
     add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
     T_lo, T_hi = SUBBEHAVIORS[seg.name].duration
+    qdd_max = robot.qdd_bound(SUBBEHAVIORS[seg.name].free_motion)
     add("time_grid", k, _outside(T, T_lo, T_STRETCH * T_hi), tol)
     dyn_tol = tol * robot.u_max / 10
     tau = np.array([robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
@@ -170,10 +175,10 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     for group, x, lo, hi, scale in (
             ("q_limits", seg.q, robot.q_min, robot.q_max, 1.0),
             ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
-            ("qdd_limits", seg.qdd, -robot.qdd_max, robot.qdd_max, 10.0),
+            ("qdd_limits", seg.qdd, -qdd_max, qdd_max, 10.0),
             ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
         report.add_nodes(group, k, _outside(np.asarray(x), lo, hi), tol * scale)
-    _check_interpolant(report, k, seg, robot, tol)
+    _check_interpolant(report, k, seg, robot, qdd_max, tol)
     report.add_nodes("singularity", k, branch_violation(seg.q, plan.robot["q_home"],
                                                         SINGULARITY_MARGIN), tol)
     mid = np.arange(1, N, 2)  # Hermite–Simpson midpoints; a = i − 1, b = i + 1
@@ -213,7 +218,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     _check_behavior(report, k, seg, robot, plan, cell, states, tol)
 
 
-def _check_interpolant(report, k, seg, robot, tol) -> None:
+def _check_interpolant(report, k, seg, robot, qdd_max, tol) -> None:
     """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly: on
     interval i, q = c0 τ³ + c1 τ² + c2 τ + c3 (τ ∈ [0, h]), so q̈ is linear (extremes at the
     ends) and q̇ a parabola (extremes at the ends or at τ* = −c1 / (3 c0))."""
@@ -222,7 +227,7 @@ def _check_interpolant(report, k, seg, robot, tol) -> None:
     n = np.arange(seg.N)
     for i, qdd in enumerate((2 * c[1], 6 * c[0] * h + 2 * c[1])):
         # node of the interval's start (i = 0) or end (i = 1)
-        report.add_nodes("interpolant", k, _outside(qdd, -robot.qdd_max, robot.qdd_max),
+        report.add_nodes("interpolant", k, _outside(qdd, -qdd_max, qdd_max),
                          INTERPOLANT_TOL[1] * tol, n + i)
     with np.errstate(divide="ignore", invalid="ignore"):
         tau = np.clip(np.nan_to_num(-c[1] / (3 * c[0]), nan=0.0, posinf=0.0, neginf=0.0), 0, h)
@@ -249,6 +254,14 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
             pose(seg.goal)
     elif seg.name == "go_to_burger":
         pose(tg.scoop_ready(cell, pb))
+        rim, start = approach_limits(cell, pb)  # the tip behind the rim, then low (approach)
+        for i in range(descent_node(N), N + 1):
+            tip = states[i].p + states[i].R @ np.array([cell.spatula.length / 2, 0.0, 0.0])
+            if i < slide_node(N):
+                add("behavior_path", k, [max(tip[0] - rim, 0.0)], tol, i)
+            else:
+                add("behavior_path", k, [max(tip[0] - start, 0.0),
+                                         max(tip[2] - hg - APPROACH_LOW, 0.0)], tol, i)
     elif seg.name == "scoop":
         pose(tg.scoop_end(cell, pb))
         for i, st in enumerate(states):  # tip pressed into the grill, within the band

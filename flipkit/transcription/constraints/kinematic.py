@@ -22,6 +22,12 @@ def _point_height(st: SpatulaState, r_local) -> tuple[np.ndarray, np.ndarray]:
             (st.dp_dq[..., 2, :] - (skew(r) @ st.Jw)[..., 2, :])[..., None, :])
 
 
+def _point_position(st: SpatulaState, r_local) -> tuple[np.ndarray, np.ndarray]:
+    """The blade point p + R r (m) and its ∂/∂q (3 rows), over leading node axes."""
+    r = st.R @ np.asarray(r_local, float)
+    return st.p + r, st.dp_dq - skew(r) @ st.Jw
+
+
 class Quantity:
     """A spatula quantity of derivative order 0 (q), 1 (q, q̇) or 2 (q, q̇, q̈).
 
@@ -104,6 +110,15 @@ class TipHeight(Quantity):
         return _point_height(st, (ctx["length"] / 2, 0.0, 0.0))
 
 
+class TipPosition(Quantity):
+    """Position (m, world) of the middle of the blade's tip edge, p + R (l_l/2, 0, 0)."""
+
+    broadcasts = True
+
+    def __call__(self, st, ctx):
+        return _point_position(st, (ctx["length"] / 2, 0.0, 0.0))
+
+
 BLADE_CORNERS = ((1, 1), (1, -1), (-1, 1), (-1, -1))  # (±l/2, ±w/2): tip left, tip right, ...
 
 
@@ -158,7 +173,8 @@ class Cone(Quantity):
 
 
 QUANTITIES = {"position": Position, "height": Height, "rpy": Rpy, "pitch": Pitch, "normal": Normal,
-              "xaxis": XAxis, "tip_height": TipHeight, "blade_heights": BladeCornerHeights,
+              "xaxis": XAxis, "tip_height": TipHeight, "tip_position": TipPosition,
+              "blade_heights": BladeCornerHeights,
               "velocity": Velocity, "acceleration": Acceleration}
 
 
