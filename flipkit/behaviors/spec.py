@@ -108,9 +108,11 @@ class Subbehavior:
         duration: (T_min, T_max) (s). The cost Σu² drives T to T_max, so the chain of a
             behaviour executes in about the sum of its upper bounds.
         carries_burger: The spatula carries the burger (the loaded dynamics model).
-        free_motion: It neither carries nor touches the burger, so the arm's torque limits
-            alone bound its joint accelerations (``RobotConfig.free_accel_limit``), not the
-            planner's bound (``RobotConfig.accel_limit``).
+        free_motion: It neither carries nor pushes the burger (the go to burger's slide
+            meets one at most at its foot as it ends, where the scoop starts), so the arm's
+            torque limits alone bound its joint accelerations
+            (``RobotConfig.free_accel_limit``), not the planner's bound
+            (``RobotConfig.accel_limit``).
         end: One of :data:`END_CONDITIONS`: ``rest``, ``home`` (q_home at rest) or
             ``moving`` (the next segment must have room to brake).
         needs: :class:`Task` fields it cannot do without (:data:`TASK_FIELDS`).
