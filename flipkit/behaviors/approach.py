@@ -24,11 +24,11 @@ import math
 import numpy as np
 
 from flipkit.behaviors import targets as tg
+from flipkit.behaviors.guesses import pose_path
 from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.config import PHYSICAL_RANGES, CellConfig, ScoopUncertainty
 from flipkit.config.task import (APPROACH_CLEARANCE, APPROACH_FRACTION, APPROACH_LOW,
                                  APPROACH_SLIDE_FRACTION)
-from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy
 from flipkit.transcription.constraints import KinematicBlock
 from flipkit.transcription.guess import fit_guess
@@ -78,10 +78,10 @@ def approach_path(ctx) -> list:
 
 
 def approach_guess(ctx, T, pose):
-    """The go to burger's initial guess: the blade's pose interpolated (smoothstep per leg)
-    from the start to 5 mm behind the rim and above the tallest burger (at the descent's first
-    node), down to the grill there (at the slide's first node), then in to ``pose``; IK node
-    by node, fitted by the Bezier polynomial."""
+    """The go to burger's initial guess: the blade's pose path
+    (:func:`~flipkit.behaviors.guesses.pose_path`) from the start to 5 mm behind the rim and
+    above the tallest burger (at the descent's first node), down to the grill there (at the
+    slide's first node), then in to ``pose``, fitted by the Bezier polynomial."""
     L, robot = ctx.layout, ctx.robot
     rim, start = approach_limits(ctx.cell, ctx.location)
     end = np.asarray(pose.p, float)
@@ -92,15 +92,7 @@ def approach_guess(ctx, T, pose):
     knots = [(0.0, robot.position(ctx.q_start), rpy(robot.rotation(ctx.q_start))),
              (descent_node(L.N) / L.N, high, o1), (slide_node(L.N) / L.N, low, o1),
              (1.0, end, o1)]
-    q, waypoints = ctx.q_start, []
-    for s in L.s:
-        k = next(j for j in range(1, len(knots)) if s <= knots[j][0] + 1e-12)
-        (s0, pa, oa), (s1, pb, ob) = knots[k - 1], knots[k]
-        u = (s - s0) / (s1 - s0)
-        w = u * u * (3 - 2 * u)
-        q = solve_pose(robot, (1 - w) * pa + w * pb, (1 - w) * oa + w * ob, q)
-        waypoints.append(q)
-    return fit_guess(L, robot, waypoints, T, ctx.qd_start, ctx.spec.at_rest)
+    return fit_guess(L, robot, pose_path(ctx, knots), T, ctx.qd_start, ctx.spec.at_rest)
 
 
 __all__ = ["approach_guess", "approach_limits", "approach_path", "arrival_floor",

@@ -49,6 +49,33 @@ def withdraw_then_home(L, robot, q_start, qd_start, T):
     return fit_guess(L, robot, np.clip(waypoints, robot.q_min, robot.q_max), T, qd_start, True)
 
 
+def pose_path(ctx, knots, *, tip_pressed: bool = False, solved: list | None = None) -> list:
+    """Joint waypoints at the segment's nodes along a spatula pose path: ``knots`` are
+    ``(s, p, o)`` (s from 0 to 1 in node time, blade-centre position (m), rpy (rad)); between
+    two knots p and o follow a smoothstep in s, and each node's pose is solved by IK from the
+    previous node's solution. ``tip_pressed`` keeps the blade tip pressed into the grill (the
+    scoop): p_z = h_g − press + (l/2) sin o_y. ``solved``: a list that receives each node's
+    solution as it is found (what was reached before an :class:`UnreachableError`).
+
+    Raises:
+        UnreachableError: A node's pose is out of reach.
+    """
+    cell, q = ctx.cell, ctx.q_start
+    waypoints = [] if solved is None else solved
+    for s in ctx.layout.s:
+        k = next(j for j in range(1, len(knots)) if s <= knots[j][0] + 1e-12)
+        (s0, pa, oa), (s1, pb, ob) = knots[k - 1], knots[k]
+        u = (s - s0) / (s1 - s0)
+        w = u * u * (3 - 2 * u)
+        o = (1 - w) * np.asarray(oa) + w * np.asarray(ob)
+        p = (1 - w) * np.asarray(pa) + w * np.asarray(pb)
+        if tip_pressed:
+            p[2] = cell.grill.height - tg.SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
+        q = solve_pose(ctx.robot, p, o, q)
+        waypoints.append(q)
+    return waypoints
+
+
 def task_path_guess(ctx, T, pose, *, tip_pressed: bool = False,
                     joint_fallback: bool = False):
     """The spatula pose interpolated from start to ``pose`` (smoothstep in time), solved by IK
@@ -62,24 +89,18 @@ def task_path_guess(ctx, T, pose, *, tip_pressed: bool = False,
             straight carry to the table passes near the base), a joint-space path to an IK
             solution of the end pose instead.
     """
-    L, robot, cell, q_start = ctx.layout, ctx.robot, ctx.cell, ctx.q_start
-    p0, R0 = robot.position(q_start), robot.rotation(q_start)
-    o0, o1 = rpy(R0), np.asarray(pose.o)
-    waypoints, q = [], q_start
-    for s in L.s:
-        w = s * s * (3 - 2 * s)
-        o = (1 - w) * o0 + w * o1
-        p = (1 - w) * p0 + w * np.asarray(pose.p)
-        if tip_pressed:
-            p[2] = cell.grill.height - tg.SCOOP_PRESS + cell.spatula.length / 2 * np.sin(o[1])
-        try:
-            q = solve_pose(robot, p, o, q)
-        except UnreachableError:
-            if not joint_fallback:
-                raise
-            return bezier_guess(L, robot, q_start, sv.reach(robot, pose, (q_start, q)),
-                                T, ctx.qd_start)
-        waypoints.append(q)
+    L, robot, q_start = ctx.layout, ctx.robot, ctx.q_start
+    knots = [(0.0, robot.position(q_start), rpy(robot.rotation(q_start))),
+             (1.0, np.asarray(pose.p, float), np.asarray(pose.o, float))]
+    solved = []
+    try:
+        waypoints = pose_path(ctx, knots, tip_pressed=tip_pressed, solved=solved)
+    except UnreachableError:
+        if not joint_fallback:
+            raise
+        last = solved[-1] if solved else q_start  # the seed the path reached before it failed
+        return bezier_guess(L, robot, q_start, sv.reach(robot, pose, (q_start, last)),
+                            T, ctx.qd_start)
     return fit_guess(L, robot, waypoints, T, ctx.qd_start, ctx.spec.at_rest)
 
 

@@ -77,7 +77,7 @@ def scoop_scenarios(segment, location, models,
     nominal = np.mean([path.outcome(mu_blade=mu, overhang=e, **kw) for e in ends], axis=0)
     xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), overhang=e, **kw)[0]
           for e in ends for f in uncertainty.mu_scale for s in (-d, d)]
-    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    half = cell.spatula.half_extent
     scenarios = [(min(xs), nominal[1]), (max(xs), nominal[1]),
                  (nominal[0], nominal[1] - d), (nominal[0], nominal[1] + d)]
     return np.clip(nominal, -half, half), [np.clip(v, -half, half) for v in scenarios]

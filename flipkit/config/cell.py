@@ -103,6 +103,12 @@ class SpatulaConfig:
         for name in ("length", "width", "thickness", "handle", "mass"):
             positive(f"spatula {name}", getattr(self, name))
 
+    @property
+    def half_extent(self) -> np.ndarray:
+        """(l_l/2, l_w/2) (m): how far a place on the blade (x, y, blade frame) may lie from
+        its centre."""
+        return np.array([self.length, self.width]) / 2
+
     def placement_in_tool(self) -> np.ndarray:
         """4x4 placement of the spatula frame in the tool frame.
 

@@ -194,7 +194,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = trace.burger_body
     sense = {"sensed": None, "failure": None, "time": None, "plan": plan}
-    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    half = cell.spatula.half_extent
     thick = cell.spatula.thickness
 
     def sense_and_replan(k: int, refs: References) -> References | None:

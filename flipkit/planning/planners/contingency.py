@@ -58,7 +58,7 @@ def contingency_places(plan: Plan, margin=MARGIN) -> list[tuple[float, float]]:
     x0, y0 = (float(v) for v in landing["burger_on_blade"][:2])
     pts = np.array([row["burger_on_blade"][:2] for row in landing.get("scenarios", ())]
                    or [(x0, y0)], float)
-    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    half = cell.spatula.half_extent
     mx, my = (float(v) for v in margin)
     places = [(pts[:, 0].min() - mx, y0), (pts[:, 0].max() + mx, y0),
               (x0, pts[:, 1].min() - my), (x0, pts[:, 1].max() + my)]

@@ -202,7 +202,7 @@ def sensed_scenarios(cell: CellConfig, on_blade,
     ``sensing.reach`` from it along the blade and across it, clipped to the blade."""
     x, y = (float(v) for v in on_blade)
     d = sensing.reach
-    half = np.array([cell.spatula.length, cell.spatula.width]) / 2
+    half = cell.spatula.half_extent
     return tuple(np.clip(p, -half, half) for p in ((x - d, y), (x + d, y), (x, y - d), (x, y + d)))
 
 

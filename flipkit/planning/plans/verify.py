@@ -110,9 +110,14 @@ def _angle(a, b) -> np.ndarray:
     return np.abs((np.asarray(a) - np.asarray(b) + np.pi) % (2 * np.pi) - np.pi)
 
 
+def _point(st, r_local) -> np.ndarray:
+    """World position (m) of the blade point at r_local in the spatula frame."""
+    return st.p + st.R @ np.asarray(r_local, float)
+
+
 def _point_height(st, r_local) -> float:
     """World height (m) of the blade point at r_local in the spatula frame."""
-    return float(st.p[2] + (st.R @ np.asarray(r_local, float))[2])
+    return float(_point(st, r_local)[2])
 
 
 def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
@@ -256,7 +261,7 @@ def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
         pose(tg.scoop_ready(cell, pb))
         rim, start = approach_limits(cell, pb)  # the tip behind the rim, then low (approach)
         for i in range(descent_node(N), N + 1):
-            tip = states[i].p + states[i].R @ np.array([cell.spatula.length / 2, 0.0, 0.0])
+            tip = _point(states[i], (cell.spatula.length / 2, 0.0, 0.0))
             if i < slide_node(N):
                 add("behavior_path", k, [max(tip[0] - rim, 0.0)], tol, i)
             else:
