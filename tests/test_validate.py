@@ -10,6 +10,7 @@ from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.cli import main
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
+from flipkit.experiments.perturbations import trial_rng
 from flipkit.experiments.trials import STAGES, Perturbations, run_trial, track_plan, trial_jobs
 
 LOCATION = TABLE1_LOCATIONS[5]  # where conftest's flip_plan is planned
@@ -59,8 +60,23 @@ def test_same_seed_same_result_other_seed_other_draws(plan_file, result, tmp_pat
     draws = {seed: [run_trial(j)["perturbation"] for j in trial_jobs(text, TRIALS, seed,
                                                                         Perturbations())]
              for seed in (3, 4)}
-    assert draws[3][1] == draws[4][0]  # trial i draws from default_rng(seed + i)
-    assert draws[3][0] != draws[4][0]
+    # each (seed, trial) has a stream of its own: no draw of seed 3 recurs in seed 4 (with
+    # default_rng(seed + trial), seed 3's trial 1 would be seed 4's trial 0)
+    assert not any(d == e for d in draws[3] for e in draws[4])
+    assert draws[3] == [run_trial(j)["perturbation"] for j in trial_jobs(text, TRIALS, 3,
+                                                                          Perturbations())]
+
+
+def test_trial_streams_are_fixed_and_distinct():
+    first = trial_rng(0, 0).normal(size=3)
+    assert np.array_equal(first, trial_rng(0, 0).normal(size=3))
+    assert not np.array_equal(first, trial_rng(0, 1).normal(size=3))
+    assert not np.array_equal(trial_rng(3, 0).normal(size=3), trial_rng(0, 3).normal(size=3))
+    for bad in (-1, 1.5, True, "0"):
+        with pytest.raises(ConfigError, match="non-negative integer"):
+            trial_rng(bad, 0)
+        with pytest.raises(ConfigError, match="non-negative integer"):
+            trial_rng(0, bad)
 
 
 def test_perturbation_draws_within_their_ranges():
@@ -102,7 +118,7 @@ def failed_plan(plan_file, tmp_path):
 
 @pytest.mark.parametrize("case, message", [
     ("missing", "cannot read"), ("not_json", "not a JSON"), ("failed", "status is 'failed'"),
-    ("zero_trials", "--trials"), ("negative_trials", "--trials"),
+    ("zero_trials", "--trials"), ("negative_trials", "--trials"), ("negative_seed", "seed"),
 ])
 def test_bad_input_exits_2(plan_file, failed_plan, tmp_path, capsys, case, message):
     bad = tmp_path / "bad.json"
@@ -111,8 +127,9 @@ def test_bad_input_exits_2(plan_file, failed_plan, tmp_path, capsys, case, messa
         case, plan_file)
     trials = {"zero_trials": "0", "negative_trials": "-2"}.get(case, "2")
     out = tmp_path / "out.json"
+    seed = ["--seed", "-1"] if case == "negative_seed" else []
     code = main(["validate", "--plan", str(plan), "--trials", trials, "--workers", "1",
-                 "--no-progress", "--json", str(out)])
+                 "--no-progress", "--json", str(out), *seed])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and message in err
     assert not out.exists()

@@ -57,4 +57,27 @@ class Perturbations:
         return {**out, "sense_dx_m": float(sx), "sense_dy_m": float(sy)}
 
 
-__all__ = ["Perturbations"]
+def check_seed(seed) -> int:
+    """``seed`` as an int, or :class:`ConfigError` (one line): a non-negative integer."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+    return int(seed)
+
+
+def trial_rng(seed: int, trial: int) -> np.random.Generator:
+    """The random generator of trial ``trial`` (0, 1, …) of a run seeded ``seed``.
+
+    Seeded by numpy's ``SeedSequence`` of the pair, so that each (seed, trial) has a stream
+    of its own and runs with different seeds share no draw: a run with seed 3 is a second
+    sample, not the run with seed 0 shifted by three trials (as ``default_rng(seed + trial)``
+    would make it). Every location and every parameter setting of a run sees the same draws.
+
+    Raises:
+        ConfigError: ``seed`` or ``trial`` is not a non-negative integer.
+    """
+    if isinstance(trial, bool) or not isinstance(trial, (int, np.integer)) or trial < 0:
+        raise ConfigError(f"trial must be a non-negative integer, got {trial!r}")
+    return np.random.default_rng(np.random.SeedSequence([check_seed(seed), int(trial)]))
+
+
+__all__ = ["Perturbations", "check_seed", "trial_rng"]

@@ -3,7 +3,7 @@
 As :mod:`flipkit.experiments.trials` for flips: each trial executes the plan closed-loop in the
 MuJoCo cell (:func:`flipkit.simulation.execute.execute_plan`) with the burger misplaced and the
 physics perturbed (:class:`~flipkit.experiments.perturbations.Perturbations`, drawn from
-``np.random.default_rng(seed + trial)``), then judges the scoop and pickup (paper Sec. V) and
+:func:`~flipkit.experiments.perturbations.trial_rng` of the seed and the trial), then judges the scoop and pickup (paper Sec. V) and
 the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
 within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
 ``replan`` the cell measures where the burger lies on the blade at the end of the carry and
@@ -20,7 +20,7 @@ import numpy as np
 from flipkit.config import known_physics, with_parameter
 from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
-from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.perturbations import Perturbations, trial_rng
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             plan_from_text, servo_physics, trial_jobs,
@@ -47,7 +47,7 @@ def run_serve_trial(job: dict) -> dict:
     """
     plan = plan_from_text(job["plan_text"])
     draw = Perturbations(**job["perturbations"]).draw(
-        np.random.default_rng(job["seed"] + job["trial"]))
+        trial_rng(job["seed"], job["trial"]))
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)

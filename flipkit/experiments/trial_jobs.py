@@ -14,7 +14,7 @@ import numpy as np
 
 from flipkit.config import PhysicsConfig
 from flipkit.config.physics import servo_lookahead
-from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.perturbations import Perturbations, check_seed
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.simulation.modes import FEEDFORWARD
@@ -22,6 +22,10 @@ from flipkit.simulation.scene import NOSLIP_ITERATIONS, SLEEP_TOLERANCE
 
 TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
 HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
+# How a trial's perturbation is drawn from its seed and number (part of the cache key, so a
+# trial drawn another way is never served from the cache):
+# :func:`~flipkit.experiments.perturbations.trial_rng`.
+DRAWS = "SeedSequence([seed, trial])"
 PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
              "cone", "segments", "created_by")
 
@@ -45,7 +49,8 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
     """The trial jobs of one plan (``physics``: see :func:`flipkit.experiments.trials.run_trial`;
     the key is left out when empty, so the cache keys of nominal trials do not change)."""
     extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
-    return [{"plan_text": plan_text, "trial": i, "seed": int(seed),
+    seed = check_seed(seed)
+    return [{"plan_text": plan_text, "trial": i, "seed": seed, "draws": DRAWS,
              "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
              "replan": bool(replan), "command": command, **extra} for i in range(trials)]
 
@@ -93,5 +98,5 @@ def merge_tracking(errors: list) -> dict:
     return out
 
 
-__all__ = ["HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "lookahead_of", "merge_tracking",
+__all__ = ["DRAWS", "HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "lookahead_of", "merge_tracking",
            "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key"]

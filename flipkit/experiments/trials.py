@@ -3,8 +3,8 @@
 One trial (:func:`run_trial`): the plan is executed closed-loop in the MuJoCo cell
 (:func:`flipkit.simulation.execute.execute_plan`): the arm with its spatula is simulated with the
 burger lying on the grill, misplaced and with perturbed physics (:class:`Perturbations`,
-drawn from ``np.random.default_rng(seed + trial)``), the blade colliding with the grill and
-the burger; the joint controller is the job's ``mode`` (``"feedforward"``: plan torques plus
+drawn from :func:`~flipkit.experiments.perturbations.trial_rng` of the seed and the trial),
+the blade colliding with the grill and the burger; the joint controller is the job's ``mode`` (``"feedforward"``: plan torques plus
 PD; ``"position"``: the robot's own PD position control on servo-rate, delayed desired
 states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
 the previous ones succeeded, as in Table I.
@@ -29,7 +29,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.pauses import pause_summary
-from flipkit.experiments.perturbations import Perturbations
+from flipkit.experiments.perturbations import Perturbations, check_seed, trial_rng
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.slides import slide_summary
 from flipkit.experiments.sweep import run_sweep
@@ -144,7 +144,7 @@ def run_trial(job: dict) -> dict:
     plan = plan_from_text(job["plan_text"])
     mode = job.get("mode", FEEDFORWARD)
     draw = Perturbations(**job["perturbations"]).draw(
-        np.random.default_rng(job["seed"] + job["trial"]))
+        trial_rng(job["seed"], job["trial"]))
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
@@ -260,7 +260,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             (m), a dict describing the plan (recorded as is) and the text of its solved plan
             file (``None``: no plan, every trial fails at stage ``plan``).
         trials: Trials per location (≥ 1). seed: Trial i draws from
-            ``np.random.default_rng(seed + i)``.
+            :func:`~flipkit.experiments.perturbations.trial_rng` ``(seed, i)``; seeds ≥ 0.
         perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
         mode: Joint controller, one of :data:`flipkit.simulation.modes.MODES`.
         replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
@@ -353,6 +353,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         raise InvalidChoiceError("solver", solver, SOLVERS)
     if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
         raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    check_seed(seed)  # before any planning
     cell, locs = CellConfig(), []
     for k, loc in enumerate(locations, 1):
         try:
