@@ -65,18 +65,31 @@ def test_same_seed_same_result_other_seed_other_draws(plan_file, result, tmp_pat
     assert not any(d == e for d in draws[3] for e in draws[4])
     assert draws[3] == [run_trial(j)["perturbation"] for j in trial_jobs(text, TRIALS, 3,
                                                                           Perturbations())]
+    doc = json.loads(text)  # the same plan moved 1 cm: trials elsewhere draw their own
+    doc["burger"]["location"][1] += 0.01
+    moved = [run_trial(j)["perturbation"] for j in trial_jobs(json.dumps(doc), TRIALS, 3,
+                                                              Perturbations())]
+    assert not any(d == e for d in draws[3] for e in moved)
 
 
 def test_trial_streams_are_fixed_and_distinct():
-    first = trial_rng(0, 0).normal(size=3)
-    assert np.array_equal(first, trial_rng(0, 0).normal(size=3))
-    assert not np.array_equal(first, trial_rng(0, 1).normal(size=3))
-    assert not np.array_equal(trial_rng(3, 0).normal(size=3), trial_rng(0, 3).normal(size=3))
+    here, there = (0.75, 0.0, 0.072), (0.75, 0.0, 0.073)  # 1 mm apart
+
+    def first(seed, trial, loc):
+        return trial_rng(seed, trial, loc).normal(size=3)
+    assert np.array_equal(first(0, 0, here), first(0, 0, here))
+    assert not np.array_equal(first(0, 0, here), first(0, 1, here))
+    assert not np.array_equal(first(0, 0, here), first(0, 0, there))
+    assert not np.array_equal(first(3, 0, here), first(0, 3, here))
+    assert not np.array_equal(first(0, 0, (0.7, -0.1, 0.072)), first(0, 0, (0.7, 0.1, 0.072)))
     for bad in (-1, 1.5, True, "0"):
         with pytest.raises(ConfigError, match="non-negative integer"):
-            trial_rng(bad, 0)
+            trial_rng(bad, 0, here)
         with pytest.raises(ConfigError, match="non-negative integer"):
-            trial_rng(0, bad)
+            trial_rng(0, bad, here)
+    for bad in ((0.7, 0.0), (0.7, np.nan, 0.07)):
+        with pytest.raises(ConfigError, match="three finite numbers"):
+            trial_rng(0, 0, bad)
 
 
 def test_perturbation_draws_within_their_ranges():

@@ -64,20 +64,27 @@ def check_seed(seed) -> int:
     return int(seed)
 
 
-def trial_rng(seed: int, trial: int) -> np.random.Generator:
-    """The random generator of trial ``trial`` (0, 1, …) of a run seeded ``seed``.
+def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
+    """The random generator of trial ``trial`` (0, 1, …) at the burger location ``location``
+    (x, y, z) (m) of a run seeded ``seed``.
 
-    Seeded by numpy's ``SeedSequence`` of the pair, so that each (seed, trial) has a stream
-    of its own and runs with different seeds share no draw: a run with seed 3 is a second
-    sample, not the run with seed 0 shifted by three trials (as ``default_rng(seed + trial)``
-    would make it). Every location and every parameter setting of a run sees the same draws.
+    Seeded by numpy's ``SeedSequence`` of the seed, the trial and the location in µm, so
+    that every trial of every location has a stream of its own: Table I's 10 × 10 trials are
+    100 perturbations, not 10 repeated at each location, and runs with different seeds share
+    no draw (with ``default_rng(seed + trial)``, seed 3's trial 0 was seed 0's trial 3). Every
+    parameter setting of a run sees the same draws at a location (common random numbers).
 
     Raises:
-        ConfigError: ``seed`` or ``trial`` is not a non-negative integer.
+        ConfigError: ``seed`` or ``trial`` is not a non-negative integer, or ``location`` is
+            not three finite numbers.
     """
     if isinstance(trial, bool) or not isinstance(trial, (int, np.integer)) or trial < 0:
         raise ConfigError(f"trial must be a non-negative integer, got {trial!r}")
-    return np.random.default_rng(np.random.SeedSequence([check_seed(seed), int(trial)]))
+    loc = np.asarray(location, float).ravel()
+    if loc.shape != (3,) or not np.all(np.isfinite(loc)):
+        raise ConfigError(f"trial location must be three finite numbers (m), got {location!r}")
+    where = [int(round(v * 1e6)) % 2**32 for v in loc]  # µm, wrapped to non-negative
+    return np.random.default_rng(np.random.SeedSequence([check_seed(seed), int(trial), *where]))
 
 
 __all__ = ["Perturbations", "check_seed", "trial_rng"]

@@ -61,8 +61,8 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
     Args:
         plan_texts: Texts of solved flip plan files (e.g. the Table I plans).
         trials: Trials per plan and setting (trial i draws its perturbation from
-            :func:`~flipkit.experiments.perturbations.trial_rng` ``(seed, i)``: every setting
-            sees the same draws).
+            :func:`~flipkit.experiments.perturbations.trial_rng` ``(seed, i, location)``:
+            every setting sees the same draws).
         parameters: Dotted names of :data:`PHYSICAL_RANGES` to move; default all.
         seed, mode, replan, perturbations, rate_hz: As :func:`flipkit.experiments.trials.validate`.
         nominal: Also run the nominal cell (``result["nominal"]``).

@@ -3,9 +3,10 @@
 As :mod:`flipkit.experiments.trials` for flips: each trial executes the plan closed-loop in the
 MuJoCo cell (:func:`flipkit.simulation.execute.execute_plan`) with the burger misplaced and the
 physics perturbed (:class:`~flipkit.experiments.perturbations.Perturbations`, drawn from
-:func:`~flipkit.experiments.perturbations.trial_rng` of the seed and the trial), then judges the scoop and pickup (paper Sec. V) and
-the serve (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up,
-within 3 cm of the spot). A stage counts only if the previous ones succeeded. With
+:func:`~flipkit.experiments.perturbations.trial_rng` of the seed, the trial and the
+location), then judges the scoop and pickup (paper Sec. V) and the serve
+(:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up, within
+3 cm of the spot). A stage counts only if the previous ones succeeded. With
 ``replan`` the cell measures where the burger lies on the blade at the end of the carry and
 re-plans place and return home for it (:func:`flipkit.planning.planners.serve.replan_serve`).
 """
@@ -47,7 +48,7 @@ def run_serve_trial(job: dict) -> dict:
     """
     plan = plan_from_text(job["plan_text"])
     draw = Perturbations(**job["perturbations"]).draw(
-        trial_rng(job["seed"], job["trial"]))
+        trial_rng(job["seed"], job["trial"], plan.burger["location"]))
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)

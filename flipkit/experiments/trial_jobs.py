@@ -25,7 +25,7 @@ HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to l
 # How a trial's perturbation is drawn from its seed and number (part of the cache key, so a
 # trial drawn another way is never served from the cache):
 # :func:`~flipkit.experiments.perturbations.trial_rng`.
-DRAWS = "SeedSequence([seed, trial])"
+DRAWS = "SeedSequence([seed, trial, location in µm])"
 PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
              "cone", "segments", "created_by")
 

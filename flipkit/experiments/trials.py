@@ -3,10 +3,10 @@
 One trial (:func:`run_trial`): the plan is executed closed-loop in the MuJoCo cell
 (:func:`flipkit.simulation.execute.execute_plan`): the arm with its spatula is simulated with the
 burger lying on the grill, misplaced and with perturbed physics (:class:`Perturbations`,
-drawn from :func:`~flipkit.experiments.perturbations.trial_rng` of the seed and the trial),
-the blade colliding with the grill and the burger; the joint controller is the job's ``mode`` (``"feedforward"``: plan torques plus
-PD; ``"position"``: the robot's own PD position control on servo-rate, delayed desired
-states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
+drawn from :func:`~flipkit.experiments.perturbations.trial_rng` of the seed, the trial and the
+location), the blade colliding with the grill and the burger; the joint controller is the
+job's ``mode`` (``"feedforward"``: plan torques plus PD; ``"position"``: the robot's own PD
+position control on servo-rate, delayed desired states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
 the previous ones succeeded, as in Table I.
 
 :func:`track_plan` (the older pinocchio-only tracking, whose poses drove the blade of
@@ -144,7 +144,7 @@ def run_trial(job: dict) -> dict:
     plan = plan_from_text(job["plan_text"])
     mode = job.get("mode", FEEDFORWARD)
     draw = Perturbations(**job["perturbations"]).draw(
-        trial_rng(job["seed"], job["trial"]))
+        trial_rng(job["seed"], job["trial"], plan.burger["location"]))
     cell = plan.cell()
     for name, value in (job.get("physics") or {}).items():
         cell = with_parameter(cell, name, value)
@@ -260,7 +260,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             (m), a dict describing the plan (recorded as is) and the text of its solved plan
             file (``None``: no plan, every trial fails at stage ``plan``).
         trials: Trials per location (≥ 1). seed: Trial i draws from
-            :func:`~flipkit.experiments.perturbations.trial_rng` ``(seed, i)``; seeds ≥ 0.
+            :func:`~flipkit.experiments.perturbations.trial_rng` ``(seed, i,
+            location)``; seeds ≥ 0.
         perturbations: See :class:`Perturbations`. rate_hz: Joint controller rate (Hz).
         mode: Joint controller, one of :data:`flipkit.simulation.modes.MODES`.
         replan: Sense, plan, act: after the scoop, measure where the burger lies on the blade
