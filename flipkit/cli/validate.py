@@ -40,8 +40,8 @@ def register(subparsers) -> None:
     parser.add_argument("--trials", type=int, required=True, metavar="K",
                         help=f"simulated trials per location, in [1, {MAX_TRIALS}]")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
-                        help="non-negative; trial i at each location draws from a stream of its own, numpy "
-                             "SeedSequence([S, i, location]) (default 0)")
+                        help="non-negative (default 0); trial i at each location draws from "
+                             "a stream of its own, numpy SeedSequence([S, i, location])")
     parser.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
                         help="collocation solver for --locations (default auto: the SQP, then IPOPT where it fails)")
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")

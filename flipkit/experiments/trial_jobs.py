@@ -22,9 +22,9 @@ from flipkit.simulation.scene import NOSLIP_ITERATIONS, SLEEP_TOLERANCE
 
 TRACK_RATE_HZ = 1000.0  # PD controller and arm integration rate (Hz)
 HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to land
-# How a trial's perturbation is drawn from its seed and number (part of the cache key, so a
-# trial drawn another way is never served from the cache):
-# :func:`~flipkit.experiments.perturbations.trial_rng`.
+# How a trial's perturbation is drawn from its seed, number and location
+# (:func:`~flipkit.experiments.perturbations.trial_rng`); part of the cache key, so that a
+# trial drawn another way is never served from the cache.
 DRAWS = "SeedSequence([seed, trial, location in µm])"
 PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
              "cone", "segments", "created_by")

@@ -6,8 +6,8 @@ burger lying on the grill, misplaced and with perturbed physics (:class:`Perturb
 drawn from :func:`~flipkit.experiments.perturbations.trial_rng` of the seed, the trial and the
 location), the blade colliding with the grill and the burger; the joint controller is the
 job's ``mode`` (``"feedforward"``: plan torques plus PD; ``"position"``: the robot's own PD
-position control on servo-rate, delayed desired states). The paper's judges (Sec. V) decide scoop, pickup and flip. A stage counts only if
-the previous ones succeeded, as in Table I.
+position control on servo-rate, delayed desired states). The paper's judges (Sec. V) decide
+scoop, pickup and flip. A stage counts only if the previous ones succeeded, as in Table I.
 
 :func:`track_plan` (the older pinocchio-only tracking, whose poses drove the blade of
 :class:`flipkit.simulation.prescribed_blade.BurgerSim`) is kept for the figures that use it.
