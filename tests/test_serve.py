@@ -247,10 +247,15 @@ def test_cli_validate_judges_a_serve_plan_on_the_table(plan_file, tmp_path, caps
     out = tmp_path / "v.json"
     rc = main(["validate", "--plan", str(plan_file), "--trials", "1", "--workers", "1",
                "--replan", "--no-progress", "--json", str(out)])
-    assert rc == 0 and "serve" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert rc == 0 and "serve" in printed
     doc = json.loads(out.read_text())
     entry = doc["locations"][0]
     assert set(entry["success"]) == {"scoop", "pickup", "serve"}
+    served = entry["success"]["serve"]  # one trial: the Wilson interval of 0/1 or 1/1
+    assert doc["summary"]["interval_95"]["serve"] == pytest.approx(
+        [0.0, 0.7935] if served == 0 else [0.2065, 1.0], abs=1e-4)
+    assert "95 % Wilson intervals: scoop" in printed
     assert entry["spot"] == list(SPOT) and len(entry["rests"]) == 1
     rest = entry["rests"][0]
     assert entry["success"]["serve"] == int(rest["distance"] <= SERVE_TOL and rest["up_z"] > 0.9)

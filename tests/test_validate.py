@@ -50,6 +50,8 @@ def test_schema(result):
         for err in table.values():
             assert 0 < err["rms_m"] <= err["max_m"] < 0.01  # PD tracking: below 1 cm
     assert result["summary"]["trials"] == TRIALS
+    for stage, (lo, hi) in result["summary"]["interval_95"].items():  # Wilson, around k / n
+        assert 0 <= lo <= result["summary"]["success"][stage] / TRIALS <= hi <= 1 and lo < hi
     assert result["perturbations"]["position_sigma"] == 0.005
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from flipkit.config import known_physics, with_parameter
 from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
+from flipkit.experiments.ratios import success_intervals
 from flipkit.experiments.perturbations import Perturbations, trial_rng
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
@@ -135,6 +136,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "servo_lookahead_s": lookahead_of(servo_lookahead_s), "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
+                        "interval_95": success_intervals(entry["success"], int(trials)),
                         "independent": entry["independent"],
                         "pause": pause_summary(entry["rests"]) if replan else None}}
 

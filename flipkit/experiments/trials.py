@@ -29,6 +29,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, Unreac
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.pauses import pause_summary
+from flipkit.experiments.ratios import success_intervals
 from flipkit.experiments.perturbations import Perturbations, check_seed, trial_rng
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.slides import slide_summary
@@ -279,7 +280,9 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
-        "trials", "success": {stage: count}, "independent": {stage: count}, "pause": the
+        "trials", "success": {stage: count}, "interval_95": {stage: [low, high]} (the 95 %
+        Wilson interval of each ratio, :func:`flipkit.experiments.ratios.success_intervals`),
+        "independent": {stage: count}, "pause": the
         arm's pauses at the sense (:func:`flipkit.experiments.pauses.pause_summary`; ``None``
         open loop), "slide": how far the burgers slid after they touched the grill
         (:func:`flipkit.experiments.slides.slide_summary`)}}``.
@@ -306,6 +309,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         if text in records:
             entry["contingencies"] = contingency_summary(records[text])
     landings = [land for e in entries for land in e["landings"]]
+    success = {s: sum(e["success"][s] for e in entries) for s in STAGES}
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "servo_lookahead_s": lookahead_of(servo_lookahead_s),
@@ -313,7 +317,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
             "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
             "summary": {"locations": len(entries), "trials": len(entries) * int(trials),
-                        "success": {s: sum(e["success"][s] for e in entries) for s in STAGES},
+                        "success": success,
+                        "interval_95": success_intervals(success, len(entries) * int(trials)),
                         "independent": {s: sum(e["independent"][s] for e in entries)
                                         for s in STAGES},
                         "pause": pause_summary(landings) if replan else None,

@@ -10,6 +10,7 @@ from flipkit.cli.validate import format_table
 from flipkit.errors import ConfigError
 from flipkit.config import LOCATION_SETS
 from flipkit.experiments.pauses import format_pauses
+from flipkit.experiments.ratios import format_intervals
 from flipkit.experiments.slides import format_slides
 from flipkit.experiments.sweep import make_executor
 from flipkit.experiments.trials import validate_locations, validate_plan_file
@@ -42,6 +43,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
           f"{total['locations']} locations, "
           f"success {total['success']}; wrote {args.json}")
+    print(format_intervals(total["interval_95"]))
     if out.get("replan") and "pause" in total:  # a flip validation's re-plans
         print(format_pauses(total["pause"]))
     if total.get("slide"):  # a flip validation's landings
