@@ -69,7 +69,7 @@ def test_wilson_known_values_and_bad_counts():
     assert np.isclose(lo[0], 0.96300, atol=1e-4) and hi[0] == 1.0
     assert np.isclose(lo[1], 0.20654, atol=1e-4) and hi[1] == 1.0
     assert lo[2] == 0.0 and np.isclose(hi[2], 0.79346, atol=1e-4)
-    for k, n in (([3], [2]), ([-1], [4]), ([np.nan], [4]), ([1], [np.inf])):
+    for k, n in (([3], [2]), ([-1], [4]), ([np.nan], [4]), ([1], [np.inf]), ([1.5], [4])):
         with pytest.raises(ValueError):
             draw.wilson_interval(k, n)
 

@@ -4,39 +4,43 @@ and the sensitivity study."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import binomtest, norm
 
 from flipkit.figures.style import ACTUAL_COLOR, DESIRED_COLOR, SOLVER_COLORS, SOLVER_LABELS
 
-def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.ndarray]:
-    """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default).
 
-    The bounds always contain the observed ratio ``k / n``: at ``k = 0`` the lower bound is
-    exactly 0 and at ``k = n`` the upper bound is exactly 1 (in floating point the closed form
-    gives ``1 - 1e-16`` there, which would make an error bar negative). Entries with ``n = 0``
-    are NaN.
+def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.ndarray]:
+    """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default),
+    element by element, computed by scipy (``binomtest(k, n).proportion_ci(method="wilson")``
+    at the two-sided level of ``z``, as ``flipkit validate`` reports it,
+    :mod:`flipkit.experiments.ratios`).
+
+    The bounds contain the observed ratio ``k / n``; at ``k = 0`` the lower bound is 0 and at
+    ``k = n`` the upper bound is 1. Entries with ``n = 0`` are NaN.
 
     Args:
-        successes: Successes ``k`` (array-like, ``0 <= k <= n``).
-        trials: Trials ``n`` (array-like, ``n >= 0``).
+        successes: Successes ``k`` (array-like of whole numbers, ``0 <= k <= n``).
+        trials: Trials ``n`` (array-like of whole numbers, ``n >= 0``), broadcast with ``k``.
         z: Standard-normal quantile of the two-sided level (1.96 for 95 %).
 
     Raises:
-        ValueError: If a count is negative, not finite, or ``k > n``.
+        ValueError: If a count is negative, not a whole number, or ``k > n``.
     """
-    k, n = np.asarray(successes, float), np.asarray(trials, float)
+    k, n = np.broadcast_arrays(np.asarray(successes, float), np.asarray(trials, float))
     if not (np.all(np.isfinite(k)) and np.all(np.isfinite(n))):
         raise ValueError("wilson_interval: counts must be finite")
     if np.any(k < 0) or np.any(n < 0) or np.any(k > n):
         raise ValueError("wilson_interval: counts must satisfy 0 <= successes <= trials")
-    n_safe = np.where(n > 0, n, 1.0)
-    p = k / n_safe
-    den = 1 + z**2 / n_safe
-    mid = (p + z**2 / (2 * n_safe)) / den
-    half = z * np.sqrt(p * (1 - p) / n_safe + z**2 / (4 * n_safe**2)) / den
-    lo = np.minimum(np.clip(mid - half, 0, 1), p)
-    hi = np.maximum(np.clip(mid + half, 0, 1), p)
-    lo, hi = np.where(k == 0, 0.0, lo), np.where(k == n, 1.0, hi)
-    return np.where(n > 0, lo, np.nan), np.where(n > 0, hi, np.nan)
+    if np.any(k != np.round(k)) or np.any(n != np.round(n)):
+        raise ValueError("wilson_interval: counts must be whole numbers")
+    level = 2.0 * float(norm.cdf(z)) - 1.0
+    lo, hi = np.full(k.shape, np.nan), np.full(k.shape, np.nan)
+    for i in np.ndindex(k.shape):
+        if n[i] > 0:
+            ci = binomtest(int(k[i]), int(n[i])).proportion_ci(confidence_level=level,
+                                                               method="wilson")
+            lo[i], hi[i] = ci.low, ci.high
+    return lo, hi
 
 
 def ratio_error_bars(successes, trials, z: float = 1.96):
