@@ -27,3 +27,14 @@ def box(name: str, lower, upper, n: int) -> None:
     lo, hi = finite(f"{name} lower", lower, (n,)), finite(f"{name} upper", upper, (n,))
     if np.any(lo >= hi):
         raise ConfigError(f"{name}: lower bound must be below upper bound, got {lo} >= {hi}")
+
+
+def whole(name: str, value, low: int = 0, high: int | None = None) -> int:
+    """``value`` as an int, or ConfigError: an integer (a bool is not one) in [low, high]."""
+    if (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low
+            or (high is not None and value > high)):
+        what = (f"an integer in [{low}, {high}]" if high is not None
+                else "a non-negative integer" if low == 0 else "a positive integer" if low == 1
+                else f"an integer >= {low}")
+        raise ConfigError(f"{name} must be {what}, got {value!r}")
+    return int(value)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flipkit.config import SensingUncertainty
+from flipkit.config.checks import whole
 from flipkit.errors import ConfigError
 
 
@@ -59,9 +60,7 @@ class Perturbations:
 
 def check_seed(seed) -> int:
     """``seed`` as an int, or :class:`ConfigError` (one line): a non-negative integer."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
-    return int(seed)
+    return whole("seed", seed)
 
 
 def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
@@ -78,13 +77,12 @@ def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
         ConfigError: ``seed`` or ``trial`` is not a non-negative integer, or ``location`` is
             not three finite numbers.
     """
-    if isinstance(trial, bool) or not isinstance(trial, (int, np.integer)) or trial < 0:
-        raise ConfigError(f"trial must be a non-negative integer, got {trial!r}")
+    trial = whole("trial", trial)
     loc = np.asarray(location, float).ravel()
     if loc.shape != (3,) or not np.all(np.isfinite(loc)):
         raise ConfigError(f"trial location must be three finite numbers (m), got {location!r}")
     where = [int(round(v * 1e6)) % 2**32 for v in loc]  # µm, wrapped to non-negative
-    return np.random.default_rng(np.random.SeedSequence([check_seed(seed), int(trial), *where]))
+    return np.random.default_rng(np.random.SeedSequence([check_seed(seed), trial, *where]))
 
 
 __all__ = ["Perturbations", "check_seed", "trial_rng"]

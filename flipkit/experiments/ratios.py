@@ -10,12 +10,20 @@ the run's locations, each weighted by its trials. scipy computes it
 
 from __future__ import annotations
 
-import numpy as np
 from scipy.stats import binomtest
 
+from flipkit.config.checks import whole
 from flipkit.errors import ConfigError
 
 LEVEL = 0.95  # the intervals' confidence level
+
+
+def wilson(successes: int, trials: int, level: float = LEVEL) -> tuple[float, float]:
+    """The Wilson score interval (low, high) of ``successes`` of ``trials`` (checked integers,
+    0 ≤ successes ≤ trials, trials ≥ 1) at confidence ``level``, by scipy."""
+    ci = binomtest(int(successes), int(trials)).proportion_ci(confidence_level=level,
+                                                              method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 def success_intervals(success: dict, trials: int, level: float = LEVEL) -> dict:
@@ -26,17 +34,11 @@ def success_intervals(success: dict, trials: int, level: float = LEVEL) -> dict:
         ConfigError: ``trials`` is not a positive integer, a count is not an integer in
             [0, trials], or ``level`` is not in (0, 1).
     """
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    trials = whole("trials", trials, 1)
     if not 0.0 < level < 1.0:
         raise ConfigError(f"confidence level must be in (0, 1), got {level!r}")
-    out = {}
-    for stage, k in success.items():
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= trials:
-            raise ConfigError(f"{stage}: successes must be an integer in [0, {trials}], got {k!r}")
-        ci = binomtest(int(k), int(trials)).proportion_ci(confidence_level=level, method="wilson")
-        out[stage] = [float(ci.low), float(ci.high)]
-    return out
+    return {stage: list(wilson(whole(f"{stage} successes", k, 0, trials), trials, level))
+            for stage, k in success.items()}
 
 
 def format_intervals(intervals: dict, level: float = LEVEL) -> str:
@@ -45,4 +47,4 @@ def format_intervals(intervals: dict, level: float = LEVEL) -> str:
     return f"{100 * level:.0f} % Wilson intervals: " + ", ".join(parts)
 
 
-__all__ = ["LEVEL", "format_intervals", "success_intervals"]
+__all__ = ["LEVEL", "format_intervals", "success_intervals", "wilson"]

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import known_physics, with_parameter
+from flipkit.config.checks import whole
 from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.ratios import success_intervals
@@ -115,8 +116,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
     require_verified(plan, path, ("serve",))  # nothing unverified is simulated
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    whole("trials", trials, 1)
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
                       replan, servo_physics(servo_lookahead_s), command=command)
     results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,

@@ -25,6 +25,7 @@ from flipkit.behaviors import targets as tg
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, known_physics, with_parameter
+from flipkit.config.checks import whole
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
@@ -289,8 +290,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     """
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    whole("trials", trials, 1)
     physics = servo_physics(servo_lookahead_s)
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
@@ -357,8 +357,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
     """
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ConfigError(f"trials must be a positive integer, got {trials!r}")
+    whole("trials", trials, 1)
     check_seed(seed)  # before any planning
     cell, locs = CellConfig(), []
     for k, loc in enumerate(locations, 1):

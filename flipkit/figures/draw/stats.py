@@ -4,16 +4,16 @@ and the sensitivity study."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import binomtest, norm
+from scipy.stats import norm
 
+from flipkit.experiments.ratios import wilson
 from flipkit.figures.style import ACTUAL_COLOR, DESIRED_COLOR, SOLVER_COLORS, SOLVER_LABELS
 
 
 def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.ndarray]:
     """Wilson score interval (lower, upper) of a binomial success ratio (95 % by default),
-    element by element, computed by scipy (``binomtest(k, n).proportion_ci(method="wilson")``
-    at the two-sided level of ``z``, as ``flipkit validate`` reports it,
-    :mod:`flipkit.experiments.ratios`).
+    element by element, at the two-sided level of ``z``: scipy's, as ``flipkit validate``
+    reports it (:func:`flipkit.experiments.ratios.wilson`).
 
     The bounds contain the observed ratio ``k / n``; at ``k = 0`` the lower bound is 0 and at
     ``k = n`` the upper bound is 1. Entries with ``n = 0`` are NaN.
@@ -37,9 +37,7 @@ def wilson_interval(successes, trials, z: float = 1.96) -> tuple[np.ndarray, np.
     lo, hi = np.full(k.shape, np.nan), np.full(k.shape, np.nan)
     for i in np.ndindex(k.shape):
         if n[i] > 0:
-            ci = binomtest(int(k[i]), int(n[i])).proportion_ci(confidence_level=level,
-                                                               method="wilson")
-            lo[i], hi[i] = ci.low, ci.high
+            lo[i], hi[i] = wilson(int(k[i]), int(n[i]), level)
     return lo, hi
 
 
