@@ -36,15 +36,19 @@ FLAT_DEFAULTS = {
     "qp_max_iter": ("qp", "max_iter", (2000, 10000, 10000)),
     "condense": ("qp", "condense", True),
 }
+# Settings added since, with their defaults: (group, field, value).
+ADDED = {("trust_region", "second_order_correction", False), ("qp", "quasi_newton", True)}
 
 
 def test_defaults_are_the_flat_settings_of_before():
     o = SQPOptions()
     leaves = {(g.name, f.name) for g in fields(o) for f in fields(getattr(o, g.name))}
-    assert leaves == {(g, f) for g, f, _ in FLAT_DEFAULTS.values()}
+    assert leaves == {(g, f) for g, f, _ in FLAT_DEFAULTS.values()} | {(g, f) for g, f, _ in ADDED}
     for old, (group, name, value) in FLAT_DEFAULTS.items():
         got = getattr(getattr(o, group), name)
         assert got == value and type(got) is type(value), old
+    for group, name, value in ADDED:
+        assert getattr(getattr(o, group), name) is value
 
 
 @pytest.mark.parametrize("make, name", [
@@ -71,6 +75,8 @@ def test_defaults_are_the_flat_settings_of_before():
     (lambda: RestorationOptions(prox=0.0), "restoration.prox"),
     (lambda: RestorationOptions(slack_reg=-1.0), "restoration.slack_reg"),
     (lambda: QPOptions(condense="yes"), "qp.condense"),
+    (lambda: QPOptions(quasi_newton=1), "qp.quasi_newton"),
+    (lambda: TrustRegionOptions(second_order_correction="no"), "trust_region.second_order_correction"),
     (lambda: QPOptions(eps=(1e-4, 1e-9)), "qp.eps"),
     (lambda: QPOptions(eps_factor=0.0), "qp.eps_factor"),
     (lambda: QPOptions(max_iter=(2000, 10000)), "qp.max_iter"),

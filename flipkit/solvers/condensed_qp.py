@@ -9,8 +9,9 @@ linearised equalities E d = −r_E is then
 
     d = d_p + Z w,   Z = [−E_B⁻¹E_N; I],   d_p = [−E_B⁻¹ r_E; 0]     (B rows first)
 
-With RᵀR = Zᵀ diag(h) Z (Cholesky, r × r) and T = Z R⁻¹, w = R⁻¹v and the subproblem of
-:mod:`flipkit.solvers.full_qp` becomes
+With RᵀR = Zᵀ diag(h) Z (Cholesky, r × r; + M, the rows' curvature estimated by
+:mod:`flipkit.solvers.reduced_hessian`, when the SQP passes one) and T = Z R⁻¹, w = R⁻¹v and
+the subproblem of :mod:`flipkit.solvers.full_qp` becomes
 
     minimise ½‖v‖² + g_vᵀv   s.t.  lo ≤ [J_I T; T] v ≤ hi
 
@@ -110,6 +111,8 @@ class CondensedQP:
         if not self.problem.is_dpp():  # pragma: no cover - a programming error
             raise SolverError("the condensed subproblem must be DPP")
         self.basis: np.ndarray | None = None
+        self.Z: np.ndarray | None = None  # null-space basis of the last update (n × r)
+        self.curved = False  # the last update added a curvature estimate M
 
     # ------------------------------------------------------------------ basis
     def _split(self, jac: np.ndarray):
@@ -171,12 +174,20 @@ class CondensedQP:
 
     # ------------------------------------------------------------------ values
     def update(self, nlp: NLP, c: np.ndarray, jac: np.ndarray, grad: np.ndarray, hess: np.ndarray,
-               d_lo: np.ndarray, d_hi: np.ndarray, slack_reg: float = 1e2) -> None:
+               d_lo: np.ndarray, d_hi: np.ndarray, slack_reg: float = 1e2,
+               curvature: np.ndarray | None = None) -> None:
         """Condense the subproblem of a linearisation (scaled units, as
         :meth:`flipkit.solvers.full_qp.QPSubproblem.update`; ``hess`` must be positive;
-        ``slack_reg`` is σ of the elastic form's ½σ‖s‖², unused by the hard form)."""
+        ``slack_reg`` is σ of the elastic form's ½σ‖s‖², unused by the hard form).
+
+        ``curvature``: an r × r estimate M of the rows' curvature in the reduced coordinates
+        w = d_N of the current basis (:mod:`flipkit.solvers.reduced_hessian`), added to the
+        reduced Hessian ZᵀHZ. It is dropped (:attr:`curved` False) when ZᵀHZ + M is not
+        positive definite here, or when the basis is chosen in this update (M belongs to the
+        coordinates of the basis it was estimated in)."""
         E, JI = self._split(jac)
-        fresh = self.basis is None  # chosen at this point just now: pivoting again repeats it
+        basis = self.basis
+        fresh = basis is None  # chosen at this point just now: pivoting again repeats it
         if fresh:
             self.choose_basis(jac)
         lu = self._factor(E)
@@ -188,6 +199,8 @@ class CondensedQP:
             lu = self._factor(E)
             if lu is None:
                 raise SingularBasisError("the equality rows' Jacobian is rank deficient")
+        if self.basis is not basis:
+            curvature = None
         B, N, n, r = self.basis, self.free, self.n, self.r
         lo_s, hi_s = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
         Z = np.zeros((n, r))
@@ -195,9 +208,18 @@ class CondensedQP:
         Z[N, np.arange(r)] = 1.0
         d_p = np.zeros(n)
         d_p[B] = -lu.solve(c[self.eq_rows] - lo_s[self.eq_rows])
-        R = sla.cholesky(Z.T @ (hess[:, None] * Z))  # upper: RᵀR = Zᵀ H Z
+        reduced = Z.T @ (hess[:, None] * Z)
+        R, self.curved = None, False
+        if curvature is not None:
+            try:
+                R, self.curved = sla.cholesky(reduced + curvature), True
+            except np.linalg.LinAlgError:
+                pass
+        if R is None:
+            R = sla.cholesky(reduced)  # upper: RᵀR = Zᵀ H Z (+ M)
         T = sla.solve_triangular(R, Z.T, trans="T").T  # Z R⁻¹
         self._state = (lu, T, d_p, JI, grad, hess)
+        self.Z = Z  # the null-space basis of this linearisation (reduced_hessian reads it)
         I = self.ineq_rows
         G = np.asarray(JI @ T)
         base = c[I] + JI @ d_p

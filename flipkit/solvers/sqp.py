@@ -1,5 +1,6 @@
-"""SQP for one segment's NLP: Gauss–Newton subproblems (cvxpy + OSQP), exact projection onto the
-dynamics rows, ℓ1 merit with a line search, and a box trust region.
+"""SQP for one segment's NLP: Gauss–Newton subproblems with an estimate of the rows' curvature
+(cvxpy + OSQP), exact projection onto the dynamics rows, ℓ1 merit with a line search, and a
+box trust region.
 
 Settings are :class:`~flipkit.solvers.sqp_options.SQPOptions`, in four groups (``termination``,
 ``trust_region``, ``restoration``, ``qp``); lengths are in scaled variable units, J̃ is the
@@ -9,11 +10,16 @@ scaled cost and v the scaled violation. The design, its alternatives and referen
 Model. Each iteration linearises the constraints at Z_k and solves a convex QP for the step
 d: the cost's exact Hessian (2 on the torques) plus a Levenberg–Marquardt weight ½μ‖d‖², every
 linearised row hard, and the trust box |d|∞ ≤ Δ. With the dynamics rows u = RNEA(q, q̇, q̈)
-hard this is the Gauss–Newton model of Σ‖RNEA‖² along the linearised constraints: no second
-derivatives, no quasi-Newton memory. With ``qp.condense`` (the default) the QP is solved in
+hard this is the Gauss–Newton model of Σ‖RNEA‖² along the linearised constraints. With
+``qp.quasi_newton`` (the default) the condensed QP adds M, a damped BFGS estimate of the
+rows' curvature in the null space of the equality rows, updated after every accepted hard
+step (:mod:`flipkit.solvers.reduced_hessian`): the flip's landing, flight and cone rows are
+strongly curved, and without it the model over-predicted the decrease and the line search
+halved the step. With ``qp.condense`` (the default) the QP is solved in
 condensed form (:mod:`flipkit.solvers.condensed_qp`: the linearised equality rows eliminated by
 a sparse LU, OSQP sees a small QP with an identity Hessian and inequality rows only), else in
-full space (:mod:`flipkit.solvers.full_qp`). The compiled QPs belong to a workspace
+full space (:mod:`flipkit.solvers.full_qp`, Gauss–Newton model only). The compiled QPs belong
+to a workspace
 (:class:`~flipkit.solvers.compiled.SQPWorkspace`, the caller's or the process's default), reset
 for the NLP's structure on entry so that no solve warm-starts from another. μ regularises the
 directions along which Σu² is nearly flat (wrist motions): it is divided by 4 after a full
@@ -24,9 +30,10 @@ Globalisation. Every trial point is projected first: u_i := RNEA(q_i, q̇_i, q̈
 satisfies the dynamics rows exactly (u enters them alone and linearly), so the merit does not
 see their second-order error. A trial point Z + a·d, a ∈ {1, ½, …, 2^−``backtracks``}, is
 accepted when φ = J̃ + ρ‖v‖₁ falls by at least η·a·pred, pred the model's decrease; ρ stays
-above twice the largest QP multiplier and large enough for d to descend on φ. A full step
-that raises the violation and falls short of its prediction gets a second-order correction
-(a Newton step holding the QP's active rows) before it is judged. Δ doubles after a full,
+above twice the largest QP multiplier and large enough for d to descend on φ. With
+``trust_region.second_order_correction`` (off by default), a full step that raises the
+violation and falls short of its prediction gets a second-order correction (a Newton step
+holding the QP's active rows) before it is judged. Δ doubles after a full,
 well predicted step that used at least half of it, shrinks to the accepted length after a
 shortened step, and to a tenth of the shorter of Δ and the step after a rejected one.
 
@@ -86,6 +93,7 @@ from flipkit.errors import NoSolutionFound
 from flipkit.solvers.iterate import Iterate, newton_correction
 from flipkit.transcription.nlp import NLP
 from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
+from flipkit.solvers.reduced_hessian import ReducedHessian
 from flipkit.solvers.subproblem import QPSolution
 from flipkit.solvers.threads import single_threaded_blas
 from flipkit.solvers.result import SolveResult, Status
@@ -98,18 +106,20 @@ __all__ = ["DEFAULT_WORKSPACE", "QPOptions", "RestorationOptions", "SQPOptions",
 
 def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo, d_hi,
                 eps: float, wide=None, restore=None, restoring: bool = False, *,
-                workspace: SQPWorkspace):
+                workspace: SQPWorkspace, curvature=None):
     """The step at p: the hard QP (if OSQP runs out of iterations — not infeasible — μ is
     raised tenfold, better conditioned for ADMM and a shorter step, and it is tried again);
     if it is infeasible, the hard QP in the box ``wide`` (the variable bounds within the largest
     trust region), if given; else the restoration QP, in the box ±``restore`` ∩ the variable
     bounds (default the step box). ``restoring``: in the restoration phase, the restoration QP
-    alone. The compiled QPs are ``workspace``'s. Returns (solution, QP object, μ, tries, ADMM
+    alone. ``curvature``: the rows' reduced curvature M for the hard QP (condensed form,
+    :mod:`flipkit.solvers.reduced_hessian`). The compiled QPs are ``workspace``'s. Returns (solution, QP object, μ, tries, ADMM
     iterations)."""
     admm, attempt, sol = 0, -1, None
+    rows = {} if curvature is None else {"curvature": curvature}  # the condensed form's only
     for attempt in range(0 if restoring else 3):
         qp = workspace.get(nlp, "condensed" if o.qp.condense else "full")
-        qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi, **rows)
         sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
         admm += sol.iterations
         if "infeasible" in sol.status and attempt == 0:
@@ -137,7 +147,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         # the elastic QP took 0.2–0.7 s. (In the variable bounds alone, without Δ_max, cold
         # flips took steps into regions where they were declared infeasible: measured at
         # Table I location 2.)
-        qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide, **rows)
         qp.cold()
         sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[-1])
         admm += sol.iterations
@@ -168,7 +178,8 @@ def _line_search(o: SQPOptions, p: Iterate, d, pred: float, merit, point, correc
     step, ratio, trial = 1.0, 0.0, None
     for _ in range(o.trust_region.backtracks + 1):
         trial = point(p.x + step * d)
-        if step == 1.0 and trial.v.sum() > p.v.sum() and merit(p) - merit(trial) < 0.75 * pred:
+        if (o.trust_region.second_order_correction and step == 1.0 and trial.v.sum() > p.v.sum()
+                and merit(p) - merit(trial) < 0.75 * pred):
             # Second-order correction: the full step's curvature error on the rows (cone,
             # blade heights, landing) removed by a minimum-norm Newton step at Z + d that
             # holds the subproblem's active rows at their bounds.
@@ -220,13 +231,14 @@ def _square_violation(p: Iterate) -> float:
     return 0.5 * float(p.v @ p.v)
 
 
-def _descent_model(nlp: NLP, p: Iterate, sol: QPSolution, grad, hess, rho: float):
+def _descent_model(nlp: NLP, p: Iterate, sol: QPSolution, grad, hess, rho: float, extra=0.0):
     """(ρ, pred): ρ ≥ twice the largest multiplier and large enough for d to descend on φ
-    (elastic steps have no informative multipliers); pred = φ(p) − model(d)."""
+    (elastic steps have no informative multipliers); pred = φ(p) − model(d), the model's cost
+    change gᵀd + ½dᵀHd plus ``extra`` (the rows' curvature term ½wᵀMw of the step)."""
     d = sol.d
     rho = max(rho, 2.0 * float(np.abs(sol.multipliers).max(initial=0.0)))
     lin_v = _linearised_violation(nlp, p, d)
-    model_f = grad @ d + 0.5 * d @ (hess * d)
+    model_f = grad @ d + 0.5 * d @ (hess * d) + extra
     reduction = float(p.v.sum()) - lin_v
     if model_f > 0 and reduction > 0:
         rho = max(rho, 2.0 * model_f / reduction)
@@ -277,6 +289,8 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
     rho, trust, mu, tighten = tr.rho_min, tr.radius0, tr.prox, 1.0
     log, qp_iters, status, it, pred, stalls = [], 0, Status.MAX_ITER, 0, np.inf, 0
     entry = None  # the violation where the restoration phase began (None: not in it)
+    rows = (ReducedHessian(workspace.get(nlp, "condensed"))  # the rows' curvature, estimated
+            if o.qp.condense and o.qp.quasi_newton else None)
     if not (np.all(np.isfinite(p.c)) and np.all(np.isfinite(p.jac))):  # no model to start from
         return SolveResult(x=p.x, status=Status.INVALID_NUMBER_DETECTED, iterations=0,
                            wall_time_s=time.perf_counter() - t0, objective=nlp.objective(p.x),
@@ -293,11 +307,14 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
         restore = None if wide is not None else o.restoration.radius  # Δ at its largest
         restoring = entry is not None and p.v_max > o.restoration.exit * entry
         v_before = p.v_max
-        sol, qp, mu, tries, admm = _subproblem(nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide,
-                                               restore, restoring, workspace=workspace)
+        sol, qp, mu, tries, admm = _subproblem(
+            nlp, o, p, grad, hess, mu, d_lo, d_hi, eps, wide, restore, restoring,
+            workspace=workspace, curvature=None if rows is None else rows.curvature())
         qp_iters += admm
         hard = not qp.elastic
-        rho, pred = _descent_model(nlp, p, sol, grad, hess, rho)
+        with_rows = hard and rows is not None and qp is rows.qp
+        rho, pred = _descent_model(nlp, p, sol, grad, hess, rho,
+                                   rows.model_term(sol.d) if with_rows else 0.0)
         step, ratio, accepted = 1.0, 0.0, False
         # A negative predicted decrease at a feasible point means the QP was solved too
         # loosely (d = 0 does better): not a stationary point — solve it again, tighter.
@@ -352,6 +369,10 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
         # The restoration phase: entered by an accepted restoration step, left when the
         # violation is down to restoration.exit × its value at entry (or a step is rejected).
         entry = (entry if entry is not None else v_before) if accepted and not hard else None
+        if accepted and with_rows:  # the rows' curvature along the step, at the QP's multipliers
+            lam = sol.multipliers
+            rows.update((trial.x - p.x) / D, hess * (trial.x - p.x) / D
+                        + (trial.J.T @ lam - p.J.T @ lam), hess)
         if accepted:
             p = trial
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": p.v_max,

@@ -120,6 +120,11 @@ class TrustRegionOptions:
         good_ratio: actual/predicted decrease of a full step at or above which μ falls and
             Δ may double (dimensionless); > 0.
         backtracks: Halvings of the step tried before it is rejected; ≥ 0.
+        second_order_correction: Before judging a full step that raised the violation and
+            fell short of its prediction, try a minimum-norm Newton correction at its end
+            (holding the subproblem's active rows). Off by default: with the rows' curvature
+            in the model (:attr:`QPOptions.quasi_newton`) it cost more evaluations than it
+            saved iterations (docs/benchmarks/2026-11-28-reduced-hessian.md).
         rho_min: Smallest ℓ1 penalty ρ of the merit J̃ + ρ‖v‖₁ (scaled cost per scaled
             violation); > 0.
     """
@@ -132,6 +137,7 @@ class TrustRegionOptions:
     eta: float = 0.1
     good_ratio: float = 0.5
     backtracks: int = 5
+    second_order_correction: bool = False
     rho_min: float = 1e-3
 
     def __post_init__(self):
@@ -148,6 +154,9 @@ class TrustRegionOptions:
         _require(self.good_ratio > 0, "trust_region.good_ratio", "> 0", self.good_ratio)
         _require(_is_int(self.backtracks) and self.backtracks >= 0, "trust_region.backtracks",
                  "an integer >= 0", self.backtracks)
+        _require(isinstance(self.second_order_correction, bool),
+                 "trust_region.second_order_correction", "True or False",
+                 self.second_order_correction)
         _require(self.rho_min > 0, "trust_region.rho_min", "> 0", self.rho_min)
 
 
@@ -187,7 +196,8 @@ class QPOptions:
     Attributes:
         condense: Solve the hard and restoration subproblems in condensed form
             (:mod:`flipkit.solvers.condensed_qp`); False solves the full-space QPs of
-            :mod:`flipkit.solvers.full_qp` (slower, same solution).
+            :mod:`flipkit.solvers.full_qp` (slower; the condensed form's QP without
+            ``quasi_newton``).
         eps: (smallest, largest) OSQP tolerance (scaled units); 0 < smallest ≤ largest.
         eps_factor: OSQP tolerance = ``eps_factor`` × the max violation (at a feasible
             iterate: × the last predicted decrease), clipped to ``eps`` (inexact SQP:
@@ -195,15 +205,21 @@ class QPOptions:
         max_iter: OSQP iteration caps of the three tries of the hard QP (the third also caps
             the hard QP in the largest box; the first, the condensed restoration QP); three
             integers ≥ 1.
+        quasi_newton: Add a damped BFGS estimate of the rows' curvature in the condensed
+            null space to the Gauss–Newton model (:mod:`flipkit.solvers.reduced_hessian`);
+            with ``condense`` only (the full-space form keeps the Gauss–Newton model).
     """
 
     condense: bool = True
     eps: tuple[float, float] = (1e-9, 1e-4)
     eps_factor: float = 0.1
     max_iter: tuple[int, int, int] = (2000, 10000, 10000)
+    quasi_newton: bool = True
 
     def __post_init__(self):
         _require(isinstance(self.condense, bool), "qp.condense", "True or False", self.condense)
+        _require(isinstance(self.quasi_newton, bool), "qp.quasi_newton", "True or False",
+                 self.quasi_newton)
         _require(len(self.eps) == 2 and 0 < self.eps[0] <= self.eps[1], "qp.eps",
                  "(smallest, largest) with 0 < smallest <= largest", self.eps)
         _require(self.eps_factor > 0 and math.isfinite(self.eps_factor), "qp.eps_factor",
