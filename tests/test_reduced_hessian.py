@@ -144,3 +144,30 @@ def test_sqp_with_and_without_the_estimate_reach_one_optimum(translate):
     assert a.success and b.success
     assert a.max_violation <= 1e-6 and b.max_violation <= 1e-6
     assert a.objective == pytest.approx(b.objective, rel=1e-3)
+
+
+def test_the_sqp_feeds_the_estimate_to_its_subproblems(translate, monkeypatch):
+    """Every accepted hard step updates M, and the later subproblems solve with it (the
+    condensed QP reports ``curved``); with ``quasi_newton=False`` neither happens."""
+    from flipkit.solvers import reduced_hessian, sqp
+
+    seen = {"updates": 0, "curved": 0}
+    update, original = reduced_hessian.ReducedHessian.update, CondensedQP.update
+
+    def counting_update(self, *args):
+        seen["updates"] += 1
+        return update(self, *args)
+
+    def counting_qp(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        seen["curved"] += bool(self.curved)
+
+    monkeypatch.setattr(sqp.ReducedHessian, "update", counting_update)
+    monkeypatch.setattr(CondensedQP, "update", counting_qp)
+    res = solve_sqp(translate)
+    accepted = sum(1 for r in res.log if r["step"] > 0 and not r["elastic"])
+    assert res.success and seen["updates"] == accepted > 1
+    assert 0 < seen["curved"] <= res.iterations - 1
+    seen.update(updates=0, curved=0)
+    solve_sqp(translate, options=SQPOptions(qp=QPOptions(quasi_newton=False)))
+    assert seen == {"updates": 0, "curved": 0}

@@ -61,9 +61,10 @@ scaled violation ≤ ``tol``.
    Newton corrections onto the rows.
 2. Plateau (``solved``, as rule 1, corrections included): the last ``plateau_iterations``
    iterates were feasible to 100·``tol`` and together lowered Σu² by less than
-   ``plateau_ftol`` (relative). The Gauss–Newton model ignores the rows' curvature: creeping
-   along curved active rows it keeps predicting more than ``ftol``, so this rule watches the
-   actual decrease over a window instead of the predicted one.
+   ``plateau_ftol`` (relative). The model knows the rows' curvature only as far as the BFGS
+   estimate has seen it (the Gauss–Newton model, not at all): creeping along curved active
+   rows it can keep predicting more than ``ftol``, so this rule watches the actual decrease
+   over a window instead of the predicted one.
 3. Rejected small step (``solved``): at a feasible iterate the line search rejects a hard step
    whose predicted decrease was at most ``reject_ftol``·J̃. Rule 1 has already taken every
    prediction ≤ ``ftol``·J̃, so this rule covers (``ftol``, ``reject_ftol``]: gains inside the
@@ -113,13 +114,13 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
     trust region), if given; else the restoration QP, in the box ±``restore`` ∩ the variable
     bounds (default the step box). ``restoring``: in the restoration phase, the restoration QP
     alone. ``curvature``: the rows' reduced curvature M for the hard QP (condensed form,
-    :mod:`flipkit.solvers.reduced_hessian`). The compiled QPs are ``workspace``'s. Returns (solution, QP object, μ, tries, ADMM
-    iterations)."""
+    :mod:`flipkit.solvers.reduced_hessian`). The compiled QPs are ``workspace``'s. Returns
+    (solution, QP object, μ, tries, ADMM iterations)."""
     admm, attempt, sol = 0, -1, None
-    rows = {} if curvature is None else {"curvature": curvature}  # the condensed form's only
+    extra = {} if curvature is None else {"curvature": curvature}  # the condensed form's only
     for attempt in range(0 if restoring else 3):
         qp = workspace.get(nlp, "condensed" if o.qp.condense else "full")
-        qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi, **rows)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, d_lo, d_hi, **extra)
         sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
         admm += sol.iterations
         if "infeasible" in sol.status and attempt == 0:
@@ -147,7 +148,7 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         # the elastic QP took 0.2–0.7 s. (In the variable bounds alone, without Δ_max, cold
         # flips took steps into regions where they were declared infeasible: measured at
         # Table I location 2.)
-        qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide, **rows)
+        qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide, **extra)
         qp.cold()
         sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[-1])
         admm += sol.iterations
