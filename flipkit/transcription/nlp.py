@@ -12,6 +12,7 @@ scaled by ``obj_scale``. A constraint violation is reported in those scaled unit
 
 from __future__ import annotations
 
+import functools
 import hashlib
 
 import numpy as np
@@ -65,9 +66,11 @@ class NLP:
                                    key=lambda b: getattr(b, "project_order", 1))
         self.obj_scale = 1.0 / (layout.n_nodes * 1e4)  # Σu² of a UR10 holding a pose is ~1e4/node
 
-    @property
+    @functools.cached_property
     def structure_key(self) -> str:
-        """Hash of the sparsity pattern and bound structure; equal keys share a compiled QP."""
+        """Hash of the sparsity pattern and bound structure; equal keys share a compiled QP.
+        Computed once: an NLP's pattern and bounds do not change after it is built (the SQP
+        asks for the key at every subproblem)."""
         h = hashlib.sha1()
         for arr in (self.jac_rows, self.jac_cols, np.isfinite(self.c_lo), np.isfinite(self.c_hi),
                     self.c_lo == self.c_hi, np.array([self.n, self.m])):
