@@ -5,6 +5,7 @@ os.environ.setdefault("MUJOCO_GL", "osmesa")  # offscreen rendering (flipkit.sim
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
@@ -81,3 +82,17 @@ def flip_plan():
 @pytest.fixture(scope="package")
 def flip_plan_file(flip_plan, tmp_path_factory):
     return flip_plan.to_json(tmp_path_factory.mktemp("flip_plan") / "plan.json")
+
+
+def linearise(nlp, box=1.0):
+    """Scaled c, entries, J, gradient, Hessian (with a proximal weight) and step box at the
+    projected initial guess."""
+    x = nlp.project(nlp.x0)
+    D = nlp.x_scale
+    c, jac = nlp.evaluate(x)
+    entries = jac * nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
+    J = sp.csr_matrix((entries, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
+    g = nlp.gradient(x) * nlp.obj_scale * D
+    h = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + 1e-3
+    lo, hi = np.maximum((nlp.x_lb - x) / D, -box), np.minimum((nlp.x_ub - x) / D, box)
+    return nlp.c_scale * c, entries, J, g, h, lo, hi

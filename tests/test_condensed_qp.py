@@ -4,6 +4,7 @@ linearised equalities exact, a compiled problem per structure, warm starts that 
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from conftest import linearise
 
 from flipkit.behaviors.models import Models
 from flipkit.behaviors.options import SegmentOptions
@@ -28,27 +29,13 @@ def segments():
     return {"translate": translate, "scoop": scoop}
 
 
-def _linearise(nlp, box):
-    """Scaled c, entries, J, gradient, Hessian (with a proximal weight) and step box at the
-    projected initial guess."""
-    x = nlp.project(nlp.x0)
-    D = nlp.x_scale
-    c, jac = nlp.evaluate(x)
-    entries = jac * nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
-    J = sp.csr_matrix((entries, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
-    g = nlp.gradient(x) * nlp.obj_scale * D
-    h = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + 1e-3
-    lo, hi = np.maximum((nlp.x_lb - x) / D, -box), np.minimum((nlp.x_ub - x) / D, box)
-    return nlp.c_scale * c, entries, J, g, h, lo, hi
-
-
 @pytest.mark.parametrize("name", ["translate", "scoop"])
 def test_condensed_step_is_the_full_space_step(segments, name):
     """Both forms solve one strictly convex QP: the steps agree, the condensed one holds the
     linearised equalities to round-off, and its recovered multipliers close the KKT system
     g + H d + Jᵀy = 0 on the variables whose box is inactive."""
     nlp = segments[name]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=1.0)
     full, red = QPSubproblem(nlp), CondensedQP(nlp)
     for qp in (full, red):
         qp.update(nlp, c, entries, g, h, lo, hi)
@@ -70,7 +57,7 @@ def test_null_space_dimension_and_basis(segments):
     nlp = segments["scoop"]
     qp = CondensedQP(nlp)
     assert qp.r == nlp.n - int(np.sum(nlp.c_lo == nlp.c_hi))
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=1.0)
     qp.update(nlp, c, entries, g, h, lo, hi)
     E = J[np.flatnonzero(nlp.c_lo == nlp.c_hi)]
     T = qp.T.value
@@ -90,7 +77,7 @@ def test_warm_start_cuts_iterations(segments):
     """Re-solving a perturbed subproblem from the previous primal–dual pair takes fewer
     ADMM iterations than from scratch."""
     nlp = segments["scoop"]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=1.0)
     qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     qp.solve(eps=1e-8)
@@ -145,7 +132,7 @@ def test_infeasible_linearisation_is_reported_not_raised():
         nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
         end = nlp.layout.nodes(nlp.x0)[-1]
         q, qd = end[0], end[1]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=0.5)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=0.5)
     qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     sol = qp.solve(eps=1e-6, max_iter=20000)
@@ -157,7 +144,7 @@ def test_singular_basis_is_pivoted_again(segments):
     """If the basic columns' block E_B turns singular (here: one basic column's Jacobian
     entries zeroed), the update re-pivots at the current point instead of producing garbage."""
     nlp = segments["translate"]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=1.0)
     qp = CondensedQP(nlp)
     qp.choose_basis(entries)
     eq = np.flatnonzero(nlp.c_lo == nlp.c_hi)
@@ -199,7 +186,7 @@ def test_condensed_elastic_step_is_the_reference_restoration_step(segments, name
     method; at the scoop's guess the linearised inequality rows cannot all hold, and the
     slacks are in use."""
     nlp = segments[name]
-    c, entries, J, g, h, lo, hi = _linearise(nlp, box=1.0)
+    c, entries, J, g, h, lo, hi = linearise(nlp, box=1.0)
     elastic = CondensedQP(nlp, elastic=True)
     restoration = np.full(nlp.n, 1e-4)
     elastic.update(nlp, c, entries, 0 * g, restoration, lo, hi, 1.0)

@@ -4,7 +4,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
+from conftest import linearise
 
 from flipkit.behaviors.models import Models
 from flipkit.behaviors.options import SegmentOptions
@@ -85,24 +85,12 @@ def translate():
                       options=SegmentOptions(arm_clearance=False))
 
 
-def _linearise(nlp):
-    x = nlp.project(nlp.x0)
-    D = nlp.x_scale
-    c, jac = nlp.evaluate(x)
-    entries = jac * nlp.c_scale[nlp.jac_rows] * D[nlp.jac_cols]
-    J = sp.csr_matrix((entries, (nlp.jac_rows, nlp.jac_cols)), shape=(nlp.m, nlp.n))
-    g = nlp.gradient(x) * nlp.obj_scale * D
-    h = nlp.hessian_diagonal() * nlp.obj_scale * D**2 + 1e-3
-    lo, hi = np.maximum((nlp.x_lb - x) / D, -1.0), np.minimum((nlp.x_ub - x) / D, 1.0)
-    return nlp.c_scale * c, entries, J, g, h, lo, hi
-
-
 def test_condensed_qp_solves_the_model_with_curvature(translate):
     """With M the condensed Hessian is still the identity (Tᵀ H T + T_Nᵀ M T_N = I), the step
     holds the linearised equalities, and the recovered multipliers close the KKT system
     g + H d + [M w]_N + Jᵀy = 0 on the variables whose box is inactive."""
     nlp = translate
-    c, entries, J, g, h, lo, hi = _linearise(nlp)
+    c, entries, J, g, h, lo, hi = linearise(nlp)
     qp = CondensedQP(nlp)
     rng = np.random.default_rng(6)
     A = rng.standard_normal((qp.r, qp.r))
@@ -126,7 +114,7 @@ def test_condensed_qp_solves_the_model_with_curvature(translate):
 
 def test_indefinite_curvature_is_dropped(translate):
     nlp = translate
-    c, entries, J, g, h, lo, hi = _linearise(nlp)
+    c, entries, J, g, h, lo, hi = linearise(nlp)
     qp = CondensedQP(nlp)
     qp.update(nlp, c, entries, g, h, lo, hi)
     qp.update(nlp, c, entries, g, h, lo, hi, curvature=-1e6 * np.eye(qp.r))
