@@ -42,16 +42,20 @@ class ReducedHessian:
     def __init__(self, qp):
         self.qp, self.M, self._basis = qp, None, None
 
-    def curvature(self) -> np.ndarray | None:
-        """M for the next subproblem, or None (no estimate yet, or the basis changed since)."""
+    def _sync(self) -> None:
+        """Forget M when the subproblem's basis is not the one M was estimated in."""
         if self.qp.basis is not self._basis:
             self.M, self._basis = None, self.qp.basis
+
+    def curvature(self) -> np.ndarray | None:
+        """M for the next subproblem, or None (no estimate yet, or the basis changed since)."""
+        self._sync()
         return self.M
 
     def model_term(self, d: np.ndarray) -> float:
         """½ wᵀ M w of a step d (scaled) of the subproblem just solved, w = d_N; 0 when the
         subproblem did not use M."""
-        if self.M is None or not getattr(self.qp, "curved", False):
+        if self.M is None or not self.qp.curved:
             return 0.0
         w = d[self.qp.free]
         return 0.5 * float(w @ self.M @ w)
@@ -64,9 +68,8 @@ class ReducedHessian:
             grad_change: ∇L(Z_{k+1}, λ) − ∇L(Z_k, λ) in scaled units (n,).
             hess: The cost's Hessian diagonal H, scaled (n,), without the proximal weight.
         """
+        self._sync()  # pivoted again in this iteration: start afresh
         Z, free = self.qp.Z, self.qp.free
-        if self.qp.basis is not self._basis:  # pivoted again in this iteration: start afresh
-            self.M, self._basis = None, self.qp.basis
         s, y = s_full[free], Z.T @ grad_change
         base = Z.T @ (hess[:, None] * Z)
         B = base if self.M is None else base + self.M

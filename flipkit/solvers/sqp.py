@@ -371,9 +371,8 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
         # violation is down to restoration.exit × its value at entry (or a step is rejected).
         entry = (entry if entry is not None else v_before) if accepted and not hard else None
         if accepted and with_rows:  # the rows' curvature along the step, at the QP's multipliers
-            lam = sol.multipliers
-            rows.update((trial.x - p.x) / D, hess * (trial.x - p.x) / D
-                        + (trial.J.T @ lam - p.J.T @ lam), hess)
+            lam, moved = sol.multipliers, trial.x - p.x
+            rows.update(moved / D, hess * moved / D + (trial.J.T @ lam - p.J.T @ lam), hess)
         if accepted:
             p = trial
         log.append({"iter": it, "objective": nlp.objective(p.x), "violation": p.v_max,
