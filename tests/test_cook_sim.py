@@ -290,30 +290,81 @@ def test_a_serve_re_planned_on_the_blade_runs_only_if_it_ends_before_the_next_mo
              (None, np.inf, "refused"))
     for new, next_start, why in cases:
         refs, plan, r = blade_replan(scene, 1, NS(), replan_with(new), (0.002, -0.003),
-                                     t_now=3.0, start=0.0, next_start=next_start, dt=0.001,
-                                     references=refs_kw)
+                                     t_now=3.0, t_stop=3.0, start=0.0, next_start=next_start,
+                                     dt=0.001, references=refs_kw)
         assert refs is None and plan is None and not r["replanned"] and why in r["why"]
         assert np.allclose(seen[-1], true + (0.002, -0.003), atol=1e-9)
         assert r["on_blade_true"] == pytest.approx(true, abs=1e-5) and r["pause_s"] == 0.0
     # a burger the scoop left behind is not re-planned for: no call, and the record says so
     calls = len(seen)
     refs, plan, r = blade_replan(scene, 1, NS(), replan_with(None), (0.3, 0.0), t_now=3.0,
-                                 start=0.0, next_start=np.inf, dt=0.001, references=refs_kw)
+                                 t_stop=3.0, start=0.0, next_start=np.inf, dt=0.001,
+                                 references=refs_kw)
     assert refs is None and len(seen) == calls and "not on the blade" in r["why"]
+
+
+def test_the_blade_re_plan_runs_while_the_carry_finishes(monkeypatch):
+    """Sensed before the carry's end, the re-plan runs meanwhile: the arm holds at the carry's
+    end only for its wall time beyond the lead (whole control steps), and that hold counts
+    when the serve's end is checked against the next motion."""
+    import time as clock
+    from types import SimpleNamespace as NS
+
+    from flipkit.errors import FlipkitError
+    from flipkit.simulation import cook_blade
+
+    scene = build_scene(burgers=2)
+    scene.data.qpos[:6] = CELL.robot.q_home
+    mujoco.mj_forward(scene.model, scene.data)
+    p_b, _ = scene.blade_pose()
+    place_burger(scene, p_b[:2] + (0.03, 0.01), burger=1, height=p_b[2])
+    made = []  # plan_references' arguments after the plan: ..., hold, t_pause, pause
+    monkeypatch.setattr(cook_blade, "plan_references", lambda plan, *a: made.append(a) or "refs")
+
+    def slow(plan, xy):
+        clock.sleep(0.03)
+        return NS(status="solved", duration=6.0, failure=None)
+
+    kw = dict(start=0.0, dt=0.001, references={"robot": scene.robot, "physics": CELL.physics,
+                                              "mode": "position", "command": "compensated",
+                                              "hold_max": 1.0})
+    refs, plan, r = cook_blade.blade_replan(scene, 1, NS(), slow, (0.0, 0.0), t_now=2.5,
+                                            t_stop=3.0, next_start=6.0, **kw)
+    assert refs == "refs" and r["replanned"] and r["wall_s"] >= 0.03 and r["lead_s"] == 0.5
+    assert r["pause_s"] == 0.0 and made[-1][-2:] == (3.0, 0.0)  # no hold: 6.0 s, as scheduled
+    refs, plan, r = cook_blade.blade_replan(scene, 1, NS(), slow, (0.0, 0.0), t_now=3.0,
+                                            t_stop=3.0, next_start=np.inf, **kw)
+    t_pause, pause = made[-1][-2:]
+    assert refs == "refs" and t_pause == 3.0 and r["pause_s"] == pytest.approx(pause, abs=1e-9)
+    assert pause >= r["wall_s"] - 5e-4 and pause == pytest.approx(round(pause / 0.001) * 0.001)
+    refs, plan, r = cook_blade.blade_replan(scene, 1, NS(), slow, (0.0, 0.0), t_now=3.0,
+                                            t_stop=3.0, next_start=6.0, **kw)
+    assert refs is None and plan is None and "into the next motion" in r["why"]
+    with pytest.raises(FlipkitError, match="precedes the sense"):
+        cook_blade.blade_replan(scene, 1, NS(), slow, (0.0, 0.0), t_now=3.1, t_stop=3.0,
+                                next_start=np.inf, **kw)
 
 
 @pytest.mark.slow
 def test_serves_re_planned_on_the_blade(timeline):
     """The two-burger cook with sense-plan-act on the grill and on the blade: each serve is
-    re-planned at the end of its carry (its drops leave time for the pause), the arm pauses
-    for the re-plan, and both burgers end upright on the table near their spots."""
+    re-planned during its carry, SENSE_LEAD_S before its end, the arm holds at the carry's
+    end only for the re-plan's wall time beyond that, the burger stays where the camera saw
+    it over the lead (within the camera's error), and both burgers end upright on the table
+    near their spots."""
     from flipkit.planning.kitchen.motions import blade_replanner, serve_replanner
+    from flipkit.simulation.cook import SENSING_SIGMA
+    from flipkit.simulation.cook_blade import SENSE_LEAD_S
 
     sim = simulate_cook(timeline, sense_serve=serve_replanner(CELL),
                         sense_blade=blade_replanner())
     assert [r["serve"] for r in sim.sensed_blade] == ["b1", "b2"]
     for r in sim.sensed_blade:
         assert r["replanned"], r["why"]
-        assert r["pause_s"] >= r["wall_s"] - 1e-9 and 0.0 < r["on_blade_true"][0] < 0.08
+        assert r["lead_s"] == pytest.approx(SENSE_LEAD_S, abs=2e-3)
+        assert r["pause_s"] == pytest.approx(max(r["wall_s"] - r["lead_s"], 0.0), abs=2e-3)
+        assert 0.0 < r["on_blade_true"][0] < 0.08
+        shift = np.subtract(r["on_blade_at_stop"], r["on_blade_true"])
+        assert np.hypot(*shift) < SENSING_SIGMA
     for b in sim.burgers:
         assert b.flipped and b.serve.upright and b.serve.on_table and b.serve.distance < 0.05

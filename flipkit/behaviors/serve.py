@@ -45,7 +45,7 @@ table's: a steel tray like the grill, ``physics.mu_grill``). (Without this term 
 scoop had left at the blade centre came to rest 3.8 cm beyond its spot in MuJoCo; with
 it, 1.4 cm of that is predicted.)
 The planner puts the blade so that this point is the spot; ``on_blade`` is where the burger
-sits on the blade (default the centre; sensed at the end of the carry, :func:`flipkit.planning.planners.serve.replan_serve`).
+sits on the blade (default the centre; sensed during the carry, :func:`flipkit.planning.planners.serve.replan_serve`).
 """
 
 from __future__ import annotations

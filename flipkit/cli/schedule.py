@@ -115,9 +115,10 @@ def register(subparsers) -> None:
                    help="with --simulate: sense-plan-act serves: each serve is re-planned for "
                         "where a camera (error 5 mm per axis, seeded by --seed) sees its "
                         "burger on the grill, and the re-plan runs if verified and no longer "
-                        "than the scheduled serve; at the end of the carry, place and return "
-                        "home are re-planned for where it sees the burger on the blade, if "
-                        "the serve still ends before the next motion")
+                        "than the scheduled serve; 0.5 s before the carry ends, place and "
+                        "return home are re-planned, while the carry runs on, for where it "
+                        "sees the burger on the blade, if the serve still ends before the "
+                        "next motion")
     p.add_argument("--film", metavar="FILE",
                    help="with --simulate: a film of the motions (.gif, or .mp4 with "
                         "imageio-ffmpeg), 320x240 at 15 fps, idle intervals cut")

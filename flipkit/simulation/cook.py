@@ -32,7 +32,9 @@ With ``sense_serve`` a serve is sense-plan-act: at its start the camera sees whe
 lies on the grill (the true place plus the camera's error, :data:`SENSING_SIGMA` per axis,
 seeded) and the serve is re-planned for that place; the new plan runs if it is verified and
 no longer than the planned one (the schedule is kept), else the planned one does. Planning
-happens while the burger cooks its second side, so it takes no cook time.
+happens while the burger cooks its second side, so it takes no cook time. With
+``sense_blade`` the camera also sees the burger on the blade during the carry, and place and
+return home are re-planned while the carry finishes (:mod:`flipkit.simulation.cook_blade`).
 
 The burgers are judged one by one on their own trajectories
 (:mod:`flipkit.simulation.cook_judges`); a burger moved while it lay untouched by its own
@@ -56,7 +58,7 @@ from flipkit.simulation.cook_judges import BurgerResult, judge_burger
 from flipkit.simulation.cook_record import CookRecorder, Watch
 from flipkit.simulation.execute import HOLD_S
 from flipkit.simulation.modes import MODES, POSITION
-from flipkit.simulation.cook_blade import blade_replan
+from flipkit.simulation.cook_blade import SENSE_LEAD_S, blade_replan
 from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger, place_burger
 
@@ -164,9 +166,10 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             re-planned for its burger seen at ``xy`` (m) on the grill (module docstring;
             :class:`~flipkit.errors.FlipkitError` for a place it refuses);
             ``None`` (default): every serve runs open loop as planned.
-        sense_blade: ``sense_blade(plan, on_blade) -> plan``: at the end of each serve's
-            carry, place and return home re-planned for where the camera sees the burger on
-            the blade (:func:`~flipkit.planning.planners.serve.replan_serve`;
+        sense_blade: ``sense_blade(plan, on_blade) -> plan``: during each serve's carry,
+            :data:`~flipkit.simulation.cook_blade.SENSE_LEAD_S` before it ends, place and
+            return home re-planned for where the camera sees the burger on the blade
+            (:func:`~flipkit.planning.planners.serve.replan_serve`;
             :mod:`flipkit.simulation.cook_blade`); ``None`` (default): none.
         sensing_sigma: The camera's error (m, per axis). seed: Seed of its draws.
 
@@ -232,21 +235,34 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
         d.time = mo.start
         # the serve's end (s into it) and references as they are now: a re-plan on the blade
         # moves the one and replaces the other
-        now_run = {"end": plan.duration, "refs": refs, "sensed": mo.kind != "serve"
-                   or sense_blade is None}
+        now_run = {"end": plan.duration, "refs": refs, "sensed": None, "stop": np.inf,
+                   "done": mo.kind != "serve" or sense_blade is None}
 
         def hook(k, refs, mo=mo, i=i, nxt=nxt, run=now_run):
             apply_events(mo.start + refs.t[k])
-            if run["sensed"] or refs.t[k] < refs.bounds["carry"][1] - 1e-9:
+            if run["sensed"] is not None:  # where the sensed burger lies when the carry stops
+                if refs.t[k] >= run["stop"] - 1e-9:
+                    run["sensed"]["on_blade_at_stop"] = [round(float(v), 5) for v in
+                                                         scene.in_blade_frame(
+                                                             scene.burger_bodies[index[mo.burger]])[:2]]
+                    run["sensed"] = None
                 return None
-            run["sensed"] = True
+            if run["done"]:
+                return None
+            carry = refs.bounds["carry"]
+            if refs.t[k] < max(carry[0], carry[1] - SENSE_LEAD_S) - 1e-9:
+                return None
+            run["done"] = True
             new_refs, new, note = blade_replan(
                 scene, index[mo.burger], plans[i], sense_blade,
                 rng_blade.normal(0.0, sensing_sigma, 2),
-                t_now=refs.t[k], start=mo.start, next_start=nxt, dt=dt,
+                t_now=refs.t[k], t_stop=max(carry[1], refs.t[k]), start=mo.start,
+                next_start=nxt, dt=dt,
                 references={"robot": robot, "physics": cell.physics, "mode": mode,
                             "command": command, "hold_max": MAX_SETTLE_S})
-            sensed_blade.append({"serve": mo.burger, **note})
+            note = {"serve": mo.burger, **note}
+            sensed_blade.append(note)
+            run["sensed"], run["stop"] = note, max(carry[1], refs.t[k])
             if new_refs is None:
                 return None
             plans[i], refs_of[i], run["refs"] = new, new_refs, new_refs
@@ -283,8 +299,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
 def sensed_serve(mo, scene: Scene, k: int, sense_serve, error, sensed: list):
     """The serve plan to run for motion ``mo``: re-planned for burger ``k`` where the camera
     sees it (true place + ``error``), if verified and no longer than the serve's slot in the
-    schedule (its plan's duration, and any time the schedule gave it beyond, such as
-    :data:`~flipkit.planning.kitchen.motions.SENSE_PAUSE_S`)."""
+    schedule (its start to its end)."""
     true_xy = np.array(scene.data.qpos[scene.qpos_of(k)][:2], float)
     xy = true_xy + np.asarray(error, float)
     t0 = time.perf_counter()

@@ -1,13 +1,21 @@
-"""Sense, plan, act on the blade during a cook's serve: at the end of the carry the camera sees
-where the burger lies on the blade, and place and return home are planned again for it.
+"""Sense, plan, act on the blade during a cook's serve: :data:`SENSE_LEAD_S` before the carry
+ends the camera sees where the burger lies on the blade, and place and return home are
+planned again for it while the carry runs on.
 
-The carry ends at rest with the blade flat above the table (as
-:func:`~flipkit.planning.planners.serve.replan_serve` expects), so the cell measures the
-burger there, holds the arm at rest while the re-plan runs (the pause is whole control steps
-of its measured wall time), then runs the re-planned rest of the serve. A cook cannot stretch
-a serve into the next motion: the re-plan is used only if it is solved and the serve, paused
-and re-planned, still ends before the next motion starts; otherwise the scheduled serve runs
-on and the record says why.
+The re-plan starts where the planned carry ends (at rest, the blade flat above the table, as
+:func:`~flipkit.planning.planners.serve.replan_serve` expects), so it can run while the arm
+is still carrying: the cell never waits for it unless it takes longer than the lead, and then
+only for the rest, held at the carry's end in whole control steps. A cook cannot stretch a
+serve into the next motion: the re-plan is used only if it is solved and the serve, paused
+(if at all) and re-planned, still ends before the next motion starts; otherwise the scheduled
+serve runs on and the record says why.
+
+Why a lead of 0.5 s: the blade re-plans took 0.17–0.30 s on the idle 2-core machine (the
+two-burger cook of the tests and the `kitchen` figure's five), so 0.5 s leaves the loaded
+machine of a busy cell some room. What the camera sees then is not quite where the burger
+rests when the carry stops: the record gives both (``on_blade_true`` at the sense,
+``on_blade_at_stop`` at the carry's end), so the shift over the lead is measured in every
+simulated cook.
 """
 
 from __future__ import annotations
@@ -20,10 +28,13 @@ from flipkit.errors import FlipkitError
 from flipkit.simulation.control import pause_steps, plan_references
 from flipkit.simulation.scene import Scene
 
+SENSE_LEAD_S = 0.5  # s before the carry's end that the camera sees the burger (docstring)
+
 
 def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float,
-                 start: float, next_start: float, dt: float, references: dict) -> tuple:
-    """At cook time ``start + t_now`` (the carry's end): the re-planned serve's references, or
+                 t_stop: float, start: float, next_start: float, dt: float,
+                 references: dict) -> tuple:
+    """At cook time ``start + t_now`` (during the carry): the re-planned serve's references, or
     ``None``, and the record of the sense.
 
     Args:
@@ -31,22 +42,27 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
         replan: ``replan(plan, on_blade) -> Plan`` (e.g. ``replan_serve``); a
             :class:`~flipkit.errors.FlipkitError` is a refusal.
         error: The camera's error (m, (2,)) added to the true place on the blade.
-        t_now: Time (s) into the serve. start, next_start: The serve's and the next
-            motion's start (s, cook clock; ``inf`` for none). dt: Control period (s).
+        t_now: Time (s) into the serve of the sense. t_stop: Time (s) into the serve at
+            which the carry ends, ``t_stop >= t_now``: the re-plan runs meanwhile, and the
+            arm holds there for the part of its wall time beyond ``t_stop - t_now``.
+            start, next_start: The serve's and the next motion's start (s, cook clock;
+            ``inf`` for none). dt: Control period (s).
         references: ``plan_references``'s other arguments: ``robot``, ``physics``, ``mode``,
             ``command``, ``hold_max`` (the longest hold after the serve, s).
 
     Returns:
         ``(refs or None, new plan or None, record)``; ``record`` holds ``burger`` (index),
-        ``on_blade_true``, ``on_blade_sensed`` (m), ``replanned``, ``why``, ``wall_s`` and
-        ``pause_s``.
+        ``on_blade_true``, ``on_blade_sensed`` (m), ``replanned``, ``why``, ``wall_s``,
+        ``lead_s`` (``t_stop - t_now``) and ``pause_s`` (the hold at the carry's end).
     """
+    if not t_stop >= t_now:
+        raise FlipkitError(f"the carry's end ({t_stop} s) precedes the sense ({t_now} s)")
     true = scene.in_blade_frame(scene.burger_bodies[burger])[:2]
     sensed = true + np.asarray(error, float)
     sp = scene.robot.cell.spatula
     t0 = time.perf_counter()
     if np.any(np.abs(sensed) > (sp.length / 2, sp.width / 2)):  # the scoop missed it
-        new, why = None, (f"the burger is not on the blade after the carry: seen at "
+        new, why = None, (f"the burger is not on the blade during the carry: seen at "
                           f"({sensed[0]:+.3f}, {sensed[1]:+.3f}) m in the blade frame")
     else:
         try:
@@ -56,7 +72,8 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
         except FlipkitError as exc:
             new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0
-    pause = pause_steps(wall, dt)
+    lag = wall - (t_stop - t_now)  # the re-plan's wall beyond the rest of the carry
+    pause = pause_steps(lag, dt) if lag > 0 else 0.0
     refs = None
     if why is None:
         end = start + pause + new.duration
@@ -66,12 +83,13 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
             r = references
             hold = min(max(next_start - end, 0.0), r["hold_max"])
             refs = plan_references(new, r["robot"], r["physics"], r["mode"], r["command"], dt,
-                                   hold, t_now, pause)
+                                   hold, t_stop, pause)
     record = {"burger": int(burger), "on_blade_true": [round(float(v), 5) for v in true],
               "on_blade_sensed": [round(float(v), 5) for v in sensed],
               "replanned": why is None, "why": why, "wall_s": round(wall, 3),
+              "lead_s": round(float(t_stop - t_now), 3),
               "pause_s": round(float(pause), 3) if why is None else 0.0}
     return refs, (new if why is None else None), record
 
 
-__all__ = ["blade_replan"]
+__all__ = ["SENSE_LEAD_S", "blade_replan"]

@@ -72,8 +72,6 @@ def run(args: argparse.Namespace) -> int:
         order = check_cook(burgers, cell)
         spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
         planners = _planners(order, kinds, cell, args, atlas, spots, executor)
-        if getattr(args, "simulate", False) and args.sense:  # time for the blade re-plans
-            planners = motions.with_sense_pause(planners)
         if executor is None:
             planners = motions.cached_planners(planners)
         common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
@@ -168,6 +166,12 @@ def _report_simulation(sim, args: argparse.Namespace) -> int:
               f"{r['planned_xy'][1]:.3f}); " + (f"re-planned in {r['wall_s']:.2f} s"
                                                 if r["replanned"] else
                                                 f"scheduled serve ran: {r['why']}"))
+    for r in sim.sensed_blade:
+        seen = r["on_blade_sensed"]
+        print(f"sensed serve {r['serve']} on the blade {r['lead_s']:.2f} s before the carry's "
+              f"end: seen at ({seen[0]:+.3f}, {seen[1]:+.3f}) m; "
+              + (f"re-planned in {r['wall_s']:.2f} s, the arm held {r['pause_s']:.2f} s"
+                 if r["replanned"] else f"scheduled serve ran: {r['why']}"))
     film = ""
     if args.film:
         replace_with(args.film, lambda tmp: write_cook_film(sim, tmp,

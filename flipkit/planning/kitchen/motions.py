@@ -216,33 +216,12 @@ def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=
 def blade_replanner(solver: str = "auto") -> Callable:
     """Sense, plan, act on the blade for a cook's serves: ``replan(plan, on_blade) -> Plan``
     plans place and return home of the serve ``plan`` again for its burger seen at
-    ``on_blade`` (x, y) (m, blade frame) at the end of the carry
-    (:func:`~flipkit.planning.planners.serve.replan_serve`)."""
+    ``on_blade`` (x, y) (m, blade frame) during the carry
+    (:func:`~flipkit.planning.planners.serve.replan_serve`; :mod:`flipkit.simulation.cook_blade`)."""
     def replan(plan, on_blade):
         return replan_serve(plan, on_blade, solver=solver)
 
     return replan
-
-
-# A serve the cook senses on the blade (simulate_cook(sense_blade=)) holds the arm while place
-# and return home are re-planned: 0.2-0.3 s measured (2026-11-27, the two-burger cook of the
-# tests). The schedule gives each such serve this much time beyond its plan.
-SENSE_PAUSE_S = 0.5
-
-
-def with_sense_pause(planners: Mapping[str, MotionPlanner], pause_s: float = SENSE_PAUSE_S
-                     ) -> dict[str, MotionPlanner]:
-    """``planners`` whose serves take ``pause_s`` (s) longer than their plans: the schedule
-    then leaves each serve the time to be re-planned on the blade before the next motion
-    (:mod:`flipkit.simulation.cook_blade`). Flips are unchanged."""
-    if not (np.isfinite(pause_s) and pause_s >= 0):
-        raise FlipkitError(f"the sense pause must be >= 0 s, got {pause_s!r}")
-
-    def serve(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
-        pm = planners["serve"](job, q_start)
-        return replace(pm, duration_s=pm.duration_s + pause_s) if pm.ok else pm
-
-    return {kind: serve if kind == "serve" else planners[kind] for kind in planners}
 
 
 def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPlanner]:
@@ -262,6 +241,6 @@ def cached_planners(planners: Mapping[str, MotionPlanner]) -> dict[str, MotionPl
     return {kind: maker(kind) for kind in planners}
 
 
-__all__ = ["KINDS", "SENSE_PAUSE_S", "MissingPlannerError", "MotionJob", "MotionPlanner",
+__all__ = ["KINDS", "MissingPlannerError", "MotionJob", "MotionPlanner",
            "PlannedMotion", "blade_replanner", "cached_planners", "default_planners",
-           "flip_planner", "from_plan", "refused", "serve_planner", "with_sense_pause"]
+           "flip_planner", "from_plan", "refused", "serve_planner"]

@@ -94,10 +94,11 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
                  options: SegmentOptions = SegmentOptions()) -> Plan:
     """Re-plan place and return home of a solved serve plan for a burger measured at
-    ``on_blade`` on the blade at the end of the carry (sense, plan, act; as
-    :func:`~flipkit.planning.planners.planner.replan_flip`): the carry ends at rest with the blade flat
-    above the table, so the cell can measure where the burger lies on it and wait there while
-    this runs. Go to burger, scoop, pickup and carry are kept; the place is moved so that the
+    ``on_blade`` on the blade during the carry (sense, plan, act; as
+    :func:`~flipkit.planning.planners.planner.replan_flip`): the re-plan starts where the
+    planned carry ends, at rest with the blade flat above the table, so it can run while the
+    carry finishes (a cook's serves, :mod:`flipkit.simulation.cook_blade`) or while the arm
+    waits there (``flipkit validate``'s serve trials). Go to burger, scoop, pickup and carry are kept; the place is moved so that the
     burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a
     burger that shifted on the blade during the pickup and carry was placed 5.5 cm off in
     MuJoCo.)
