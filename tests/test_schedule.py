@@ -328,9 +328,13 @@ def test_cli_writes_the_timeline_and_exits_1_on_a_failed_plan(tmp_path, capsys, 
     code = cli.main(["schedule", str(path), "--json", str(out), "--figure", str(fig),
                      "--no-progress", "--workers", "1",  # the stubbed planners, in-process
                      "--policy", "greedy"])  # they end away from rest: the greedy rule
-    err = capsys.readouterr().err.strip().splitlines()
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
     assert code == 1 and err == ["flipkit: error: burger b2: flip: pickup: cone violated by 1 "
                                  "(test)"]
+    # nothing about the windows or the other burgers is claimed for a failed schedule
+    summary = captured.out.strip().splitlines()[-1]
+    assert "failed" in summary and "met" not in summary and "not checked" in summary
     doc = json.loads(out.read_text())
     assert doc["status"] == "failed" and [m["kind"] for m in doc["motions"]] == [
         "flip", "flip", "flip", "serve", "serve"]
