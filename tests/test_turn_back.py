@@ -98,3 +98,77 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     tau = SUBBEHAVIORS["turn_back"].duration[1] / (len(flip.t) - 1)
     d = shapes.nearest(flip.q[-1] + tau * flip.qd[-1], pairs, CAP)[0]
     assert d >= 0.02 - 1e-6
+
+
+GRILL_CORNER = (0.875, -0.495, 0.072)  # a cook's flip here left no turn back (before the fix)
+
+
+def test_coasting_floor_rows_are_the_corner_heights_ahead_with_their_jacobian(models):
+    """Four rows, the blade's corner heights at q_N + τ q̇_N (computed here from the spatula's
+    placement), with a Jacobian on q_N and q̇_N that matches central differences."""
+    from flipkit.transcription.constraints.coasting_floor import CoastingFloor
+    from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+
+    L, robot, cell = Layout(6, 20), models.bare, models.cell
+    rng = np.random.default_rng(5)
+    q = np.tile(robot.q_home, (L.n_nodes, 1)) + rng.normal(scale=0.2, size=(L.n_nodes, 6))
+    qd = rng.normal(scale=1.0, size=q.shape)
+    x = L.pack(q, qd, np.zeros_like(q), np.zeros_like(q), rng.normal(size=(6, 7)), 0.6)
+    tau, l, w = 0.042, cell.spatula.length, cell.spatula.width
+    block = CoastingFloor(L, L.N, tau, 0.089, l, w)
+    vals, jac = block.evaluate(Evaluation(L, robot, x))
+    M = robot.placement(q[-1] + tau * qd[-1])
+    expect = [(M.translation + M.rotation @ np.array([a * l / 2, b * w / 2, 0.0]))[2]
+              for a, b in BLADE_CORNERS]
+    np.testing.assert_allclose(vals, expect, atol=1e-12)
+    J = np.zeros((4, L.n))
+    J[block.rows, block.cols] = jac
+    fd = central_fd(lambda z: block.evaluate(Evaluation(L, robot, z))[0], x, h=1e-6)
+    np.testing.assert_allclose(J, fd, atol=1e-6, rtol=1e-6)
+    assert np.all(block.lo == 0.089) and np.all(np.isinf(block.hi))
+    with pytest.raises(ConfigError, match="coasting time"):
+        CoastingFloor(L, L.N, 0.0, 0.089, l, w)
+    with pytest.raises(ConfigError, match="coasting floor"):
+        CoastingFloor(L, L.N, tau, np.nan, l, w)
+
+
+def test_the_flip_ends_where_the_turn_back_floor_is_reachable(models):
+    """The flip's last node carries the turn back's floor at its first node, coasting for the
+    turn back's first interval at its longest; the turn back itself has no such rows."""
+    from flipkit.behaviors import targets as tg
+    from flipkit.behaviors.flip import above_burger
+    from flipkit.model.ik import solve_pose
+
+    pose = tg.pickup_end(models.cell, np.asarray(FAR_GRILL))
+    q = solve_pose(models.loaded, pose.p, pose.o, models.bare.q_home)
+    flip = transcribe("flip", models, q, location=FAR_GRILL)
+    rows = [b for b in flip.blocks if b.name == "coasting_floor"]
+    assert len(rows) == 1 and rows[0].node == flip.layout.N
+    assert rows[0].tau == pytest.approx(
+        T_STRETCH * SUBBEHAVIORS["turn_back"].duration[1] / flip.layout.N)
+    assert np.all(rows[0].lo == above_burger(models.cell, flip.layout.N)[1])
+    back = transcribe("turn_back", models, q, location=FAR_GRILL)
+    assert not [b for b in back.blocks if b.name == "coasting_floor"]
+
+
+def test_a_cook_flip_at_the_grill_corner_turns_back():
+    """At the grill area's corner, coming in above other burgers as a cook's flips do, the
+    whole chain solves with the SQP alone, and the flip ends with its coasting corners above
+    the turn back's floor."""
+    from flipkit.behaviors.flip import above_burger
+    from flipkit.config import CellConfig
+    from flipkit.planning.kitchen.sweep import approach_height
+    from flipkit.planning.planners.planner import plan_flip
+    from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+
+    cell = CellConfig()
+    plan = plan_flip(GRILL_CORNER, solver="sqp", approach_height=approach_height(cell))
+    assert plan.status == "solved", plan.failure
+    assert plan.report.ok and [s.solver.name for s in plan.segments] == ["sqp"] * 5
+    flip = plan.segments[[s.name for s in plan.segments].index("flip")]
+    tau = T_STRETCH * SUBBEHAVIORS["turn_back"].duration[1] / (len(flip.t) - 1)
+    M = plan.robot_for(flip).placement(flip.q[-1] + tau * flip.qd[-1])
+    l, w = cell.spatula.length, cell.spatula.width
+    lowest = min((M.translation + M.rotation @ np.array([a * l / 2, b * w / 2, 0.0]))[2]
+                 for a, b in BLADE_CORNERS)
+    assert lowest >= above_burger(cell, 1)[0] - 1e-6

@@ -27,6 +27,7 @@ from flipkit.transcription.constraints import (BezierOutput, Dynamics, FixedValu
                                                HermiteSimpson, KinematicBlock)
 from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.clearance import ArmClearance, CoastingClearance
+from flipkit.transcription.constraints.coasting_floor import CoastingFloor
 from flipkit.transcription.constraints.interpolant import InterpolantLimits
 from flipkit.transcription.constraints.kinematic import Cone
 from flipkit.transcription.layout import Layout
@@ -137,6 +138,12 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
             coast = T_STRETCH * subbehavior(spec.coast_into).duration[1] / L.N
             blocks.append(CoastingClearance(L, models.shapes, L.N, coast,
                                             spec.exempt(L.N, L.N), cell.space.margin))
+    if spec.coast_into is not None:  # the next segment's blade floor at its first node, coasting
+        following = subbehavior(spec.coast_into)
+        coast = T_STRETCH * following.duration[1] / L.N
+        blocks.append(CoastingFloor(L, L.N, coast,
+                                    float(blade_floor(following, cell, L.N, ctx.task)[1]),
+                                    cell.spatula.length, cell.spatula.width))
     # Orientation limits (Constraint 1, eq. 4): the pitch; roll and yaw are free.
     blocks.append(KinematicBlock("task_orientation", L, "pitch", moving, *lim.pitch_range))
     return blocks
