@@ -242,9 +242,9 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             apply_events(mo.start + refs.t[k])
             if run["sensed"] is not None:  # where the sensed burger lies when the carry stops
                 if refs.t[k] >= run["stop"] - 1e-9:
-                    run["sensed"]["on_blade_at_stop"] = [round(float(v), 5) for v in
-                                                         scene.in_blade_frame(
-                                                             scene.burger_bodies[index[mo.burger]])[:2]]
+                    body = scene.burger_bodies[index[mo.burger]]
+                    run["sensed"]["on_blade_at_stop"] = [
+                        round(float(v), 5) for v in scene.in_blade_frame(body)[:2]]
                     run["sensed"] = None
                 return None
             if run["done"]:
