@@ -128,19 +128,19 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
         KinematicBlock("grill_clearance", L, "blade_heights", moving,
                        blade_floor(spec, cell, L.N, ctx.task)[1:, None], np.inf, ctx=blade),
     ]
+    following = None if spec.coast_into is None else subbehavior(spec.coast_into)
+    # a segment that ends moving: the next one's first node interval at its longest (its
+    # bound stretched) is how long the arm coasts into it
+    coast = None if following is None else T_STRETCH * following.duration[1] / L.N
     if o.arm_clearance:
         margins = np.full(L.N, cell.space.margin)  # nodes 1..N
         margins[-1] += spec.end_allowance
         blocks.append(ArmClearance(L, models.shapes, moving, lambda i: spec.exempt(i, L.N),
                                    margins))
-        if spec.coast_into is not None:
-            # the next segment's first node interval at its longest (its bound stretched)
-            coast = T_STRETCH * subbehavior(spec.coast_into).duration[1] / L.N
+        if coast is not None:
             blocks.append(CoastingClearance(L, models.shapes, L.N, coast,
                                             spec.exempt(L.N, L.N), cell.space.margin))
-    if spec.coast_into is not None:  # the next segment's blade floor at its first node, coasting
-        following = subbehavior(spec.coast_into)
-        coast = T_STRETCH * following.duration[1] / L.N
+    if coast is not None:  # the next segment's blade floor at its first node, coasting
         blocks.append(CoastingFloor(L, L.N, coast,
                                     float(blade_floor(following, cell, L.N, ctx.task)[1]),
                                     cell.spatula.length, cell.spatula.width))

@@ -252,17 +252,16 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             carry = refs.bounds["carry"]
             if refs.t[k] < max(carry[0], carry[1] - SENSE_LEAD_S) - 1e-9:
                 return None
-            run["done"] = True
+            run["done"], run["stop"] = True, max(carry[1], refs.t[k])
             new_refs, new, note = blade_replan(
                 scene, index[mo.burger], plans[i], sense_blade,
                 rng_blade.normal(0.0, sensing_sigma, 2),
-                t_now=refs.t[k], t_stop=max(carry[1], refs.t[k]), start=mo.start,
-                next_start=nxt, dt=dt,
+                t_now=refs.t[k], t_stop=run["stop"], start=mo.start, next_start=nxt, dt=dt,
                 references={"robot": robot, "physics": cell.physics, "mode": mode,
                             "command": command, "hold_max": MAX_SETTLE_S})
             note = {"serve": mo.burger, **note}
             sensed_blade.append(note)
-            run["sensed"], run["stop"] = note, max(carry[1], refs.t[k])
+            run["sensed"] = note
             if new_refs is None:
                 return None
             plans[i], refs_of[i], run["refs"] = new, new_refs, new_refs
