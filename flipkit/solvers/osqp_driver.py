@@ -25,7 +25,9 @@ Compact mode (``compact=True``, used by the condensed subproblem of
 :mod:`flipkit.solvers.condensed_qp`): OSQP is set up afresh on the working rows alone each round,
 warm-started from the previous primal–dual pair. With 19–31 variables the setup is a
 fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~1 500
-(measured: a condensed solve 12 ms → 5 ms).
+(measured: a condensed solve 12 ms → 5 ms). A compact solve's solution reaches the cvxpy
+variables and duals through a :class:`~flipkit.solvers.solution_map.SolutionMap` (cvxpy's
+unpacking found once), not through ``unpack_results`` at each solve.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ import scipy.sparse as sp
 
 from flipkit.errors import SolverError
 from flipkit.solvers.param_map import ParameterMap, osqp_form
+from flipkit.solvers.solution_map import SOLVED, SolutionMap
 from flipkit.solvers.stdout_redirect import c_stdout_silenced
 import osqp
 
@@ -80,7 +83,7 @@ class OSQPDriver:
 
     def __init__(self, problem: cp.Problem, compact: bool = False):
         self.problem, self.compact = problem, compact
-        self._map = None
+        self._map, self._solution_map, self.status = None, None, None
         if all(prm.sparse_idx is None for prm in problem.parameters()):
             # cvxpy's parameter map applied directly (fixed patterns, no round trip)
             self._map = ParameterMap(problem, self._cvxpy_data()[0])
@@ -195,13 +198,18 @@ class OSQPDriver:
     def solve(self, settings: dict):
         """Solve for the current parameter values; returns (OSQP result, total ADMM iterations).
 
-        The cvxpy variables and constraint duals are set as by ``problem.solve``; with a
+        The cvxpy variables and constraint duals are set as by ``problem.solve``, and
+        :attr:`status` to cvxpy's name of the status (``None`` when OSQP failed). With a
         parameter map, ``problem.value`` carries the objective's constant term of the first
-        compile, not the current one (the SQP reads the variables and duals only).
+        compile, not the current one; in compact mode a solution is stored by a
+        :class:`~flipkit.solvers.solution_map.SolutionMap`, which leaves ``problem.value``
+        and ``problem.status`` alone (the SQP reads the variables, the duals and
+        :attr:`status` only).
         """
         P, A, q, l, u, chain, inverse = self._data()
         if self.compact:  # OSQP takes 32-bit indices
-            P, A = (sp.csc_matrix((M.data, M.indices.astype(np.int32), M.indptr.astype(np.int32)),
+            P, A = (sp.csc_matrix((M.data, M.indices.astype(np.int32, copy=False),
+                                   M.indptr.astype(np.int32, copy=False)),
                                   shape=M.shape) for M in (P, A))
         elif self._map is None:  # `update` needs the setup's sparsity pattern
             P, A = self._on_pattern(0, P), self._on_pattern(1, A)
@@ -241,10 +249,17 @@ class OSQPDriver:
             margin = np.minimum(z - l, u - z)
             self._active = _capped(ineq & ((np.abs(res.y) > 0) | (margin <= tol)),
                                    -np.abs(res.y), margin, cap)
-        if res.info.status_val in (1, 2, 3, 4):  # cvxpy raises on the other statuses
+        self.status = None
+        if self.compact and res.info.status_val in SOLVED:  # cvxpy's unpacking, precomputed
+            if self._solution_map is None:
+                self._solution_map = SolutionMap(self.problem, chain, inverse, A.shape[1],
+                                                 A.shape[0])
+            self.status = self._solution_map.apply(res)
+        elif res.info.status_val in (1, 2, 3, 4):  # cvxpy raises on the other statuses
             with warnings.catch_warnings():  # an inaccurate solve is reported by its status
                 warnings.simplefilter("ignore", UserWarning)
                 self.problem.unpack_results(res, chain, inverse)
+            self.status = str(self.problem.status)
         else:
             self.reset()  # next solve starts afresh
         return res, total
@@ -274,5 +289,5 @@ def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_ite
     except cp.error.SolverError as exc:  # OSQP broke down (cvxpy's error): ours, one line
         raise SolverError(f"OSQP failed inside a subproblem: {' '.join(str(exc).split())}") from None
     ok = res.info.status_val in (1, 2, 3, 4)
-    status = str(problem.status) if ok else f"osqp:{res.info.status}"
+    status = driver.status if ok else f"osqp:{res.info.status}"
     return res, iterations, status, res.info.status_val in (1, 2)

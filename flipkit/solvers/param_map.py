@@ -116,11 +116,11 @@ class ParameterMap:
     def data(self):
         """(P upper triangle, A, q, l, u) at the current values; P and A on their fixed
         patterns (explicit zeros kept), as ``osqp.update`` needs."""
-        p = self.vector()
-        P = self.P_pattern.copy()
-        P.data = self.P_map @ p
-        A = self.A_pattern.copy()
-        A.data = self.A_map @ p
+        p = self.vector()  # the patterns' index arrays are shared, not copied: read-only
+        P = sp.csc_matrix((self.P_map @ p, self.P_pattern.indices, self.P_pattern.indptr),
+                          shape=self.P_pattern.shape)
+        A = sp.csc_matrix((self.A_map @ p, self.A_pattern.indices, self.A_pattern.indptr),
+                          shape=self.A_pattern.shape)
         b = self.b_map @ p
         u = np.where(np.arange(self.m) < self.n_eq, -b, b)
         l = np.where(np.arange(self.m) < self.n_eq, -b, -np.inf)
