@@ -3,6 +3,7 @@
 whom and when, and the landing spot that keeps clear. Hand-built geometry with known answers;
 no planner runs."""
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -146,10 +147,11 @@ def test_the_approach_clears_a_lying_burger_by_the_margin():
 
 
 # ---------------------------------------------------------------- a cook's timeline
-def fake_timeline(landing_b1=(0.64, -0.33)):
-    """b1 flipped at 90 s (landed at ``landing_b1``), b2's flip at 105 s scoops over
-    (0.56..0.72, -0.33 +- W/2); serves later."""
-    b1, b2 = CookBurger("b1", 0, 0.64, -0.33), CookBurger("b2", 15, 0.75, -0.45)
+def fake_timeline(landing_b1=(0.64, -0.33), drop_b1=(0.64, -0.33), blade_b2=(0.64, -0.33)):
+    """b1 dropped at ``drop_b1`` and flipped at 90 s (landed at ``landing_b1``), b2's flip at
+    105 s scoops with its blade at ``blade_b2`` (by default over (0.56..0.72, -0.33 +- W/2));
+    serves later."""
+    b1, b2 = CookBurger("b1", 0, *drop_b1), CookBurger("b2", 15, 0.75, -0.45)
     plans = {k: object() for k in ("f1", "f2", "s1", "s2")}
     mk = SimpleNamespace
     motions = [mk(kind="flip", burger="b1", key="flip:b1", start=87.0, end=91.0, event=90.0,
@@ -162,7 +164,7 @@ def fake_timeline(landing_b1=(0.64, -0.33)):
                   event=165.0, ok=True, plan=plans["s2"])]
     burgers = [mk(burger=b1, landing=landing_b1), mk(burger=b2, landing=(0.75, -0.45))]
     fps = {plans["f1"]: Footprint(landing=(3.0, landing_b1, R + 0.015)),
-           plans["f2"]: blade_at(0.64, -0.33, t=1.0),
+           plans["f2"]: blade_at(*blade_b2, t=1.0),
            plans["s1"]: Footprint(), plans["s2"]: Footprint()}
     return SimpleNamespace(burgers=burgers, motions=motions, ok=True), fps
 
@@ -200,11 +202,46 @@ def test_a_met_burger_is_landed_clear_of_the_blade_nearest_its_drop():
         return (point_polygon_distance(c, blade) >= radius + M
                 and np.hypot(c[0] - 0.75, c[1] + 0.45) >= radius + R + M)
 
+    spread = radius - R  # the spot lies this far inside the grill area's edges
     grid = [(x, y) for x in np.arange(0.60, 0.88 + 1e-9, M / 2)
-            for y in np.arange(-0.50, 0.16 + 1e-9, M / 2)]
+            for y in np.arange(-0.50, 0.16 + 1e-9, M / 2)
+            if 0.60 + spread - 1e-9 <= x <= 0.88 - spread + 1e-9
+            and -0.50 + spread - 1e-9 <= y <= 0.16 - spread + 1e-9]
     best = min((c for c in grid if clear(c)), key=lambda c: np.hypot(c[0] - 0.64, c[1] + 0.33))
     assert spot == pytest.approx(best) and clear(spot) and CELL.grill.contains(spot)
     assert free_landing("b1", tl, CELL, fps.__getitem__, exclude=[spot]) != pytest.approx(spot)
+
+
+def test_a_moved_landing_keeps_the_landed_burger_inside_the_grill_area():
+    """b1 dropped at the grill area's back edge with b2's blade over it: the nearest clear spot
+    lies on the edge, but b1 may land its spread (1.5 cm) beyond its spot, so the spot offered
+    lies that far inside."""
+    back = CELL.grill.x_range[1]
+    tl, fps = fake_timeline((back, -0.20), (back, -0.20), (back, -0.20))
+    spot = free_landing("b1", tl, CELL, fps.__getitem__)
+    spread = 0.015
+    blade = blade_at(back, -0.20).blade[0][2]
+    assert spot is not None and spot[0] <= back - spread + 1e-9
+    assert CELL.grill.contains((spot[0] + spread, spot[1]))
+    assert point_polygon_distance(spot, blade) >= R + spread + M - 1e-9
+    # on the edge itself a clear spot lies nearer the drop place than the one offered
+    edge = [y for y in np.arange(-0.50, 0.16 + 1e-9, M / 2)
+            if point_polygon_distance((back, y), blade) >= R + spread + M
+            and np.hypot(back - 0.75, y + 0.45) >= R + spread + R + M]
+    assert min(np.hypot(0.0, y + 0.20) for y in edge) < np.hypot(spot[0] - back, spot[1] + 0.20)
+
+
+def test_a_spot_nearer_the_edge_is_offered_when_no_inner_spot_is_clear():
+    """A grill area 2.5 cm deep has no spot 1.5 cm inside both its edges: the nearest clear
+    spot is offered all the same, not None."""
+    back = CELL.grill.x_range[1]
+    cell = dataclasses.replace(CELL, grill=dataclasses.replace(CELL.grill,
+                                                               x_range=(back - 0.025, back)))
+    tl, fps = fake_timeline((back, -0.20), (back, -0.20), (back, -0.20))
+    spot = free_landing("b1", tl, cell, fps.__getitem__)
+    blade = blade_at(back, -0.20).blade[0][2]
+    assert spot is not None and cell.grill.contains(spot)
+    assert point_polygon_distance(spot, blade) >= R + 0.015 + M - 1e-9
 
 
 def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypatch):

@@ -122,7 +122,13 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
     """The landing spot (x, y) (m) for ``burger`` nearest its drop place that keeps clear of
     every other motion and burger over its stay, and whose serve (its present footprint,
     moved with the spot) meets nobody; ``None`` if there is none. ``exclude``: spots
-    already tried (nothing within ``margin`` of them is offered again)."""
+    already tried (nothing within ``margin`` of them is offered again).
+
+    Spots at least the flip's landing spread inside the grill area's edges come first: the
+    burger lands within that spread of its spot, so from such a spot its centre stays in the
+    area, where the grill's re-plan takes burgers from. A spot nearer an edge is offered only
+    when no such spot is clear; the burger may then land beyond the area, and its serve is the
+    one scheduled, not one re-planned for where it lies."""
     margin = default_margin() if margin is None else margin
     r = cell.burger.diameter / 2
     motions = {m.key: m for m in timeline.motions if m.ok and m.event is not None}
@@ -175,6 +181,11 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
                      >= 2 * r + lie.spread + margin)
     if not ok.any():
         return None
+    g, spread = cell.grill, radius - r
+    inner = ((P[:, 0] >= g.x_range[0] + spread - 1e-12) & (P[:, 0] <= g.x_range[1] - spread + 1e-12)
+             & (P[:, 1] >= g.y_range[0] + spread - 1e-12) & (P[:, 1] <= g.y_range[1] - spread + 1e-12))
+    if (ok & inner).any():
+        ok &= inner
     drop = np.array([rec.burger.x, rec.burger.y])
     best = np.argmin(np.where(ok, np.hypot(*(P - drop).T), np.inf))
     return tuple(float(v) for v in P[best])
