@@ -365,6 +365,7 @@ def test_serves_re_planned_on_the_blade(timeline):
         assert r["pause_s"] == pytest.approx(max(r["wall_s"] - r["lead_s"], 0.0), abs=2e-3)
         assert 0.0 < r["on_blade_true"][0] < 0.08
         shift = np.subtract(r["on_blade_at_stop"], r["on_blade_true"])
-        assert np.hypot(*shift) < SENSING_SIGMA
+        assert r["shift_over_lead_m"] == pytest.approx(np.hypot(*shift), abs=1e-5)
+        assert r["shift_over_lead_m"] < SENSING_SIGMA
     for b in sim.burgers:
         assert b.flipped and b.serve.upright and b.serve.on_table and b.serve.distance < 0.05

@@ -243,8 +243,10 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             if run["sensed"] is not None:  # where the sensed burger lies when the carry stops
                 if refs.t[k] >= run["stop"] - 1e-9:
                     body = scene.burger_bodies[index[mo.burger]]
-                    run["sensed"]["on_blade_at_stop"] = [
-                        round(float(v), 5) for v in scene.in_blade_frame(body)[:2]]
+                    at_stop = [round(float(v), 5) for v in scene.in_blade_frame(body)[:2]]
+                    run["sensed"]["on_blade_at_stop"] = at_stop
+                    run["sensed"]["shift_over_lead_m"] = round(float(np.hypot(*np.subtract(
+                        at_stop, run["sensed"]["on_blade_true"]))), 5)
                     run["sensed"] = None
                 return None
             if run["done"]:

@@ -14,8 +14,8 @@ Why a lead of 0.5 s: the blade re-plans took 0.15–0.30 s on the idle 2-core ma
 two-burger cook of the tests and the five-burger cooks), so 0.5 s leaves the loaded
 machine of a busy cell some room. What the camera sees then is not quite where the burger
 rests when the carry stops: the record gives both (``on_blade_true`` at the sense,
-``on_blade_at_stop`` at the carry's end), so the shift over the lead is measured in every
-simulated cook.
+``on_blade_at_stop`` at the carry's end) and the distance between them
+(``shift_over_lead_m``), so the shift over the lead is measured in every simulated cook.
 """
 
 from __future__ import annotations
