@@ -243,6 +243,30 @@ def test_serve_lands_on_the_table_in_simulation(plan):
     assert run.on_blade()[k] and rpy(run.burger_rot[k])[0] == pytest.approx(0.0, abs=0.3)
 
 
+def test_a_serve_is_sensed_before_the_carry_ends_and_holds_only_beyond_the_lead(plan):
+    """The serve's re-plan runs during the last SENSE_LEAD of the carry: one quicker than
+    that costs no hold, a slower one holds the arm at the carry's end for the rest only."""
+    import time
+
+    from flipkit.simulation.execute import SENSE_LEAD, execute_plan
+
+    def taking(wall):
+        def replan(p, on_blade):  # changes nothing, takes ``wall`` s
+            time.sleep(wall)
+            return p
+        return replan
+
+    lead = SENSE_LEAD["serve"]
+    plain = execute_plan(plan)
+    quick = execute_plan(plan, replan=taking(0.1))
+    slow = execute_plan(plan, replan=taking(lead + 0.2))
+    assert quick.replan_failure is None and slow.replan_failure is None
+    assert quick.bounds == plain.bounds  # no hold
+    hold = slow.bounds["place"][0] - plain.bounds["place"][0]
+    assert slow.replan_time_s - lead - 1e-3 <= hold <= slow.replan_time_s - lead + 2e-3
+    assert slow.bounds["carry"] == plain.bounds["carry"]
+
+
 def test_cli_validate_judges_a_serve_plan_on_the_table(plan_file, tmp_path, capsys):
     out = tmp_path / "v.json"
     rc = main(["validate", "--plan", str(plan_file), "--trials", "1", "--workers", "1",

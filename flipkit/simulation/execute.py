@@ -37,6 +37,7 @@ from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
+from flipkit.simulation.cook_blade import SENSE_LEAD_S
 from flipkit.simulation.control import (ArmController, References, pause_steps,
                                         plan_references, step_references)
 from flipkit.simulation.modes import FEEDFORWARD, MODES
@@ -58,6 +59,11 @@ SETTLED_TURN = 2e-3  # (unitless)
 # burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
 # μ × 0.81, sensed after the scoop; the place depends on where it lies then).
 SENSE_AFTER = {"flip": "scoop", "serve": "carry"}
+# How long before that segment ends the camera sees the burger (s). A serve's re-plan starts
+# where the planned carry ends, so it runs while the carry finishes, as in a cook
+# (flipkit.simulation.cook_blade). A flip's re-plan starts where the scoop ends too, but the
+# burger is still being scooped before then: it is seen when the scoop has ended.
+SENSE_LEAD = {"flip": 0.0, "serve": SENSE_LEAD_S}
 NO_DRAW = {"dx_m": 0.0, "dy_m": 0.0, "grill_offset_m": 0.0, "mu_factor": 1.0, "mass_factor": 1.0,
            "sense_dx_m": 0.0, "sense_dy_m": 0.0}
 
@@ -154,15 +160,16 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
             rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
-            flat above the table, :data:`SENSE_AFTER`) with the burger's centre measured in
+            flat above the table, :data:`SENSE_AFTER`; a serve's burger is seen
+            :data:`SENSE_LEAD` before the carry ends) with the burger's centre measured in
             the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planners.planner.replan_flip`
             (serve: :func:`flipkit.planning.planners.serve.replan_serve`); the rest of the run
             follows the returned plan, which must keep the segments up to then and be solved
             (verified): a controller never receives an unverified trajectory. If the replan
             raises :class:`~flipkit.errors.FlipkitError` or is not solved, the original plan
-            runs on (``replan_failure`` says why). The arm holds at rest while the replan
-            runs: the simulation pauses the plan for its measured wall time, so the executed
-            duration includes it.
+            runs on (``replan_failure`` says why). The arm holds at rest at the sensed
+            segment's end for the replan's measured wall time beyond the lead (a flip's: all
+            of it), in whole control steps, so the executed duration includes it.
 
     Returns:
         The :class:`Execution`; ``execution.plan`` is the plan finally executed.
@@ -182,7 +189,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     dt = control.substeps * m.opt.timestep
 
     refs = plan_references(plan, robot, ph, mode, command, dt, hold, servo=servo)
-    t_sense = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
+    t_stop = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
+    t_sense = max(t_stop - SENSE_LEAD[plan.behavior], 0.0)
 
     pb = np.asarray(plan.burger["location"], float)
     place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=refs.q_des[0],
@@ -222,11 +230,12 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         if new is None:
             return None
         sense["plan"] = new
-        # The arm held at rest while the replan ran: the rest of the run starts after that
-        # pause, a whole number of control steps long.
-        pause = pause_steps(sense["time"], dt)
-        new_refs = plan_references(new, robot, ph, mode, command, dt, hold, t[k], pause,
-                                   servo=servo)
+        # The arm holds at rest at the sensed segment's end for the replan's wall time
+        # beyond what was left of the segment at the sense, a whole number of control steps.
+        lag = sense["time"] - max(t_stop - t[k], 0.0)
+        pause = pause_steps(lag, dt) if lag > 0 else 0.0
+        new_refs = plan_references(new, robot, ph, mode, command, dt, hold, max(t_stop, t[k]),
+                                   pause, servo=servo)
         if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):
             raise ConfigError("the replanned run does not extend the executed one")
         return new_refs
@@ -298,4 +307,4 @@ def _desired_positions(robot, q_des) -> np.ndarray:
     return _DESIRED[key]
 
 
-__all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "NO_DRAW", "Execution", "execute_plan"]
+__all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "SENSE_LEAD", "NO_DRAW", "Execution", "execute_plan"]
