@@ -21,6 +21,14 @@ def test_the_summary_counts_every_replanned_trial_and_skips_open_loop_ones():
     assert pause_summary([_trial(t) for t in times], target_s=0.5)["over_target"] == 1
 
 
+def test_a_serves_wait_beyond_its_lead_is_the_pause_not_its_replan_time():
+    serves = [{"replan": {"time_s": 0.3, "wait_s": 0.0, "failure": None}},
+              {"replan": {"time_s": 0.7, "wait_s": 0.2, "failure": None}}]
+    out = pause_summary(serves)
+    assert out["worst_s"] == pytest.approx(0.2) and out["median_s"] == pytest.approx(0.1)
+    assert out["over_target"] == 1
+
+
 def test_no_replans_give_none_and_say_open_loop():
     assert pause_summary([_trial(None), _trial(None)]) is None
     assert pause_summary([]) is None

@@ -264,6 +264,8 @@ def test_a_serve_is_sensed_before_the_carry_ends_and_holds_only_beyond_the_lead(
     assert quick.bounds == plain.bounds  # no hold
     hold = slow.bounds["place"][0] - plain.bounds["place"][0]
     assert slow.replan_time_s - lead - 1e-3 <= hold <= slow.replan_time_s - lead + 2e-3
+    assert quick.replan_wait_s == 0.0
+    assert slow.replan_wait_s == pytest.approx(slow.replan_time_s - lead, abs=1e-3)
     assert slow.bounds["carry"] == plain.bounds["carry"]
 
 

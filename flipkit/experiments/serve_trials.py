@@ -72,7 +72,7 @@ def run_serve_trial(job: dict) -> dict:
             "rest": {"xy": [float(v) for v in run.burger_pos[-1, :2]],
                      "distance": serve.distance, "up_z": serve.up_z},
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
-                       "time_s": ex.replan_time_s}
+                       "time_s": ex.replan_time_s, "wait_s": ex.replan_wait_s}
             if replan is not None else None}
 
 

@@ -171,7 +171,7 @@ def run_trial(job: dict) -> dict:
             "touchdown_xy": touch_xy, "touchdown_tilt_deg": touch_tilt,
             "predicted_landing_xy": _predicted(ex.plan),
             "replan": {"sensed_on_blade": ex.sensed_on_blade, "failure": ex.replan_failure,
-                       "time_s": ex.replan_time_s}
+                       "time_s": ex.replan_time_s, "wait_s": ex.replan_wait_s}
             if replan is not None else None, "physics": dict(job.get("physics") or {})}
 
 

@@ -90,8 +90,11 @@ class Execution:
             (``replan_failure`` says where it was).
         replan_failure: Why the replan failed (the original, verified plan then ran on), or
             ``None``.
-        replan_time_s: Wall time (s) of the replan; the arm held at rest that long (rounded
-            up to a control step) before the replanned motion. ``None`` open loop.
+        replan_time_s: Wall time (s) of the replan. ``None`` open loop.
+        replan_wait_s: The part of it beyond what was left of the sensed segment at the
+            sense (:data:`SENSE_LEAD`): a flip's whole replan time, a serve's beyond the
+            lead, else 0. A replanned run holds the arm at rest that long (rounded up to a
+            control step) at the sensed segment's end. ``None`` open loop.
     """
 
     run: BurgerRun
@@ -108,6 +111,7 @@ class Execution:
     sensed_on_blade: list | None = None
     replan_failure: str | None = None
     replan_time_s: float | None = None
+    replan_wait_s: float | None = None
 
 
 def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> dict:
@@ -201,7 +205,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     trace = BurgerTrace(scene, N)
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = trace.burger_body
-    sense = {"sensed": None, "failure": None, "time": None, "plan": plan}
+    sense = {"sensed": None, "failure": None, "time": None, "wait": None, "plan": plan}
     half = cell.spatula.half_extent
     thick = cell.spatula.thickness
 
@@ -225,6 +229,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             except FlipkitError as exc:
                 new, sense["failure"] = None, str(exc)
             sense["time"] = time.perf_counter() - started
+            sense["wait"] = max(sense["time"] - max(t_stop - t[k], 0.0), 0.0)
         if new is not None and new.status != "solved":
             new, sense["failure"] = None, new.failure or "replanned plan not solved"
         if new is None:
@@ -232,8 +237,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         sense["plan"] = new
         # The arm holds at rest at the sensed segment's end for the replan's wall time
         # beyond what was left of the segment at the sense, a whole number of control steps.
-        lag = sense["time"] - max(t_stop - t[k], 0.0)
-        pause = pause_steps(lag, dt) if lag > 0 else 0.0
+        pause = pause_steps(sense["wait"], dt) if sense["wait"] > 0 else 0.0
         new_refs = plan_references(new, robot, ph, mode, command, dt, hold, max(t_stop, t[k]),
                                    pause, servo=servo)
         if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):
@@ -269,7 +273,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     errors = _errors(robot, t, qa, q_des, bounds)
     return Execution(run, bounds, errors, qa, q_des, ua, qpos, tr.fbg, mode, scene, plan,
                      None if sensed is None else [float(v) for v in sensed], replan_failure,
-                     replan_time)
+                     replan_time, sense["wait"])
 
 
 def _errors(robot, t, q, q_des, bounds) -> dict:
