@@ -89,3 +89,19 @@ def test_the_compact_driver_reports_cvxpys_status_and_values():
     problem.solve(solver=cp.OSQP, eps_abs=1e-9, eps_rel=1e-9)
     np.testing.assert_allclose(got[0], x.value, atol=1e-6)
     np.testing.assert_allclose(got[1], Y.value, atol=1e-6)
+
+
+def test_the_driver_unpacks_through_cvxpy_when_the_map_cannot_be_built(monkeypatch):
+    import flipkit.solvers.osqp_driver as driver_module
+
+    def refuse(*args):
+        raise SolverError("not a selection")
+
+    monkeypatch.setattr(driver_module, "SolutionMap", refuse)
+    problem, (x, Y) = _problem()
+    driver = OSQPDriver(problem, compact=True)
+    res, _, status, solved = run_osqp(driver, problem, 1e-9, None)
+    assert solved and status == "optimal" and problem.status == "optimal"
+    assert driver._solution_map is False
+    # cvxpy unpacked it: the problem has a value (the map sets none)
+    assert problem.value == pytest.approx(problem.objective.value, rel=1e-9)

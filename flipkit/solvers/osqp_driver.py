@@ -202,8 +202,8 @@ class OSQPDriver:
         :attr:`status` to cvxpy's name of the status (``None`` when OSQP failed). With a
         parameter map, ``problem.value`` carries the objective's constant term of the first
         compile, not the current one; in compact mode a solution is stored by a
-        :class:`~flipkit.solvers.solution_map.SolutionMap`, which leaves ``problem.value``
-        and ``problem.status`` alone (the SQP reads the variables, the duals and
+        :class:`~flipkit.solvers.solution_map.SolutionMap`, which does not set
+        ``problem.value`` and ``problem.status`` (the SQP reads the variables, the duals and
         :attr:`status` only).
         """
         P, A, q, l, u, chain, inverse = self._data()
@@ -250,10 +250,13 @@ class OSQPDriver:
             self._active = _capped(ineq & ((np.abs(res.y) > 0) | (margin <= tol)),
                                    -np.abs(res.y), margin, cap)
         self.status = None
-        if self.compact and res.info.status_val in SOLVED:  # cvxpy's unpacking, precomputed
-            if self._solution_map is None:
+        if self.compact and res.info.status_val in SOLVED and self._solution_map is None:
+            try:  # cvxpy's unpacking, found once; if it is not a selection, cvxpy's own
                 self._solution_map = SolutionMap(self.problem, chain, inverse, A.shape[1],
                                                  A.shape[0])
+            except SolverError:
+                self._solution_map = False
+        if self.compact and res.info.status_val in SOLVED and self._solution_map:
             self.status = self._solution_map.apply(res)
         elif res.info.status_val in (1, 2, 3, 4):  # cvxpy raises on the other statuses
             with warnings.catch_warnings():  # an inaccurate solve is reported by its status

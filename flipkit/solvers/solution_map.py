@@ -8,7 +8,8 @@ entry of a variable is one entry of OSQP's primal vector x, every entry of a con
 is plus or minus one entry of its dual vector y. :class:`SolutionMap` finds that signed
 selection once, by unpacking coded vectors through cvxpy itself, then applies it; the values
 it stores are those cvxpy would store, bit for bit. If cvxpy does anything else than select
-and negate, building the map raises, so a change in cvxpy is caught there and not in a plan.
+and negate, building the map raises, so a change in cvxpy is caught there and not in a plan
+(:class:`~flipkit.solvers.osqp_driver.OSQPDriver` then unpacks through cvxpy).
 """
 
 from __future__ import annotations
