@@ -68,7 +68,8 @@ def register(subparsers) -> None:
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "
-                             "(serve: at the end of the carry, re-plan place and return home)")
+                             "(serve: 0.5 s before the carry ends, re-plan place and return "
+                             "home while it finishes)")
     parser.add_argument("--contingencies", action="store_true",
                         help="with --replan, flips only: prepare each plan's contingency flips "
                              "once and let the re-plans hand them out (docs/robust-flips.md "

@@ -7,8 +7,10 @@ physics perturbed (:class:`~flipkit.experiments.perturbations.Perturbations`, dr
 location), then judges the scoop and pickup (paper Sec. V) and the serve
 (:func:`flipkit.simulation.judges.judge_serve`: resting on the table, top face up, within
 3 cm of the spot). A stage counts only if the previous ones succeeded. With
-``replan`` the cell measures where the burger lies on the blade at the end of the carry and
-re-plans place and return home for it (:func:`flipkit.planning.planners.serve.replan_serve`).
+``replan`` the cell measures where the burger lies on the blade 0.5 s before the carry ends
+and re-plans place and return home for it while the carry finishes
+(:func:`flipkit.planning.planners.serve.replan_serve`,
+:data:`flipkit.simulation.execute.SENSE_LEAD`).
 """
 
 from __future__ import annotations
