@@ -39,3 +39,14 @@ def test_the_report_line_names_median_p90_worst_and_overruns():
     line = format_pauses(pause_summary([_trial(0.002), _trial(0.004), _trial(0.3)]))
     assert "over 3 re-plans" in line and "median 0.004 s" in line
     assert "worst 0.300 s" in line and "1 over 0.15 s" in line
+
+
+def test_the_arms_pause_is_whole_control_steps_of_the_replan_beyond_its_lead():
+    from flipkit.simulation.control import pause_steps
+
+    dt = 0.002
+    assert pause_steps(0.0051, dt) == pytest.approx(0.006)  # no lead: all of it
+    assert pause_steps(0.6051, dt, 0.6) == pytest.approx(0.006)  # the part beyond the lead
+    for within in (0.3, 0.6):  # within the lead: no pause, and not -0.0
+        p = pause_steps(within, dt, 0.6)
+        assert p == 0.0 and str(p) == "0.0"

@@ -32,9 +32,12 @@ def paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
     return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
 
 
-def pause_steps(wall_s: float, dt: float) -> float:
-    """The arm's pause (s) for a re-plan of ``wall_s`` s: whole control steps of ``dt``."""
-    return dt * np.ceil(wall_s / dt - 1e-9)
+def pause_steps(wall_s: float, dt: float, lead_s: float = 0.0) -> float:
+    """The arm's pause (s) for a re-plan of ``wall_s`` s that had ``lead_s`` s of motion still
+    to run when it started: whole control steps of ``dt`` covering the part beyond the lead,
+    0 if none."""
+    excess = wall_s - lead_s
+    return dt * np.ceil(excess / dt - 1e-9) if excess > 0 else 0.0
 
 
 def hold_torque(plan) -> np.ndarray:

@@ -58,7 +58,7 @@ from flipkit.simulation.cook_judges import BurgerResult, judge_burger
 from flipkit.simulation.cook_record import CookRecorder, Watch
 from flipkit.simulation.execute import HOLD_S
 from flipkit.simulation.modes import MODES, POSITION
-from flipkit.simulation.cook_blade import SENSE_LEAD_S, blade_replan
+from flipkit.simulation.cook_blade import blade_replan, sense_time
 from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, park_burger, place_burger
 
@@ -252,7 +252,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated
             if run["done"]:
                 return None
             carry = refs.bounds["carry"]
-            if refs.t[k] < max(carry[0], carry[1] - SENSE_LEAD_S) - 1e-9:
+            if refs.t[k] < sense_time(carry) - 1e-9:
                 return None
             run["done"], run["stop"] = True, max(carry[1], refs.t[k])
             new_refs, new, note = blade_replan(

@@ -31,6 +31,12 @@ from flipkit.simulation.scene import Scene
 SENSE_LEAD_S = 0.5  # s before the carry's end that the camera sees the burger (docstring)
 
 
+def sense_time(span, lead_s: float = SENSE_LEAD_S) -> float:
+    """When (s) the camera sees the burger in the sensed segment ``span`` = (start, end) (s):
+    ``lead_s`` before its end, not before its start."""
+    return max(span[0], span[1] - lead_s)
+
+
 def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float,
                  t_stop: float, start: float, next_start: float, dt: float,
                  references: dict) -> tuple:
@@ -72,8 +78,7 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
         except FlipkitError as exc:
             new, why = None, f"the re-plan was refused: {exc}"
     wall = time.perf_counter() - t0
-    lag = wall - (t_stop - t_now)  # the re-plan's wall beyond the rest of the carry
-    pause = pause_steps(lag, dt) if lag > 0 else 0.0
+    pause = pause_steps(wall, dt, t_stop - t_now)  # the hold beyond the rest of the carry
     refs = None
     if why is None:
         end = start + pause + new.duration
@@ -92,4 +97,4 @@ def blade_replan(scene: Scene, burger: int, plan, replan, error, *, t_now: float
     return refs, (new if why is None else None), record
 
 
-__all__ = ["SENSE_LEAD_S", "blade_replan"]
+__all__ = ["SENSE_LEAD_S", "blade_replan", "sense_time"]

@@ -37,7 +37,7 @@ from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
-from flipkit.simulation.cook_blade import SENSE_LEAD_S
+from flipkit.simulation.cook_blade import SENSE_LEAD_S, sense_time
 from flipkit.simulation.control import (ArmController, References, pause_steps,
                                         plan_references, step_references)
 from flipkit.simulation.modes import FEEDFORWARD, MODES
@@ -193,8 +193,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     dt = control.substeps * m.opt.timestep
 
     refs = plan_references(plan, robot, ph, mode, command, dt, hold, servo=servo)
-    t_stop = refs.bounds[SENSE_AFTER[plan.behavior]][1] if replan is not None else np.inf
-    t_sense = max(t_stop - SENSE_LEAD[plan.behavior], 0.0)
+    span = refs.bounds[SENSE_AFTER[plan.behavior]] if replan is not None else (np.inf, np.inf)
+    t_stop, t_sense = span[1], sense_time(span, SENSE_LEAD[plan.behavior])
 
     pb = np.asarray(plan.burger["location"], float)
     place_burger(scene, pb[:2] + [d_["dx_m"], d_["dy_m"]], q=refs.q_des[0],
@@ -205,7 +205,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     trace = BurgerTrace(scene, N)
     qa, ua, qpos = np.zeros((N, ARM_JOINTS)), np.zeros((N, ARM_JOINTS)), np.zeros((N, m.nq))
     burger_body = trace.burger_body
-    sense = {"sensed": None, "failure": None, "time": None, "wait": None, "plan": plan}
+    sense = {"sensed": None, "failure": None, "time": None, "lead": None, "wait": None,
+             "plan": plan}
     half = cell.spatula.half_extent
     thick = cell.spatula.thickness
 
@@ -229,7 +230,8 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             except FlipkitError as exc:
                 new, sense["failure"] = None, str(exc)
             sense["time"] = time.perf_counter() - started
-            sense["wait"] = max(sense["time"] - max(t_stop - t[k], 0.0), 0.0)
+            sense["lead"] = max(t_stop - t[k], 0.0)
+            sense["wait"] = max(sense["time"] - sense["lead"], 0.0)
         if new is not None and new.status != "solved":
             new, sense["failure"] = None, new.failure or "replanned plan not solved"
         if new is None:
@@ -237,7 +239,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
         sense["plan"] = new
         # The arm holds at rest at the sensed segment's end for the replan's wall time
         # beyond what was left of the segment at the sense, a whole number of control steps.
-        pause = pause_steps(sense["wait"], dt) if sense["wait"] > 0 else 0.0
+        pause = pause_steps(sense["time"], dt, sense["lead"])
         new_refs = plan_references(new, robot, ph, mode, command, dt, hold, max(t_stop, t[k]),
                                    pause, servo=servo)
         if len(new_refs.t) > N or np.any(np.abs(new_refs.t[:k + 1] - t[:k + 1]) > 1e-9):

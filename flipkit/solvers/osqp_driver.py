@@ -235,7 +235,7 @@ class OSQPDriver:
             if res.x is None or not np.all(np.isfinite(res.x)):
                 break
             self._x, self._y = res.x, res.y
-            if res.info.status_val not in (1, 2) or work.all() or rnd == MAX_ROUNDS:
+            if res.info.status_val not in SOLVED or work.all() or rnd == MAX_ROUNDS:
                 # solved (inaccurate), or every row that is not constant was in
                 break
             z = A @ res.x
@@ -244,7 +244,7 @@ class OSQPDriver:
                 break
             add = np.argsort(-viol)[:ADD_PER_ROUND if self.compact else len(viol)]
             work[add[viol[add] > tol[add]]] = True
-        if res.info.status_val in (1, 2) and np.all(np.isfinite(res.x)):
+        if res.info.status_val in SOLVED and np.all(np.isfinite(res.x)):
             z = A @ res.x
             margin = np.minimum(z - l, u - z)
             self._active = _capped(ineq & ((np.abs(res.y) > 0) | (margin <= tol)),
@@ -293,4 +293,4 @@ def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_ite
         raise SolverError(f"OSQP failed inside a subproblem: {' '.join(str(exc).split())}") from None
     ok = res.info.status_val in (1, 2, 3, 4)
     status = driver.status if ok else f"osqp:{res.info.status}"
-    return res, iterations, status, res.info.status_val in (1, 2)
+    return res, iterations, status, res.info.status_val in SOLVED
