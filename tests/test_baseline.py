@@ -119,8 +119,9 @@ def test_benign_verdicts(benign):
     by = {s.subbehavior: s for s in benign.segments}
     for name in ("go_to_burger", "scoop", "pickup"):
         assert by[name].status == "solved", by[name]
-        assert by[name].measures["tracking_position_m"] < 5e-6  # placo's IK accuracy
-    # the 2.7 rad roll within the flip's T_max needs ~9 rad/s of wrist 3 (limit 3.2): IK lags
+        # placo's IK accuracy, where the profile's speeds (0.9 of UR's) bind for a few samples
+        assert by[name].measures["tracking_position_m"] < 1e-4  # measured 42 µm
+    # the 2.7 rad roll within the flip's T_max needs ~9 rad/s of wrist 3 (bound 2.83): IK lags
     assert benign.status == "failed" and benign.subbehavior == "flip"
     assert benign.reason == "tracking_error" and benign.amount > 0.05
     assert all(s.reason in REASONS for s in benign.segments if s.status == "failed")
@@ -143,6 +144,8 @@ def test_narrowed_joint_limit_is_reported(benign, cell, tmp_path):
     text = Path(Robot(cell).urdf).read_text()
     text = re.sub(r'(<joint name="wrist_1_joint".*?<limit [^>]*upper=")[^"]*"',
                   lambda m: m.group(1) + f'{q4_max + 5e-4:.9f}"', text, flags=re.S)
+    # a URDF of one's own stays within the UR10's published speeds (or is refused)
+    text = re.sub(r'velocity="[^"]*"', 'velocity="2.0"', text)
     urdf = tmp_path / "ur10_narrow.urdf"
     urdf.write_text(text)
     narrow = replace(cell, robot=RobotConfig(urdf=str(urdf)))
@@ -193,14 +196,14 @@ def test_classifier_hand_made(bare, cell):
     v = _verdict(bare, t, jump)
     assert v.reason == "configuration_jump" and v.amount == pytest.approx(0.3)
 
-    fast = qs + np.outer(t, [3.0, 0, 0, 0, 0, 0])  # base at 3 rad/s > 2.16
+    fast = qs + np.outer(t, [3.0, 0, 0, 0, 0, 0])  # base at 3 rad/s > 0.9 × 2.094
     v = _verdict(bare, t, fast)
     assert v.reason == "joint_velocity" and v.amount == pytest.approx(3.0)
-    assert v.limit == pytest.approx(2.16) and "joint 1" in v.detail
+    assert v.limit == pytest.approx(0.9 * np.radians(120)) and "joint 1" in v.detail
 
-    accel = qs + np.outer(0.5 * 30.0 * t**2, [0, 0, 0, 1, 0, 0])  # 30 rad/s² > 20
+    accel = qs + np.outer(0.5 * 25.0 * t**2, [0, 0, 0, 1, 0, 0])  # 25 rad/s² > 20
     v = _verdict(bare, t, accel)
-    assert v.reason == "joint_acceleration" and v.amount == pytest.approx(30.0)
+    assert v.reason == "joint_acceleration" and v.amount == pytest.approx(25.0)
 
     q_low = solve_pose(bare, (0.70, -0.20, 0.05), (0.0, 0.0, 0.0))  # blade flat 2.2 cm low
     t, low = _static(bare, q_low)

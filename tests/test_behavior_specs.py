@@ -74,7 +74,9 @@ def test_floors_follow_the_spec():
     assert np.all(blade_floor("translate", CELL, N) == hg)
     arrival = blade_floor("go_to_burger", CELL, N)  # above the tallest burger, then down
     assert np.all(arrival[:16] > hg + 0.019) and np.all(arrival[16:18] == hg)
-    assert np.all(arrival[18:] < hg)  # pressed in over the slide to the scoop's start
+    # the tip pressed in over the slide to the scoop's start; the neck never below the grill
+    assert np.all(arrival[18:, :2] < hg) and np.all(arrival[:, 2:] >= hg)
+    assert blade_floor("translate", CELL, N).shape == (N + 1, 4)
     assert np.all(blade_floor("turn_back", CELL, N) > hg + CELL.burger.thickness)
 
 

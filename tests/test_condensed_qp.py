@@ -23,9 +23,9 @@ def segments():
     qs = solve_pose(models.loaded, (0.64, -0.33, 0.15), (0, 0, 0))
     translate = transcribe("translate", models, qs, goal=flat_pose((0.75, 0.0, 0.15)))
     scoop_start = transcribe("go_to_burger", models, models.bare.q_home, None,
-                                location=TABLE1_LOCATIONS[3])
+                                location=TABLE1_LOCATIONS[4])
     end = scoop_start.layout.nodes(scoop_start.x0)[-1]
-    scoop = transcribe("scoop", models, end[0], end[1], location=TABLE1_LOCATIONS[3])
+    scoop = transcribe("scoop", models, end[0], end[1], location=TABLE1_LOCATIONS[4])
     return {"translate": translate, "scoop": scoop}
 
 
@@ -91,7 +91,9 @@ def test_warm_start_cuts_iterations(segments):
 
 def test_sqp_condensed_and_full_space_agree(segments):
     """The SQP reaches the same optimum with either form of the subproblem on a smooth NLP (the
-    translate without the arm's clearance rows), to 1e-4 of Σu². Until 2026-11-23 the two forms
+    translate without the arm's clearance rows), to 5e-4 of Σu² (with the UR10's published
+    speeds, 90 % of them active on more of the cruise: 15 532.08 vs 15 528.22, 2.5e-4; with
+    the URDF's looser speeds the forms agreed to 1e-4). Until 2026-11-23 the two forms
     took the same iterations to the same point to rounding; since the joint limits hold between
     the nodes (InterpolantLimits, active along the cruise at 2.16 rad/s) OSQP's tolerance on the
     full-space form's active rows sends it another way through a flat valley: measured 6
@@ -112,7 +114,7 @@ def test_sqp_condensed_and_full_space_agree(segments):
     a = solve_sqp(smooth, options=SQPOptions(tight, qp=gn))
     b = solve_sqp(smooth, options=SQPOptions(tight, qp=QPOptions(condense=False)))
     assert a.success and b.success
-    assert a.objective == pytest.approx(b.objective, rel=1e-4)
+    assert a.objective == pytest.approx(b.objective, rel=5e-4)
     assert a.max_violation <= 1e-6 and b.max_violation <= 1e-6
     nlp = segments["translate"]
     a = solve_sqp(nlp, options=SQPOptions(qp=gn))

@@ -95,8 +95,10 @@ def test_two_burgers_are_flipped_and_served_in_one_simulation(simulated, timelin
     for b in simulated.burgers:
         assert b.flipped, b.failure
         assert b.flip.upside_down and max(map(abs, b.flip.offset)) <= 0.05
-        # the simulated landing lies within a control step or two of the planned one
-        assert abs(b.deviation_s["flip"] - b.planned_deviation_s["flip"]) < 0.05
+        # the simulated landing comes after the planned one by the lag of the plan's own
+        # commands through servoj's smoothing (τ 0.1 s), within a few control steps
+        late = b.deviation_s["flip"] - b.planned_deviation_s["flip"]
+        assert -0.01 < late < CELL.physics.servo_lookahead_s + 0.05
     # b2 lies untouched after it landed and after its serve. b1 lies where its serve put it, a
     # few cm off its table spot (the bending patty passes the place the serve planned for,
     # docs/benchmarks/2026-11-27-bending-patty.md), and b2's serve brushes it: reported.

@@ -36,7 +36,11 @@ def test_payload_changes_gravity_torque_by_its_weight():
     np.testing.assert_allclose(dG, -J.T @ (cell.burger.mass * np.array(cell.gravity)), atol=1e-9)
 
 
-def test_world_gravity_and_urdf_limits(robot):
+def test_world_gravity_and_profile_limits(robot):
+    """The URDF's torques (54 N·m on the wrists, within UR's 56), UR's published speeds
+    (120 and 180 deg/s, not the URDF's 2.16/3.15/3.2 rad/s), plans held to 95 % of them."""
     np.testing.assert_allclose(robot.model.gravity.linear, [0, 0, -9.81])
     np.testing.assert_allclose(robot.u_max, [330, 330, 150, 54, 54, 54])
-    np.testing.assert_allclose(robot.qd_max, [2.16, 2.16, 3.15, 3.2, 3.2, 3.2])
+    np.testing.assert_allclose(robot.qd_limit, np.radians([120, 120, 180, 180, 180, 180]))
+    np.testing.assert_allclose(robot.qd_max, 0.9 * robot.qd_limit)
+    np.testing.assert_allclose(robot.model.velocityLimit, robot.qd_limit)

@@ -8,6 +8,7 @@ import pinocchio as pin
 import pytest
 
 from flipkit.simulation.judges import SCOOP_OVERLAP, judge_scoop
+from flipkit.config import PhysicsConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.simulation import execute
 from flipkit.simulation.execute import HOLD_S, MODES, SETTLED_WINDOW, execute_plan
@@ -40,6 +41,10 @@ def test_motionless_arm_never_scoops(flip_plan):
     assert max(e["max_m"] for e in ex.errors.values()) < 1e-3  # holding still
 
 
+# the rigid blade whose press the grill's compliant contact absorbs (not the default's hinge)
+CONTACT = PhysicsConfig(blade_flex="contact")
+
+
 def test_blade_pressed_into_grill_pushes_back_and_arm_tracks(flip_plan):
     """q_home holds the blade flat and level; the grill is raised so that the planned blade
     underside is 2 mm below its surface."""
@@ -51,7 +56,7 @@ def test_blade_pressed_into_grill_pushes_back_and_arm_tracks(flip_plan):
     bottom = top - cell.physics.blade_thickness
     offset = bottom + 0.002 - cell.grill.height
     ex = execute_plan(plan, "feedforward", draw={"grill_offset_m": offset, "dx_m": 0.15},
-                      hold=0.0)
+                      hold=0.0, physics=CONTACT, safety_stop=False)
     late = ex.run.t > ex.run.t[-1] - 0.5
     force = ex.force_blade_grill[late]
     assert force.min() > 1.0  # the grill pushes the blade up the whole time (N)
@@ -139,16 +144,19 @@ def test_validate_checks_the_mode_and_records_it(flip_plan_file):
     with pytest.raises(InvalidChoiceError, match="'feedforward', 'position'"):
         validate([((0.69, -0.16, 0.072), {}, None)], 1, mode="servo")
     text = flip_plan_file.read_text()
-    job = trial_jobs(text, 1, 0, Perturbations(), mode="position")[0]
+    raw = run_trial(trial_jobs(text, 1, 0, Perturbations(), mode="position")[0])
+    assert raw["mode"] == "position" and set(raw["ok"]) == {"scoop", "pickup", "flip"}
+    assert raw["command"] == "raw"  # the default: the plan's own (q, q̇), as export writes
+    assert raw["safety"]["preset"] == "least_restricted" and raw["safety"]["stop"] is None
+    assert 0.5 < raw["safety"]["peaks"]["joint_speed"] <= 1.0
+    job = trial_jobs(text, 1, 0, Perturbations(), mode="position", command="compensated")[0]
     out = run_trial(job)
-    assert out["mode"] == "position" and set(out["ok"]) == {"scoop", "pickup", "flip"}
     assert out["command"] == "compensated"
     # compensated commands track within 5 mm once under way (the servo's smoothing lags the
     # go to burger's first step of torque by up to a centimetre), the plan as it is lags
     under_way = ("scoop", "pickup", "flip", "turn_back")
     assert max(out["tracking"][k]["max_m"] for k in under_way) < 0.005
     assert out["tracking"]["go_to_burger"]["max_m"] < 0.015
-    raw = run_trial(trial_jobs(text, 1, 0, Perturbations(), mode="position", command="raw")[0])
     assert min(raw["tracking"][k]["max_m"] for k in under_way) > 0.02
 
 
@@ -158,7 +166,9 @@ def test_pressed_blade_is_the_blades_spring_and_does_not_bounce(flip_plan):
     penetration), at most k × 3 mm (the arm's PD yields the rest)."""
     scoop = flip_plan.segment("scoop")
     plan = held(flip_plan, scoop.q[0])
-    ex = execute_plan(plan, "feedforward", draw={"dx_m": 0.2}, hold=0.0)  # burger out of the way
+    # burger out of the way; the run starts pressed (the safety system would stop its first step)
+    ex = execute_plan(plan, "feedforward", draw={"dx_m": 0.2}, hold=0.0, safety_stop=False,
+                      physics=CONTACT)
     late = ex.run.t > 0.5
     force = ex.force_blade_grill[late]
     assert np.mean(force > 0) >= 0.95

@@ -95,15 +95,20 @@ def within_limits(robot, q):
 
 
 # ------------------------------------------------------------------ URScript
-def test_urscript_raw_streams_the_resampled_q(plan, robot, tmp_path):
+def test_urscript_streams_the_plans_q_and_ends_at_rest(plan, robot, tmp_path):
+    """The default command is the plan's own q at t_j = j / rate, through the plan's end
+    (1.8 s is sample 225 at 125 Hz), then the final configuration once more: at rest."""
     path = tmp_path / "flip.script"
-    options = ServoOptions(command="raw")
-    assert write_urscript(plan, path, 125.0, options) == 226
+    assert ServoOptions().command == "raw"
+    assert write_urscript(plan, path, 125.0) == 227
     prog = parse_urscript(path.read_text())
-    t, q, _ = export.resample(plan, 125.0)
-    assert prog["name"] == "flipkit_translate" and prog["q"].shape == q.shape == (226, 6)
+    t = np.arange(227) / 125.0
+    q = export.evaluate(plan, np.minimum(t, plan.duration))[0]
+    assert prog["name"] == "flipkit_translate" and prog["q"].shape == q.shape == (227, 6)
     assert np.abs(prog["q"] - q).max() <= HALF_ULP
+    assert np.abs(prog["q"][-2:] - plan.segments[-1].q[-1]).max() <= HALF_ULP
     assert np.abs(prog["q_start"] - plan.segments[0].q[0]).max() <= HALF_ULP
+    assert np.abs(prog["q"][0] - prog["q_start"]).max() == 0.0
     assert prog["tol"] == 0.01 and prog["t"] == {0.008}
     assert prog["lookahead"] == {0.1} and prog["gain"] == {300.0}
     assert "command raw" in "\n".join(prog["head"])
@@ -115,28 +120,22 @@ def test_urscript_options_and_rate(plan, tmp_path):
     options = ServoOptions(lookahead=0.05, gain=1000, command="raw", start_tol=0.02)
     write_urscript(plan, path, 500.0, options)
     prog = parse_urscript(path.read_text())
-    assert prog["q"].shape[0] == export.resample(plan, 500.0)[0].size == 901
+    assert prog["q"].shape[0] == 900 + 2  # 1.8 s at 500 Hz, its end and the rest sample
     assert prog["t"] == {0.002} and prog["lookahead"] == {0.05} and prog["gain"] == {1000.0}
     assert prog["tol"] == 0.02
 
 
 @pytest.mark.parametrize("rate", [125.0, 500.0])
-def test_the_default_command_is_the_position_modes_compensation(plan, robot, tmp_path, rate):
+def test_the_compensated_stream_is_the_servo_models_inverse(plan, robot, rate):
     """The first segment is a cubic: the plan 8 ms (latency) + half a servo period ahead is
     known in closed form, u between nodes is linear, and Kp (q_c − q_d) + g_c(q_d)
     must give back the plan's torque u_d (the burger's weight, which the controller's model
-    lacks, makes the offset non-zero). The stream sent is q_c made for servoj's smoothing
-    at the default lookahead (0.1 s): x = q_c + τ q̇_c, q̇_c by differences within the
-    segment."""
-    out = tmp_path / "c.script"
-    rate_args = [] if rate == 125.0 else ["--rate", f"{rate:g}"]  # the default: 125 Hz
-    assert main(["export", str(plan.to_json(tmp_path / "p.json")), "--format", "urscript",
-                 "--out", str(out), *rate_args]) == 0
-    prog = parse_urscript(out.read_text())
-    assert "command compensated" in "\n".join(prog["head"])
+    lacks, makes the offset non-zero). The stream is q_c made for servoj's smoothing at the
+    default lookahead (0.1 s): x = q_c + τ q̇_c, q̇_c by differences within the segment."""
+    t_sent, q_cmd, _ = export_urscript.servo_stream(plan, rate, "compensated")
     physics, seg = PhysicsConfig(), plan.segments[0]
     lead = physics.latency_s + 0.5 / rate
-    t = np.arange(prog["q"].shape[0]) / rate + lead
+    t = t_sent + lead
     first = t <= seg.T
     s, d = t[first] / seg.T, seg.q[-1] - seg.q[0]
     q_d = seg.q[0] + np.outer(3 * s**2 - 2 * s**3, d)
@@ -146,35 +145,66 @@ def test_the_default_command_is_the_position_modes_compensation(plan, robot, tmp
     kp = np.asarray(physics.kp)
     q_c = q_d + (u_d - g_c) / kp
     tau = physics.servo_lookahead_s
-    assert tau == 0.1 and "lookahead_time 0.1 s" in "\n".join(prog["head"])
+    assert tau == 0.1
     x = q_c + tau * np.gradient(q_c, t[first], axis=0)
     # the last τ/2 (and a sample) carry the spread step to the next segment
     inner = t[first] < seg.T - tau / 2 - 1.0 / rate
-    np.testing.assert_allclose(prog["q"][first][inner], x[inner], atol=HALF_ULP + 1e-9)
+    np.testing.assert_allclose(q_cmd[first][inner], x[inner], atol=1e-9)
     assert np.abs(q_c - q_d).max() > 1e-4
-    within_limits(robot, prog["q"])
 
 
-def test_a_flip_streams_within_the_limits(flip_plan, tmp_path):
+def test_the_compensated_stream_of_a_flip_is_refused_by_the_arms_limits(flip_plan, tmp_path,
+                                                                        capsys):
+    """Where the plan's torque steps (the segments' joins) the compensated stream steps too,
+    faster than the UR10's published joint speeds: refused in one line naming the joint, the
+    time and the amount, nothing written; the raw stream of the same plan is written."""
+    src = flip_plan.to_json(tmp_path / "flip.json")
+    for rate in ("125", "500"):
+        out = tmp_path / f"c{rate}.script"
+        assert main(["export", str(src), "--format", "urscript", "--rate", rate, "--out",
+                     str(out), "--command", "compensated"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and "nothing written" in err and not out.exists()
+        assert re.search(r"speed: \w+_joint at [\d.]+ rad/s near t = [\d.]+ s, [\d.]+x the UR10",
+                         err), err
+        assert main(["export", str(src), "--format", "urscript", "--rate", rate, "--out",
+                     str(out)]) == 0
+        assert "stream checked" in capsys.readouterr().out
+
+
+def test_a_flip_streams_within_the_arms_limits(flip_plan, tmp_path):
+    """The raw stream as written, parsed here on its own: within 100 % of UR's published
+    speeds (the plan keeps to 95 %), starting at the guard's q_start and ending at rest."""
     path = tmp_path / "flip.script"
     n = write_urscript(flip_plan, path, 500.0)
     prog = parse_urscript(path.read_text())
-    assert prog["q"].shape == (n, 6) and n == export.resample(flip_plan, 500.0)[0].size
+    assert prog["q"].shape == (n, 6)
     assert np.abs(prog["q_start"] - flip_plan.segments[0].q[0]).max() <= HALF_ULP
-    within_limits(Robot(flip_plan.cell(), with_burger=False), prog["q"])
-    raw = export.evaluate(flip_plan, np.arange(n) / 500.0 + 0.008 + 0.5 / 500.0)[0]
-    # rad: the compensation and the smoothing's lead τ q̇ (τ 0.1 s, |q̇| ≤ 3.2 rad/s)
-    assert 1e-3 < np.abs(prog["q"] - raw).max() < 0.1 * 3.2 + 0.05
-    # no sample is an impulse: where segments meet, the compensation steps, and the stream
-    # steps with it (a step inverted through the smoothing would be τ/Δt = 50 times larger)
-    assert np.abs(np.diff(prog["q"], axis=0)).max() < 0.1
+    robot = Robot(flip_plan.cell(), with_burger=False)
+    within_limits(robot, prog["q"])
+    speed = np.abs(np.diff(prog["q"], axis=0)) * 500.0
+    assert np.all(speed <= np.radians([120, 120, 180, 180, 180, 180]))
+    assert np.all(prog["q"][-1] == prog["q"][-2])
 
 
-def test_a_command_outside_the_limits_is_refused(plan):
-    t, q, _ = export.resample(plan, 125.0)
-    q[40, 2] = 3.2
-    with pytest.raises(ExportError, match=r"t = 0\.320 s puts q3 at 3\.2000 rad"):
-        export_urscript.check_limits(plan, t, q)
+def test_a_stream_over_the_arms_speed_is_refused_with_nothing_written(plan, tmp_path):
+    """A stream that asks a joint for more than the UR10 publishes never reaches a file: one
+    sample moved 0.05 rad (6 rad/s at 125 Hz on the elbow)."""
+    from flipkit.planning.plans import stream_check
+
+    t, q, _ = export_urscript.servo_stream(plan, 125.0)
+    q = q.copy()
+    q[40, 2] += 0.05
+    report = stream_check.check_stream(plan, t, q, evaluate=export.evaluate)
+    assert not report.ok and report.speed_ratio > 1.9  # 6.25 rad/s on a 3.14 rad/s joint
+    assert report.failures[0].startswith("speed: elbow_joint at")
+    assert "t = 0.312 s" in report.failures[0] or "t = 0.320 s" in report.failures[0]
+    with pytest.raises(ExportError, match="nothing written: speed: elbow_joint"):
+        stream_check.require_stream(report, "p.json")
+    bad = export_urscript.urscript_text(plan, t, q, 125.0, ServoOptions(), "p.json")
+    with pytest.raises(ExportError, match="elbow_joint"):
+        export.check_written(plan, "urscript", bad, "p.json")
+    assert any("deviation" in f for f in report.failures)  # 0.05 rad moves the blade cm
 
 
 # ------------------------------------------------------------------ ROS 2
@@ -192,19 +222,18 @@ def test_ros2_yaml_is_the_resampled_trajectory(plan, robot, tmp_path):
     ns = np.array([s["sec"] * 10**9 + s["nanosec"] for s in stamp])
     assert ns[0] == 0 and np.all(np.diff(ns) > 0) and ns[-1] == 1_800_000_000
     t, q, qd = export.resample(plan, 126.0)
-    np.testing.assert_array_equal(ns[:-1], np.round(t * 1e9))
+    np.testing.assert_array_equal(ns, np.round(t * 1e9))
     pos, vel = (np.array([p[k] for p in pts]) for k in ("positions", "velocities"))
-    np.testing.assert_array_equal(pos[:-1], q)  # repr: round-trip exact
-    np.testing.assert_array_equal(vel[:-1], qd)
-    np.testing.assert_array_equal(pos[-1], plan.segments[-1].q[-1])
+    np.testing.assert_array_equal(pos, q)  # repr: round-trip exact
+    np.testing.assert_array_equal(vel, qd)
+    np.testing.assert_allclose(pos[-1], plan.segments[-1].q[-1], rtol=0, atol=1e-12)
     assert np.abs(vel[-1]).max() < 1e-9  # ends at rest
     within_limits(robot, pos)
-
-
-def test_ros2_without_an_extra_end_point_when_a_sample_is_on_it(plan, tmp_path):
-    message = export_ros2.trajectory(plan, 125.0)  # 1.8 s: sample 225 is the end
-    assert len(message["points"]) == 226
-    assert message["points"][-1]["time_from_start"] == {"sec": 1, "nanosec": 800_000_000}
+    # the velocities are the positions' slope: a spline through them is the plan's q
+    from scipy.interpolate import CubicHermiteSpline
+    mid = (t[:-1] + t[1:]) / 2
+    spline = CubicHermiteSpline(t, pos, vel, axis=0)
+    assert np.abs(spline(mid) - export.evaluate(plan, mid)[0]).max() < 1e-6
 
 
 # ------------------------------------------------------------------ refusals
@@ -237,13 +266,15 @@ def test_a_tampered_plan_is_refused_by_every_format(tampered, tmp_path, capsys, 
     (["--format", "pdf", "--out", "o.pdf"], ["export format 'pdf'", "'csv', 'urscript', 'ros2'"]),
     (["--format", "urscript", "--out", "o.script", "--rate", "fast"], ["--rate", "'fast'"]),
     (["--format", "ros2", "--out", "o.yaml", "--rate", "0"], ["--rate", "[1, 10000] Hz"]),
-    (["--format", "urscript", "--out", "o.script", "--rate", "300"], ["500/k Hz"]),
+    (["--format", "ros2", "--out", "o.yaml", "--rate", "10"], ["--rate", "[100, 1000] Hz"]),
+    (["--format", "csv", "--out", "o.csv", "--rate", "2000"], ["--rate", "[100, 1000] Hz"]),
+    (["--format", "urscript", "--out", "o.script", "--rate", "300"], ["125, 250, 500 Hz"]),
     (["--format", "urscript", "--out", "o.script", "--gain", "50"], ["--gain", "[100, 2000]"]),
     (["--format", "urscript", "--out", "o.script", "--gain", "big"], ["--gain", "'big'"]),
     (["--format", "urscript", "--out", "o.script", "--lookahead", "0.5"], ["--lookahead", "0.2"]),
     (["--format", "urscript", "--out", "o.script", "--start-tol", "nan"], ["--start-tol"]),
     (["--format", "urscript", "--out", "o.script", "--command", "comp"],
-     ["position command 'comp'", "'compensated', 'raw'"]),
+     ["position command 'comp'", "'raw', 'compensated'"]),
     (["--format", "ros2", "--out", "o.yaml", "--gain", "300"], ["--gain", "urscript only"]),
     (["--format", "ros2", "--out", "o.script"], ["--out", ".yaml"]),
     (["--format", "urscript"], ["--out"]),
@@ -266,5 +297,8 @@ def test_the_command_lines_constants_are_the_librarys():
         assert default == getattr(defaults, key)
         assert rng == getattr(export_urscript, {"lookahead": "LOOKAHEAD_RANGE", "gain": "GAIN_RANGE",
                                                 "start_tol": "START_TOL_RANGE"}[key])
-    assert cli_export.COMMANDS == servo_command.COMMANDS and defaults.command == "compensated"
+    assert cli_export.COMMANDS == servo_command.COMMANDS
+    assert defaults.command == servo_command.DEFAULT_COMMAND == servo_command.COMMANDS[0] == "raw"
     assert cli_export.RATE_RANGE == export.RATE_RANGE
+    assert cli_export.STREAM_RATES == export.STREAM_RATES
+    assert cli_export.SERVO_RATES == export_urscript.SERVO_RATES

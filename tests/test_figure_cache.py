@@ -49,7 +49,7 @@ def test_an_identical_trial_hits_the_cache_and_any_changed_input_misses(tmp_path
         trial_jobs(PLAN, 2, 0, Perturbations(), mode="position", replan=True),
         trial_jobs(PLAN, 2, 0, Perturbations(), mode="position", physics={"burger.mu": 0.2}),
         trial_jobs(PLAN, 2, 0, Perturbations(), rate_hz=500.0, mode="position"),
-        trial_jobs(PLAN, 2, 0, Perturbations(), mode="position", command="raw"),
+        trial_jobs(PLAN, 2, 0, Perturbations(), mode="position", command="compensated"),
     ]
     for other in changed:
         assert run_trials(other, tmp_path)[1] == 2, other[0]

@@ -126,7 +126,9 @@ def test_a_rigid_patty_is_the_disc_and_keeps_yaw_zero(bare):
     cell = _cell(1)
     scene = build_scene(bare, cell)
     place_burger(scene, (0.7, -0.1), heading=0.4)
-    assert scene.model.nq == 6 + 7 and scene.burger_geoms == ((scene.geoms["burger"],),)
+    flex = int(scene.blade_contact["flex"] == "hinge")  # the flexing blade's hinge
+    assert scene.model.nq == 6 + flex + 7
+    assert scene.burger_geoms == ((scene.geoms["burger"],),)
     assert np.allclose(scene.data.qpos[scene.qpos_of(0)][3:], (1, 0, 0, 0))
 
 
@@ -134,7 +136,7 @@ def test_several_patties_park_and_place_with_their_strips(bare):
     cell = _cell(5)
     scene = build_scene(bare, cell, burgers=3)
     m, d = scene.model, scene.data
-    assert m.nq == 6 + 3 * (7 + 4)
+    assert m.nq == 6 + 1 + 3 * (7 + 4)  # the arm, the flexing blade's hinge, three patties
     place_burger(scene, (0.7, 0.1), burger=1, heading=0.2)
     assert np.all(m.body_gravcomp[scene.patty_bodies(1)] == 0.0)
     assert np.all(m.body_gravcomp[scene.patty_bodies(0)] == 1.0)  # still parked

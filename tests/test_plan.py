@@ -90,7 +90,9 @@ def test_round_trip_is_exact_and_keys_follow_the_format(models, tmp_path):
                          "cell_geometry"]
     assert doc["format"] == FORMAT and doc["status"] == "solved"
     assert list(doc["robot"]) == ["urdf", "urdf_sha256", "base_in_world", "tool_parent_frame",
-                                  "spatula_in_parent", "payload", "q_home"]
+                                  "spatula_in_parent", "payload", "q_home", "arm"]
+    assert doc["robot"]["arm"] == {"profile": "ur10", "speed_margin": 0.9,
+                                   "safety_preset": "least_restricted"}
     seg = doc["segments"][0]
     assert list(seg) == ["name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes",
                          "solver", "payload", "goal"]

@@ -93,9 +93,10 @@ def test_a_lifted_overhang_rides_on_the_blade():
 def test_scoop_model_predicts_the_simulated_scoop(flip_plan):
     """The model, from the plan's scoop alone, against MuJoCo's nominal cell (feed-forward).
     The plan's place is the midpoint of the blade carrying none of the overhang and the
-    overhang its thickness lifts; the rigid disc ends within 1.5 cm of the first, the bending
-    patty between the two, give or take a centimetre (the model is not fitted to any trial;
-    docs/benchmarks/2026-11-27-bending-patty.md)."""
+    overhang its thickness lifts; on the blade that flexes from its neck (the default: its tip
+    rides on the grill, its face above it) the rigid disc and the bending patty both end
+    between the two, give or take a centimetre (the model is not fitted to any trial;
+    docs/benchmarks/2026-11-27-bending-patty.md, 2026-11-27-flexing-blade.md)."""
     from flipkit.behaviors.models import Models
     from flipkit.simulation.execute import execute_plan
 
@@ -121,7 +122,7 @@ def test_scoop_model_predicts_the_simulated_scoop(flip_plan):
         places[strips] = ex.run.in_blade_frame()[k][0]
     rigid, bent = places[1], places[cell.physics.burger_strips]
     assert rigid > 0.015  # the scoop does leave it well ahead of the centre
-    assert abs(flush - rigid) < 0.015
+    assert flush - 0.01 < rigid < lifted + 0.01
     assert flush - 0.01 < bent < lifted + 0.01
 
 
@@ -329,7 +330,8 @@ def test_a_place_the_plan_already_lands_needs_no_replan(flip_plan):
     for row in flip.landing["scenarios"]:  # each scenario within its promise
         assert landing_miss(flip, row["burger_on_blade"], models) <= row["r_land"] + 1e-4
     r = max(row["r_land"] for row in flip.landing["scenarios"])
-    near = nominal + (0.0, 0.012)  # outside the hull (y spread ±2σ), landed within r
+    near = nominal + (0.02, 0.0)  # 2 cm toward the tip: outside the hull (x spread ±1.5 cm),
+    # landed within r (off to the side instead, 1.2 cm, the burger lands tilted under 175°)
     assert not covers(flip.landing, near) and landing_miss(flip, near, models) <= r
     assert replan_flip(flip_plan, near) is flip_plan
     far = nominal - (0.06, 0.0)  # 6 cm further back: it lands short by more than r

@@ -109,7 +109,10 @@ class Task:
                      "pickup": tg.pickup_end(cell, pb), "turn_back": home}.get(name)
         self.guess_goal = self.goal or flip_guess_pose(cell, pb)
         n = SAMPLES
-        self.floor = blade_floor(name, cell, n - 1)
+        c = blade_floor(name, cell, n - 1)  # per corner: tip left, tip right, back left, right
+        # the floors of the edges' midpoints (EDGES: tip, heel, left, right), (n, 4)
+        self.floor = np.column_stack([c[:, :2].mean(1), c[:, 2:].mean(1), c[:, ::2].mean(1),
+                                      c[:, 1::2].mean(1)])
         self.p_lo = np.array(cell.limits.p_min, float)
         if name in ("go_to_burger", "scoop", "pickup"):
             self.p_lo[2] -= SCOOP_PRESS + SCOOP_TIP_BAND
@@ -164,7 +167,7 @@ def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> d
     P, A, O = B[0] @ C, B[2] @ C / T**2, B[0] @ D
     R = np.array([rpy_matrix(o) for o in O])
     h = P[:, 2:3] + R[:, 2] @ task.edges  # (n, 4)
-    out = {"grill_clearance": float(np.max(task.floor[:, None] - h)) / 0.01}
+    out = {"grill_clearance": float(np.max(task.floor - h)) / 0.01}
     if task.name == "scoop":
         out["scoop_tip"] = (np.max(np.abs(h[1:-1, 0] - task.tip)) - SCOOP_TIP_BAND) / 0.01
     idx = task.cone_idx(len(P))

@@ -63,7 +63,8 @@ class PlacoTracker:
     Args:
         robot: flipkit robot (URDF, spatula mount, base placement, joint names).
         iterations: Solver iterations per sample (≥ 1).
-        velocity_limits: Enforce the URDF joint velocity limits in the IK.
+        velocity_limits: Enforce the joint velocity limits in the IK (``robot.qd_max``: the
+            arm profile's speeds × the plans' margin, as collocation keeps to).
         w_pos: Weight of the position part of the frame task (soft task).
         w_ori: Weight of the orientation part (per rad against per m).
     """
@@ -84,6 +85,10 @@ class PlacoTracker:
         missing = set(self.joints) - set(self.placo.joint_names())
         if missing:
             raise ConfigError(f"placo model lacks joints {sorted(missing)}")
+        for name, limit, lo, hi in zip(self.joints, robot.qd_max, robot.q_min, robot.q_max):
+            # the bounds a plan keeps to (the arm profile's), not the URDF's own
+            self.placo.set_velocity_limit(name, float(limit))
+            self.placo.set_joint_limits(name, float(lo), float(hi))
         self.placo.set_T_world_fbase(np.asarray(robot.cell.robot.base_in_world, dtype=float))
         self.solver = placo.KinematicsSolver(self.placo)
         self.solver.mask_fbase(True)

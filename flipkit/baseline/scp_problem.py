@@ -77,12 +77,12 @@ class SCPProblem:
         # Linearisation coefficients stacked in few Parameters: setting a Parameter costs
         # cvxpy a validation of its value (measured: 0.3 of a flip's 1.6 s with one Parameter
         # per coefficient vector, 65 per iteration)
-        edge, floor = [], P("floor", n)
+        edge, floor = [], P("floor", (4, n))  # each edge's floor (EDGES' order)
         He, Ce = P("He", (12, n)), P("Ce", (4, n))
         for e in range(4):  # blade edge heights p_z + R[2, :] r_e, linearised in o
             h = pos[:, 2] + Ce[e] + sum(cp.multiply(He[3 * e + j], O[:, j]) for j in range(3))
             edge.append(h)
-            cons.append(h >= floor - 0.01 * sig)
+            cons.append(h >= floor[e] - 0.01 * sig)
         if name in POSED:
             cons += [pos[-1] == P("p_end", 3), O[-1] == P("o_end", 3)]
         if name in REST:
@@ -137,7 +137,7 @@ class SCPProblem:
         values = {"p0": st.p, "v0T": np.asarray(st.v) * T, "o0": st.o, "w0T": np.asarray(st.w) * T,
                   "p_lo": task.p_lo, "p_hi": lim.p_max, "vT": lim.v_max * T,
                   "aT2": lim.a_max * T**2, "pitch_lo": lim.pitch_range[0],
-                  "pitch_hi": lim.pitch_range[1], "floor": task.floor, "tip": task.tip,
+                  "pitch_hi": lim.pitch_range[1], "floor": task.floor.T, "tip": task.tip,
                   "pb_y": task.pb[1], "spot": tg.landing_spot(cell, task.pb),
                   "z_lo": cell.grill.height + tg.FLIP_HEIGHT_BAND[0],
                   "z_hi": cell.grill.height + tg.FLIP_HEIGHT_BAND[1],

@@ -56,11 +56,12 @@ def approach_limits(cell: CellConfig, pb) -> tuple[float, float]:
 
 
 def arrival_floor(cell: CellConfig, N: int) -> np.ndarray:
-    """The go to burger's floor under the blade's corners (m): above the tallest burger
-    until the descent, above the grill during it, pressed into it over the slide."""
-    floor = np.full(N + 1, cell.grill.height)
+    """The go to burger's floor under the blade's corners (m), (N + 1) × 4: above the tallest
+    burger until the descent, above the grill during it, the tip pressed into it over the
+    slide (the back corners on its surface, :func:`~flipkit.behaviors.targets.tip_pressed`)."""
+    floor = np.full((N + 1, 4), cell.grill.height)
     floor[:descent_node(N)] += PHYSICAL_RANGES["burger.thickness"][1] + APPROACH_CLEARANCE
-    floor[slide_node(N):] = cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND
+    floor[slide_node(N):] = tg.tip_pressed(cell, cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND)
     return floor
 
 

@@ -2,10 +2,12 @@
 shared by the flip and the serve; and where the scoop leaves the burger on the blade.
 
 The scoop slides the blade under the burger with its tip pressed SCOOP_PRESS into the grill
-(the grill's contact absorbs it) within ±SCOOP_TIP_BAND, straight (a lateral and attitude
-band: a blade that drifts sideways or yaws pushes the burger), and ends at rest with the
-blade flat: any downward or pitching velocity there would push it through the grill on
-pickup. It brakes within friction once the burger is over the blade.
+(the blade flexes from its neck, and its spring presses the tip onto the grill) within
+±SCOOP_TIP_BAND, straight (a lateral and attitude band: a blade that drifts sideways or yaws
+pushes the burger), and ends at rest with the tip pressed and the blade's back edge on the
+grill's surface (:func:`~flipkit.behaviors.targets.scoop_end`): any downward or pitching
+velocity there would push it through the grill on pickup. The blade's neck never goes below
+the grill's surface (:func:`pressed_floor`). It brakes within friction once the burger is over the blade.
 """
 
 from __future__ import annotations
@@ -27,8 +29,13 @@ from flipkit.transcription.constraints import KinematicBlock
 
 
 def pressed_floor(cell: CellConfig, N: int) -> np.ndarray:
-    """The blade pressed SCOOP_PRESS into the grill, less the tip's band, at every node (m)."""
-    return np.full(N + 1, cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND)
+    """The floor of the blade's corners (m), (N + 1) × 4 in the order of
+    :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS` (tip left, tip right,
+    back left, back right): the tip's corners may be pressed SCOOP_PRESS into the grill (less
+    the tip's band), where the blade flexes; the back corners, at the blade's neck, never go
+    below the grill's surface (a blade flexes from its neck, not at it)."""
+    tip = cell.grill.height - SCOOP_PRESS - SCOOP_TIP_BAND
+    return np.tile(tg.tip_pressed(cell, tip), (N + 1, 1))
 
 
 def scoop_path(ctx) -> list:

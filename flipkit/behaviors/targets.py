@@ -72,10 +72,22 @@ def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
 
 
 def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
-    """End of scoop (eq. 23): blade flat, centred under the burger, pressed ``press`` (m)
-    into the grill."""
-    z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
-    return Pose((float(pb[0]), float(pb[1]), z), (0.0, 0.0, 0.0))
+    """End of scoop (eq. 23): the blade centred under the burger, its tip pressed ``press``
+    (m) into the grill and its back edge, the neck, on the grill's surface: pitched
+    asin(press / l) tip down (1.1° for 3 mm on a 16 cm blade), the pose of a blade that
+    flexes from its neck (the paper's blade lies flat on the grill)."""
+    hg, l = cell.grill.height, cell.spatula.length  # Table I's z differs from h_g by ≤ 1 mm
+    pitch = math.asin(press / l)
+    return Pose((float(pb[0]), float(pb[1]), hg - press / 2), (0.0, pitch, 0.0))
+
+
+def tip_pressed(cell: CellConfig, tip_floor: float) -> np.ndarray:
+    """The floors (m) of the blade's four corners (tip left, tip right, back left, back
+    right: :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS`) when the tip
+    may go down to ``tip_floor``: the back corners, at the neck the blade flexes from, stay
+    on the grill's surface."""
+    hg = cell.grill.height
+    return np.array([tip_floor, tip_floor, hg, hg])
 
 
 def pickup_end(cell: CellConfig, pb) -> Pose:

@@ -92,13 +92,16 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
 
 
 def blade_floor(spec: Subbehavior | str, cell, N: int, task=None) -> np.ndarray:
-    """Lowest height (m) of the blade's four corners at nodes 0..N: the spec's
-    floor, the grill's surface by default; on an approach (``spec.approach``) at least
-    ``task.approach_height`` above the grill until its descent
+    """Lowest height (m) of the blade's four corners at nodes 0..N, (N + 1) × 4 in the order
+    of :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS`: the spec's floor
+    (per node, or per node and corner), the grill's surface by default; on an approach
+    (``spec.approach``) at least ``task.approach_height`` above the grill until its descent
     (:func:`~flipkit.behaviors.approach.descent_node`) when the task sets one."""
     spec = subbehavior(spec) if isinstance(spec, str) else spec
-    floor = (np.full(N + 1, cell.grill.height) if spec.floor is None
-             else np.array(spec.floor(cell, N), float))
+    floor = np.full((N + 1, 4), cell.grill.height)
+    if spec.floor is not None:  # per node, or per node and corner
+        own = np.array(spec.floor(cell, N), float)
+        floor[:] = own if own.ndim == 2 else own[:, None]
     height = None if task is None else task.approach_height
     if spec.approach and height is not None:
         d = descent_node(N)
@@ -126,7 +129,7 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
         KinematicBlock("task_acceleration", L, "acceleration", range(L.n_nodes), -lim.a_max,
                        lim.a_max, scale=0.1),
         KinematicBlock("grill_clearance", L, "blade_heights", moving,
-                       blade_floor(spec, cell, L.N, ctx.task)[1:, None], np.inf, ctx=blade),
+                       blade_floor(spec, cell, L.N, ctx.task)[1:], np.inf, ctx=blade),
     ]
     following = None if spec.coast_into is None else subbehavior(spec.coast_into)
     # a segment that ends moving: the next one's first node interval at its longest (its
@@ -142,7 +145,7 @@ def _common(ctx: Context, models: Models, q_lo, q_hi) -> list:
                                             spec.exempt(L.N, L.N), cell.space.margin))
     if coast is not None:  # the next segment's blade floor at its first node, coasting
         blocks.append(CoastingFloor(L, L.N, coast,
-                                    float(blade_floor(following, cell, L.N, ctx.task)[1]),
+                                    float(blade_floor(following, cell, L.N, ctx.task)[1].max()),
                                     cell.spatula.length, cell.spatula.width))
     # Orientation limits (Constraint 1, eq. 4): the pitch; roll and yaw are free.
     blocks.append(KinematicBlock("task_orientation", L, "pitch", moving, *lim.pitch_range))

@@ -3,9 +3,10 @@ a URScript ``servoj`` program or a ROS 2 JointTrajectory (YAML).
 
 Exit status: 0 written; 2 refused, nothing written — one line on stderr: an unreadable or
 malformed plan, a plan that fails verification (the line names the failed check), an
-unknown format or command, a rate outside [1, 10000] Hz or one that gives fewer than two
-rows (URScript: 500/k Hz), a servoj option outside its range or given for another format, a
-command outside the joint limits, an output whose suffix is not the format's or that is
+unknown format or command, a rate the format does not take (csv and ros2: [100, 1000] Hz;
+urscript: 125, 250 or 500 Hz), a servoj option outside its range or given for another
+format, a stream that fails its check against the arm's published limits (the line names
+the joint, the time and the amount), an output whose suffix is not the format's or that is
 the plan itself.
 """
 
@@ -29,7 +30,11 @@ SERVO = {"lookahead": ("--lookahead", (0.03, 0.2), "s", 0.1,
          "gain": ("--gain", (100.0, 2000.0), "", 300.0, "servoj gain (proportional)"),
          "start_tol": ("--start-tol", (1e-4, 0.1), "rad", 0.01,
                        "the start guard's tolerance per joint")}
-COMMANDS = ("compensated", "raw")
+COMMANDS = ("raw", "compensated")  # servo_command.COMMANDS; raw is DEFAULT_COMMAND
+# The rates each format is written at (flipkit.planning.plans.export.STREAM_RATES and
+# export_urscript.SERVO_RATES): a stream at another rate is refused before any work.
+STREAM_RATES = {"csv": (100.0, 1000.0), "ros2": (100.0, 1000.0)}
+SERVO_RATES = (125.0, 250.0, 500.0)
 
 
 def register(subparsers) -> None:
@@ -51,8 +56,8 @@ def register(subparsers) -> None:
                              "format; not the plan")
     parser.add_argument("--csv", metavar="OUT.csv", help="same as --format csv --out OUT.csv")
     parser.add_argument("--rate", default=str(DEFAULT_RATE), metavar="HZ",
-                        help="controller rate (Hz) in [1, 10000], default 125 (CB3; e-Series "
-                             "500); urscript: 500/k (servoj t = 1/rate, whole 2 ms cycles)")
+                        help="controller rate (Hz), default 125 (CB3; e-Series 500): csv and "
+                             "ros2 in [100, 1000]; urscript 125, 250 or 500 (servoj t = 1/rate)")
     parser.add_argument("--force", action="store_true",
                         help="export even a plan whose status is not 'solved' (it must still "
                              "pass verification)")
@@ -62,9 +67,9 @@ def register(subparsers) -> None:
                                                    f"{' ' + unit if unit else ''}, default "
                                                    f"{default:g}")
     servo.add_argument("--command", metavar="KIND",
-                       help="the positions streamed: compensated (default; as the simulation's "
-                            "position mode, flipkit.planning.plans.servo_command) or raw (the "
-                            "plan's q)")
+                       help="the positions streamed: raw (default; the plan's q, as the paper "
+                            "sends them) or compensated (flipkit.planning.plans.servo_command; "
+                            "refused where it breaks the arm's limits)")
     parser.set_defaults(run=run)
 
 
@@ -108,6 +113,15 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"give --out FILE ({' or '.join(FORMATS[args.format])})")
     check_output(args.out, flag, FORMATS[args.format], inputs=[args.plan])
     args.rate = number("--rate", args.rate, *RATE_RANGE, "Hz")
+    lo, hi = STREAM_RATES.get(args.format, (0.0, 0.0))
+    if args.format == "urscript" and args.rate not in SERVO_RATES:
+        raise ConfigError(f"--rate for urscript must be one of "
+                          f"{', '.join(f'{r:g}' for r in SERVO_RATES)} Hz (servoj t a whole "
+                          f"number of controller cycles: 8 ms on a CB3, 2 ms on an e-Series), "
+                          f"got {args.rate:g}")
+    if args.format != "urscript" and not lo <= args.rate <= hi:
+        raise ConfigError(f"--rate for {args.format} must be in [{lo:g}, {hi:g}] Hz (a "
+                          f"controller's rate), got {args.rate:g}")
     args.servo = servo_options(args)
     precheck_plan(args.plan)
     return deferred("export")(args)

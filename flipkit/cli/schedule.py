@@ -110,7 +110,7 @@ def register(subparsers) -> None:
                         "unless all are flipped and served)")
     p.add_argument("--mode", choices=SIM_MODES, default="position",
                    help="with --simulate: the joint controller, position (default: the "
-                        "robot's servo on compensated commands) or feedforward")
+                        "robot's servo on the plans' own commands) or feedforward")
     p.add_argument("--sense", action="store_true",
                    help="with --simulate: sense-plan-act serves: each serve is re-planned for "
                         "where a camera (error 5 mm per axis, seeded by --seed) sees its "

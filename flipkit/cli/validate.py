@@ -56,15 +56,21 @@ def register(subparsers) -> None:
                         help="joint controller: plan torques + PD (feedforward, default) or "
                              "the robot's PD position control on servo-rate, delayed commands "
                              "with its own gravity compensation (position)")
-    parser.add_argument("--command", choices=("compensated", "raw"), default="compensated",
-                        help="position mode's commands: the plan pre-compensated for the servo "
-                             "(compensated, default; docs/robust-flips.md) or the plan's "
-                             "(q, qd) as they are (raw)")
+    parser.add_argument("--command", choices=("raw", "compensated"), default="raw",
+                        help="position mode's commands, the stream flipkit export writes: the "
+                             "plan's (q, qd) as they are (raw, default; the paper's) or "
+                             "pre-compensated for a modelled servo (compensated; "
+                             "docs/robust-flips.md)")
     parser.add_argument("--servo-lookahead", type=float, default=None, metavar="S",
                         help="with --mode position: the servo smooths its commands as UR's "
                              "servoj does with this lookahead_time, in [0.03, 0.2] s, and the "
                              "commands are made for it (default 0.1, servoj's default); 0: a "
                              "servo without smoothing (docs/robust-flips.md section 3)")
+    parser.add_argument("--servo-form", choices=("pd_gravity", "model_based"), default=None,
+                        help="with --mode position: how the simulated servo follows its "
+                             "smoothed commands: PD plus gravity (pd_gravity, the default) or "
+                             "its model's inverse dynamics (model_based); UR publishes neither "
+                             "(docs/arm-profile.md)")
     parser.add_argument("--replan", action="store_true",
                         help="sense, plan, act: after the scoop, measure where the burger lies "
                              "on the blade and re-plan pickup, flip and turn back for it "

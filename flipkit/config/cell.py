@@ -16,6 +16,7 @@ import numpy as np
 from flipkit.config.checks import box, finite, positive
 from flipkit.config.physics import PhysicsConfig
 from flipkit.config.space import CellBox, SpaceConfig, cell_boxes
+from flipkit.config.arm import DEFAULT_PRESET, DEFAULT_PROFILE, SPEED_MARGIN, arm_profile
 from flipkit.config.urdf import default_urdf, resolve_urdf
 from flipkit.errors import ConfigError
 
@@ -49,6 +50,13 @@ class RobotConfig:
             ``free_motion``: go to burger, turn back), which neither carry nor touch the
             burger: ``inf`` by default, the URDF's torque limits alone bound them, as the arm's
             maker states.
+        profile: The arm as its maker publishes it (:data:`flipkit.config.arm.PROFILES`):
+            its joint limits replace the URDF's, and a URDF of the user's whose limits are
+            looser than the profile's is refused (:class:`flipkit.model.robot.Robot`).
+        speed_margin: Plans keep every joint within this fraction of the profile's speed,
+            in (0, 1] (:data:`flipkit.config.arm.SPEED_MARGIN`, 0.9).
+        safety_preset: The safety system's preset the cell is configured with (one of the
+            profile's presets; default :data:`flipkit.config.arm.DEFAULT_PRESET`).
     """
 
     urdf: str | None = None
@@ -57,8 +65,16 @@ class RobotConfig:
     q_home: tuple = (-0.988933, -1.792774, 2.362261, -0.569486, 0.581863, 1.570796)
     accel_limit: float = 20.0
     free_accel_limit: float = math.inf
+    profile: str = DEFAULT_PROFILE
+    speed_margin: float = SPEED_MARGIN
+    safety_preset: str = DEFAULT_PRESET
 
     def __post_init__(self):
+        arm_profile(self.profile).preset(self.safety_preset)  # both names valid
+        if not (isinstance(self.speed_margin, (int, float)) and not isinstance(
+                self.speed_margin, bool) and 0 < self.speed_margin <= 1):
+            raise ConfigError(f"speed_margin must be a number in (0, 1], got "
+                              f"{self.speed_margin!r}")
         if self.urdf is not None:
             resolve_urdf(self.urdf)  # a path, or a portable name (flipkit.config.urdf)
         base = finite("base_in_world", self.base_in_world, (4, 4))

@@ -21,6 +21,8 @@ if TYPE_CHECKING:  # the cell imports this module
 
 
 BLADE_FLEX = ("contact", "hinge")  # the simulated blade's flex (PhysicsConfig.blade_flex)
+# How the simulated joint servo follows position commands (PhysicsConfig.servo_form)
+SERVO_FORMS = ("pd_gravity", "model_based")
 
 
 SERVOJ_LOOKAHEAD = (0.03, 0.2)  # s, servoj lookahead_time (URScript manual)
@@ -90,11 +92,12 @@ class PhysicsConfig:
             and the burger residue on a griddle add an unknown amount. No source: 1
             (critically damped: a pressed blade does not chatter), range 0.3-2 (ours).
         blade_flex: How the simulated blade flexes (:mod:`flipkit.simulation.scene`, "Blade
-            flex"): ``"contact"`` (default), a rigid blade whose penetration of a compliant
-            blade-grill contact stands for the flex (the blade's faces then sink below the
-            grill's surface by the deflection); ``"hinge"``, the blade on a hinge at its neck
-            with the cantilever's tip stiffness, meeting the grill in a stiff contact (its tip
-            stays on the surface). A modelling choice, not a physical value.
+            flex"): ``"hinge"`` (default), the blade on a hinge at its neck with the
+            cantilever's tip stiffness, meeting the grill in a stiff contact (its tip stays
+            on the surface, as a steel blade's does: it bends, it does not sink); ``"contact"``,
+            a rigid blade whose penetration of a compliant blade-grill contact stands for the
+            flex (the blade's faces then sink below the grill's surface by the deflection).
+            A modelling choice, not a physical value.
         blade_tip_mass: Effective mass (kg) the blade tip presents along the grill normal,
             1/(J M⁻¹ Jᵀ) of the arm with its spatula at the tip, vertical row: measured on the
             scoops of the Table I plans 0.34-0.75 kg (the wrist's small inertia). 0.5 kg;
@@ -128,6 +131,16 @@ class PhysicsConfig:
             compensated commands are made for it
             (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0: no
             smoothing, the held commands reach the PD as they are (no ``servoj`` does that).
+        servo_form: How the joint servo follows the smoothed commands in ``position`` mode,
+            one of :data:`SERVO_FORMS`: ``"pd_gravity"``, the PD above plus the gravity of
+            its model (arm and spatula); ``"model_based"``, the inverse dynamics of that model
+            driving each joint to the smoothed command, its acceleration fed forward and the
+            error closed at ``servo_bandwidth`` (critically damped), as a controller that
+            carries the arm's dynamic model does (UR's controller is told the payload's mass
+            and centre of gravity for that model). UR publishes neither form: the
+            sensitivity study runs both.
+        servo_bandwidth: The ``model_based`` servo's natural frequency (rad/s): 30, range
+            15-60 (ours: a joint position loop of a few hertz; UR publishes none).
     """
 
     mu_grill: float = 0.5
@@ -142,7 +155,7 @@ class PhysicsConfig:
     blade_modulus: float = 193e9
     blade_dampratio: float = 1.0
     blade_tip_mass: float = 0.5
-    blade_flex: str = "contact"
+    blade_flex: str = "hinge"
     timestep: float = 0.0005
     servo_rate_hz: float = 125.0
     latency_s: float = 0.008
@@ -150,12 +163,14 @@ class PhysicsConfig:
     kd: tuple = (120.0, 160.0, 90.0, 6.0, 6.0, 0.4)
     servo_gain_scale: float = 1.0
     servo_lookahead_s: float = SERVOJ_LOOKAHEAD_DEFAULT
+    servo_form: str = "pd_gravity"
+    servo_bandwidth: float = 30.0
 
     def __post_init__(self):
         for name in ("mu_grill", "burger_modulus", "burger_edge_radius", "burger_dampratio", "blade_thickness",
                      "bevel_length", "edge_thickness", "mu_blade_grill", "blade_modulus",
                      "blade_dampratio", "blade_tip_mass",
-                     "timestep", "servo_rate_hz", "servo_gain_scale"):
+                     "timestep", "servo_rate_hz", "servo_gain_scale", "servo_bandwidth"):
             positive(f"physics {name}", getattr(self, name))
         n = self.burger_strips
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1 or n % 2 == 0:
@@ -163,6 +178,8 @@ class PhysicsConfig:
                               f"disc), got {n!r}")
         if self.blade_flex not in BLADE_FLEX:
             raise InvalidChoiceError("physics blade_flex", self.blade_flex, BLADE_FLEX)
+        if self.servo_form not in SERVO_FORMS:
+            raise InvalidChoiceError("physics servo_form", self.servo_form, SERVO_FORMS)
         for name in ("latency_s", "servo_lookahead_s"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value)
@@ -211,9 +228,11 @@ class PhysicsConfig:
         return max(tau, 2 * self.timestep)
 
 
-# PhysicsConfig fields that no plan depends on: numerical settings of the simulation and how
-# the simulated servo treats its commands (the atlas's staleness hash leaves them out)
-SIMULATION_ONLY = ("burger_strips", "servo_lookahead_s")
+# PhysicsConfig fields that no plan depends on: numerical settings of the simulation, how the
+# simulated servo treats its commands and how the simulated blade flexes (the atlas's staleness
+# hash leaves them out)
+SIMULATION_ONLY = ("burger_strips", "servo_lookahead_s", "blade_flex", "servo_form",
+                   "servo_bandwidth")
 
 _NO_SOURCE = "no source found; range ours"
 PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at a time

@@ -55,7 +55,8 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
                     mode: str = FEEDFORWARD, replan: bool = True,
                     perturbations: Perturbations = Perturbations(),
                     rate_hz: float = TRACK_RATE_HZ, nominal: bool = True, executor=None,
-                    cache_dir=None, progress: bool = False, replanned=None) -> dict:
+                    cache_dir=None, progress: bool = False, replanned=None,
+                    servo_form: str | None = None) -> dict:
     """Run the Table I trials of every plan at both ends of every parameter's range.
 
     Args:
@@ -70,6 +71,9 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
         replanned: ``{(name, end): plan texts}``: for a parameter the cell knows and plans for
             (:data:`flipkit.config.PLANNED_PARAMETERS`), the plans made for that setting's
             value (their cell has it); they run instead of ``plan_texts`` there.
+        servo_form: The simulated servo's form (:data:`flipkit.config.physics.SERVO_FORMS`)
+            at every setting; ``None``: the cell's default. UR publishes no form: a study
+            runs once per form.
 
     Returns:
         ``{"plans", "trials", "seed", "mode", "replan", "nominal": counts or None,
@@ -99,12 +103,13 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
             # value) simulates the nominal cell: the nominal job, computed (and cached) once
             same = name is None or with_parameter(cell, name, value) == cell
             new = trial_jobs(text, trials, seed, perturbations, rate_hz, mode, replan,
-                             None if same else {name: value})
+                             None if same else {name: value}, servo_form=servo_form)
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress,
                         desc="sensitivity", dedupe=True)
     out = {"plans": len(plan_texts), "trials": int(trials), "seed": int(seed), "mode": mode,
-           "replan": bool(replan), "nominal": None, "parameters": {}}
+           "replan": bool(replan), "servo_form": servo_form, "nominal": None,
+           "parameters": {}}
     for k, (name, end, value) in enumerate(cases):
         counts = _counts([r for o, r in zip(owner, results) if o == k])
         if name is None:

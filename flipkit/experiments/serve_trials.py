@@ -18,9 +18,8 @@ from __future__ import annotations
 from dataclasses import asdict
 from pathlib import Path
 
-import numpy as np
 
-from flipkit.config import known_physics, with_parameter
+from flipkit.config import PhysicsConfig, known_physics
 from flipkit.config.checks import whole
 from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
@@ -28,9 +27,11 @@ from flipkit.experiments.ratios import success_intervals
 from flipkit.experiments.perturbations import Perturbations, trial_rng
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
+                                            job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
                                             trial_key)
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.planning.planners.serve import replan_serve, table_spot
 from flipkit.planning.plans.verify import require_verified
 from flipkit.simulation.execute import execute_plan
@@ -53,23 +54,22 @@ def run_serve_trial(job: dict) -> dict:
     plan = plan_from_text(job["plan_text"])
     draw = Perturbations(**job["perturbations"]).draw(
         trial_rng(job["seed"], job["trial"], plan.burger["location"]))
-    cell = plan.cell()
-    for name, value in (job.get("physics") or {}).items():
-        cell = with_parameter(cell, name, value)
+    cell = job_cell(plan.cell(), job)
     replan = replan_serve if job.get("replan", False) else None
     mode = job.get("mode", FEEDFORWARD)
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
-                      replan=replan, command=job.get("command", "compensated"),
+                      replan=replan, command=job.get("command", DEFAULT_COMMAND),
                       servo=known_physics(plan.cell().physics, job.get("physics") or {}))
     run, bounds = ex.run, ex.bounds
     spot = table_spot(ex.plan)
-    scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
-    serve = judge_serve(run, spot, cell.table)
-    ok = {"scoop": scoop.ok}
-    ok["pickup"] = ok["scoop"] and pickup.ok
-    ok["serve"] = ok["pickup"] and serve.ok
-    return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, serve),
-            "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "serve": serve.ok},
+    scoop, pickup = judged(judge_scoop, run, bounds["scoop"]), judged(judge_pickup, run,
+                                                                      bounds["pickup"])
+    serve = judge_serve(run, spot, cell.table)  # judged on the run's last state
+    ok, independent, failure = stage_verdicts(
+        {"scoop": scoop, "pickup": pickup, "serve": serve},
+        lambda: _failure(scoop, pickup, serve), ex.safety, bounds)
+    return {"trial": job["trial"], "ok": ok, "failure": failure, "independent": independent,
+            "safety": ex.safety,
             "perturbation": draw, "tracking": ex.errors, "mode": mode,
             "rest": {"xy": [float(v) for v in run.burger_pos[-1, :2]],
                      "distance": serve.distance, "up_z": serve.up_z},
@@ -99,10 +99,10 @@ def _failure(scoop, pickup, serve) -> dict | None:
 def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations(), *,
                    executor=None, cache_dir=None, progress: bool = True,
                    rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
-                   replan: bool = False, command: str = "compensated",
-                   servo_lookahead_s: float | None = None) -> dict:
+                   replan: bool = False, command: str = DEFAULT_COMMAND,
+                   servo_lookahead_s: float | None = None, servo_form: str | None = None) -> dict:
     """Run ``trials`` simulated executions of the serve plan file ``path`` (``servo_lookahead_s``
-    as :func:`flipkit.experiments.trials.validate`).
+    and ``servo_form`` as :func:`flipkit.experiments.trials.validate`).
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "replan", "locations":
@@ -120,13 +120,15 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     require_verified(plan, path, ("serve",))  # nothing unverified is simulated
     whole("trials", trials, 1)
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
-                      replan, servo_physics(servo_lookahead_s), command=command)
+                      replan, servo_physics(servo_lookahead_s), command=command,
+                      servo_form=servo_form)
     results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,
                         desc="trials")
     entry = {"location": plan.burger["location"].tolist(),
              "spot": table_spot(plan).tolist(), "plan": {"status": plan.status,
                                                         "file": str(path)},
              "trials": int(trials),
+             "safety": safety_summary([r.get("safety") for r in results]),
              "success": {s: sum(r["ok"][s] for r in results) for s in SERVE_STAGES},
              "independent": {s: sum(r["independent"][s] for r in results) for s in SERVE_STAGES},
              "failures": [{"trial": r["trial"], **r["failure"], "perturbation": r["perturbation"]}
@@ -136,11 +138,14 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
                        for r in results]}
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
-            "servo_lookahead_s": lookahead_of(servo_lookahead_s), "locations": [entry], "tracking": entry["tracking"],
+            "servo_lookahead_s": lookahead_of(servo_lookahead_s),
+            "servo_form": servo_form or PhysicsConfig().servo_form,
+            "locations": [entry], "tracking": entry["tracking"],
             "summary": {"locations": 1, "trials": int(trials), "success": entry["success"],
                         "interval_95": success_intervals(entry["success"], int(trials)),
                         "independent": entry["independent"],
-                        "pause": pause_summary(entry["rests"]) if replan else None}}
+                        "pause": pause_summary(entry["rests"]) if replan else None,
+                        "safety": entry["safety"]}}
 
 
 __all__ = ["SERVE_STAGES", "run_serve_trial", "validate_serve"]

@@ -7,16 +7,18 @@ from __future__ import annotations
 
 import json
 import tempfile
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 
-from flipkit.config import PhysicsConfig
-from flipkit.config.physics import servo_lookahead
+from flipkit.config import PhysicsConfig, with_parameter
+from flipkit.config.physics import SERVO_FORMS, servo_lookahead
+from flipkit.errors import InvalidChoiceError
 from flipkit.experiments.perturbations import Perturbations, check_seed
 from flipkit.experiments.sweep import stable_hash
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.simulation.modes import FEEDFORWARD
 from flipkit.simulation.scene import NOSLIP_ITERATIONS, SLEEP_TOLERANCE
 
@@ -26,6 +28,9 @@ HOLD_S = 1.0  # s of simulation after the plan ends, for the flipped burger to l
 # (:func:`~flipkit.experiments.perturbations.trial_rng`); part of the cache key, so that a
 # trial drawn another way is never served from the cache.
 DRAWS = "SeedSequence([seed, trial, location in µm])"
+# The safety system's model in the trials (part of the cache key): records made before it, or
+# with another, are not served from the cache.
+SAFETY_MODEL = "protective stop: joint speed, TCP speed, TCP force, momentum, power"
 PLAN_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
              "cone", "segments", "created_by")
 
@@ -45,14 +50,29 @@ def plan_text(plan: Plan) -> str:
 def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbations,
                rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
                replan: bool = False, physics: dict | None = None,
-               command: str = "compensated") -> list:
+               command: str = DEFAULT_COMMAND, servo_form: str | None = None) -> list:
     """The trial jobs of one plan (``physics``: see :func:`flipkit.experiments.trials.run_trial`;
-    the key is left out when empty, so the cache keys of nominal trials do not change)."""
+    ``servo_form``: the simulated servo's form, :data:`flipkit.config.physics.SERVO_FORMS`;
+    each key is left out when empty, so the cache keys of nominal trials do not change)."""
     extra = {"physics": {k: float(v) for k, v in physics.items()}} if physics else {}
+    if servo_form is not None and servo_form != PhysicsConfig().servo_form:
+        if servo_form not in SERVO_FORMS:
+            raise InvalidChoiceError("servo form", servo_form, SERVO_FORMS)
+        extra["servo_form"] = servo_form
     seed = check_seed(seed)
     return [{"plan_text": plan_text, "trial": i, "seed": seed, "draws": DRAWS,
              "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
              "replan": bool(replan), "command": command, **extra} for i in range(trials)]
+
+
+def job_cell(cell, job: dict):
+    """``cell`` with a trial job's simulated physics: its ``physics`` values
+    (:func:`flipkit.config.with_parameter`) and its ``servo_form``."""
+    for name, value in (job.get("physics") or {}).items():
+        cell = with_parameter(cell, name, value)
+    if job.get("servo_form"):
+        cell = replace(cell, physics=replace(cell.physics, servo_form=job["servo_form"]))
+    return cell
 
 
 def servo_physics(lookahead_s: float | None) -> dict | None:
@@ -74,16 +94,104 @@ def lookahead_of(lookahead_s: float | None) -> float:
 def trial_key(job: dict) -> dict:
     """Cache key of a trial job: the plan's digest instead of its text, the contingency
     record's (:mod:`flipkit.experiments.contingent`) instead of it, and the digest of the
-    simulated cell's default physics and of the scene's numerical settings (a changed model,
-    such as the patty's strips or a burger that sleeps at rest, is not served from the
-    cache)."""
+    simulated cell's default physics, of the scene's numerical settings and the safety
+    system's model (a changed model, such as the patty's strips or a burger that sleeps at
+    rest, is not served from the cache)."""
     key = {**{k: v for k, v in job.items() if k != "plan_text"},
            "plan": stable_hash(job["plan_text"]),
            "simulated_physics": stable_hash(asdict(PhysicsConfig())),
-           "scene": {"noslip_iterations": NOSLIP_ITERATIONS, "sleep_tolerance": SLEEP_TOLERANCE}}
+           "scene": {"noslip_iterations": NOSLIP_ITERATIONS, "sleep_tolerance": SLEEP_TOLERANCE},
+           "safety": SAFETY_MODEL}
     if "contingencies" in job:
         key["contingencies"] = stable_hash(job["contingencies"])
     return key
+
+
+def judged(judge, run, span, *args):
+    """``judge(run, span, *args)``, or ``None`` when the run ended before the span began (the
+    arm's safety system stopped it): a stage that never ran is not judged, it failed."""
+    if run.t[-1] < span[0] - 1e-9:
+        return None
+    return judge(run, span, *args)
+
+
+def stage_verdicts(verdicts: dict, first_failure, safety: dict | None, bounds: dict
+                   ) -> tuple[dict, dict, dict | None]:
+    """A trial's ``ok`` (cumulative), ``independent`` and ``failure`` from its judges.
+
+    Args:
+        verdicts: ``{stage: the judge's verdict (``.ok``) or None}`` in stage order; ``None``
+            is a stage the run never reached (:func:`judged`), a failure.
+        first_failure: ``() -> failure dict or None`` from the verdicts, called only when
+            every stage was judged (a stopped run's failure is its protective stop).
+        safety: The run's safety record. bounds: The run's ``{segment: (start, end)}`` (s):
+            the first two stages end with their segments, the last once the plan has ended.
+    """
+    independent = {s: v is not None and v.ok for s, v in verdicts.items()}
+    ok, so_far = {}, True
+    for stage in verdicts:
+        so_far = ok[stage] = so_far and independent[stage]
+    stages = list(verdicts)
+    ends = {s: bounds[s][1] for s in stages[:-1]}
+    ends[stages[-1]] = max(b[1] for b in bounds.values())  # judged once it rests
+    failure = first_failure() if None not in verdicts.values() else None
+    return protective_stop(ok, independent, failure, safety, ends)
+
+
+def protective_stop(ok: dict, independent: dict, failure: dict | None, safety: dict,
+                    ends: dict) -> tuple[dict, dict, dict | None]:
+    """A trial's verdicts after the arm's safety system (:mod:`flipkit.simulation.safety`):
+    a protective stop fails every stage that had not ended when the arm stopped (at least
+    the last), and is the trial's failure (reason ``protective_stop``, amount the value over its limit) unless
+    a stage had already failed before it.
+
+    Args:
+        ok, independent: ``{stage: bool}``, cumulative and each judge on its own.
+        failure: The judges' first failure, or ``None``. safety: The run's safety record.
+        ends: ``{stage: time (s) the stage's judged span ends}``.
+    """
+    stop = safety.get("stop") if safety else None
+    if stop is None:
+        return ok, independent, failure
+    # a stop after every stage's span (the arm holding at the end) still fails the last
+    late = [s for s in ok if ends[s] > stop["time_s"]] or list(ok)[-1:]
+    ok = {s: ok[s] and s not in late for s in ok}
+    independent = {s: independent[s] and s not in late for s in independent}
+    early = failure is not None and failure["stage"] not in late
+    if not early and late:
+        what = stop["quantity"] + (f" ({stop['joint']})" if stop.get("joint") else "")
+        failure = {"stage": late[0], "reason": "protective_stop",
+                   "amount": stop["value"] / stop["limit"],
+                   "detail": f"{what} {stop['value']:.4g} over {stop['limit']:.4g} at "
+                             f"t = {stop['time_s']:.3f} s"}
+    return ok, independent, failure
+
+
+def safety_summary(records: list) -> dict | None:
+    """The safety system over trials (each a ``safety`` record of
+    :meth:`~flipkit.simulation.safety.SafetyMonitor.record`, ``None`` for a trial without one):
+    ``{"preset", "limits", "protective_stops": count, "peaks": {quantity: the worst},
+    "stops": [{"trial", ...the stop}]}``; ``None`` without records."""
+    rows = [(k, r) for k, r in enumerate(records) if r]
+    if not rows:
+        return None
+    first = rows[0][1]
+    peaks = {q: max(r["peaks"][q] for _, r in rows) for q in first["peaks"]}
+    stops = [{"index": k, **r["stop"]} for k, r in rows if r["stop"]]
+    return {"preset": first["preset"], "limits": dict(first["limits"]),
+            "protective_stops": len(stops), "peaks": peaks, "stops": stops}
+
+
+def format_safety(summary: dict | None) -> str:
+    """One line for a report: the preset, the protective stops and the worst peaks."""
+    if summary is None:
+        return "safety system: no trials"
+    p, lim = summary["peaks"], summary["limits"]
+    return (f"safety system ({summary['preset']}): {summary['protective_stops']} protective "
+            f"stops; worst joint speed {p['joint_speed']:.3f} of the published, TCP speed "
+            f"{p['tcp_speed']:.2f} m/s (limit {lim['tcp_speed']:g}), TCP force "
+            f"{p['tcp_force']:.1f} N ({lim['tcp_force']:g}), momentum {p['momentum']:.1f} "
+            f"kg·m/s ({lim['momentum']:g}), power {p['power']:.1f} W ({lim['power']:g})")
 
 
 def merge_tracking(errors: list) -> dict:

@@ -26,7 +26,7 @@ from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP
                                       judge_flip, judge_pickup, judge_scoop)
 from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.config.checks import whole
-from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import plan_filename
 from flipkit.experiments.pauses import pause_summary
@@ -36,11 +36,13 @@ from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.slides import slide_summary
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
+                                            job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
                                             trial_key)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.planning.planners.planner import plan_flip, replan_flip
 from flipkit.planning.plans.verify import require_verified
 from flipkit.simulation.execute import execute_plan
@@ -147,25 +149,24 @@ def run_trial(job: dict) -> dict:
     mode = job.get("mode", FEEDFORWARD)
     draw = Perturbations(**job["perturbations"]).draw(
         trial_rng(job["seed"], job["trial"], plan.burger["location"]))
-    cell = plan.cell()
-    for name, value in (job.get("physics") or {}).items():
-        cell = with_parameter(cell, name, value)
+    cell = job_cell(plan.cell(), job)
     replan = replan_flip if job.get("replan", False) else None
     if replan is not None and "contingencies" in job:
         replan = replanner(plan, job["contingencies"])
-    command = job.get("command", "compensated")
+    command = job.get("command", DEFAULT_COMMAND)
     servo = known_physics(plan.cell().physics, job.get("physics") or {})
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
                       replan=replan, command=command, servo=servo)
     run, bounds, errors = ex.run, ex.bounds, ex.errors
     touch_xy, touch_tilt = _touchdown(run, bounds["flip"][0])
-    scoop, pickup = judge_scoop(run, bounds["scoop"]), judge_pickup(run, bounds["pickup"])
-    flip = judge_flip(run, bounds["flip"], landing_target(ex.plan))
-    ok = {"scoop": scoop.ok}
-    ok["pickup"] = ok["scoop"] and pickup.ok
-    ok["flip"] = ok["pickup"] and flip.ok
-    return {"trial": job["trial"], "ok": ok, "failure": _failure(scoop, pickup, flip, run),
-            "independent": {"scoop": scoop.ok, "pickup": pickup.ok, "flip": flip.ok},
+    scoop, pickup = judged(judge_scoop, run, bounds["scoop"]), judged(judge_pickup, run,
+                                                                      bounds["pickup"])
+    flip = judged(judge_flip, run, bounds["flip"], landing_target(ex.plan))
+    ok, independent, failure = stage_verdicts(
+        {"scoop": scoop, "pickup": pickup, "flip": flip},
+        lambda: _failure(scoop, pickup, flip, run), ex.safety, bounds)
+    return {"trial": job["trial"], "ok": ok, "failure": failure, "independent": independent,
+            "safety": ex.safety,
             "perturbation": draw, "tracking": errors, "mode": mode, "command": command,
             "landing_xy": [float(v) for v in run.burger_pos[-1, :2]],
             "touchdown_xy": touch_xy, "touchdown_tilt_deg": touch_tilt,
@@ -211,6 +212,7 @@ def location_entry(location, trials: int, results: list, plan_info: dict) -> dic
                 "success": dict.fromkeys(STAGES, 0), "independent": dict.fromkeys(STAGES, 0),
                 "failures": fails, "tracking": {}, "landings": []}
     return {"location": list(location), "plan": plan_info, "trials": trials,
+            "safety": safety_summary([r.get("safety") for r in results]),
             "success": {s: sum(r["ok"][s] for r in results) for s in STAGES},
             "independent": {s: sum(r["independent"][s] for r in results) for s in STAGES},
             "failures": [{"trial": r["trial"], **r["failure"], "perturbation": r["perturbation"]}
@@ -253,8 +255,9 @@ def plan_location(job: dict) -> dict:
 def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations = Perturbations(),
              executor=None, cache_dir=None, progress: bool = True,
              rate_hz: float = TRACK_RATE_HZ, mode: str = FEEDFORWARD,
-             replan: bool = False, command: str = "compensated",
-             contingencies: bool = False, servo_lookahead_s: float | None = None) -> dict:
+             replan: bool = False, command: str = DEFAULT_COMMAND,
+             contingencies: bool = False, servo_lookahead_s: float | None = None,
+             servo_form: str | None = None) -> dict:
     """Run ``trials`` simulated executions of each plan, all on one sweep.
 
     Args:
@@ -277,13 +280,17 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
         servo_lookahead_s: Position mode's servo smooths its commands with this lookahead
             (s, ``physics.servo_lookahead_s``; the commands are made for it); 0: it does not;
             ``None``: the cell's default (0.1 s, servoj's default).
+        servo_form: Position mode's servo (:data:`flipkit.config.physics.SERVO_FORMS`);
+            ``None``: the cell's default (``physics.servo_form``).
 
     Returns:
         ``{"seed", "trials", "perturbations", "rate_hz", "mode", "locations": [location_entry ...],
         "tracking": {segment: {"max_m", "rms_m"}} over every trial, "summary": {"locations",
         "trials", "success": {stage: count}, "interval_95": {stage: [low, high]} (the 95 %
         Wilson interval of each ratio, :func:`flipkit.experiments.ratios.success_intervals`),
-        "independent": {stage: count}, "pause": the
+        "independent": {stage: count}, "safety": the arm's safety system over every trial
+        (:func:`flipkit.experiments.trial_jobs.safety_summary`: protective stops and the peaks
+        of joint speed ratio, TCP speed, TCP force, momentum and power), "pause": the
         arm's pauses at the sense (:func:`flipkit.experiments.pauses.pause_summary`; ``None``
         open loop), "slide": how far the burgers slid after they touched the grill
         (:func:`flipkit.experiments.slides.slide_summary`)}}``.
@@ -296,7 +303,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     for k, (_, _, text) in enumerate(targets):
         if text is not None:
             new = trial_jobs(text, int(trials), seed, perturbations, rate_hz, mode, replan,
-                             physics, command=command)
+                             physics, command=command, servo_form=servo_form)
             jobs, owner = jobs + new, owner + [k] * len(new)
     records = {}
     if contingencies and replan:
@@ -313,6 +320,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     return {"seed": int(seed), "trials": int(trials), "perturbations": asdict(perturbations),
             "rate_hz": float(rate_hz), "mode": mode, "replan": bool(replan), "command": command,
             "servo_lookahead_s": lookahead_of(servo_lookahead_s),
+            "servo_form": servo_form or CellConfig().physics.servo_form,
             "contingencies": bool(contingencies and replan),
             "locations": entries,
             "tracking": merge_tracking([r["tracking"] for r in results]),
@@ -322,7 +330,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
                         "independent": {s: sum(e["independent"][s] for e in entries)
                                         for s in STAGES},
                         "pause": pause_summary(landings) if replan else None,
-                        "slide": slide_summary(landings)}}
+                        "slide": slide_summary(landings),
+                        "safety": safety_summary([r.get("safety") for r in results])}}
 
 
 def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:

@@ -13,6 +13,8 @@ import numpy as np
 import pinocchio as pin
 
 from flipkit.config import CellConfig
+from flipkit.config.arm import arm_profile
+from flipkit.config.urdf import default_urdf
 from flipkit.errors import ConfigError
 
 SPATULA_FRAME = "spatula"
@@ -78,6 +80,11 @@ class Robot:
     Args:
         cell: Cell configuration (robot, spatula, burger, gravity).
         with_burger: Add the burger to the payload (it rides on the blade).
+
+    Joint limits are the arm profile's (``cell.robot.profile``, :mod:`flipkit.config.arm`):
+    ``qd_limit`` the published speeds (rad/s), ``qd_max`` the speeds plans keep to
+    (``speed_margin`` of them), ``q_min``/``q_max`` (rad) and ``u_max`` (N·m) within both the
+    URDF's and the profile's.
     """
 
     def __init__(self, cell: CellConfig | None = None, with_burger: bool = False):
@@ -112,11 +119,47 @@ class Robot:
         if self.nq != len(rc.q_home):
             raise ConfigError(f"q_home has {len(rc.q_home)} entries, robot has {self.nq} joints")
         self.q_home = np.array(rc.q_home)
+        self.profile = arm_profile(rc.profile)
+        self._apply_profile(model, default=self.urdf == default_urdf())
+        self.qd_limit = np.array(self.profile.qd_max)
+        self.qd_max = np.minimum(model.velocityLimit, rc.speed_margin * self.qd_limit)
         self.q_min, self.q_max = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
-        self.qd_max = model.velocityLimit.copy()
         self.u_max = model.effortLimit.copy()
         self.qdd_max = np.full(self.nq, rc.accel_limit)
         self.qdd_free = np.full(self.nq, float(rc.free_accel_limit))
+
+    def _apply_profile(self, model, default: bool) -> None:
+        """Hold the model's joint limits to the arm profile's (:mod:`flipkit.config.arm`).
+
+        The package's default URDF (example-robot-data's UR10) rounds UR's joint speeds up
+        (2.16 rad/s for 2.094, 3.2 for 3.142): its limits are cut to the profile's. A URDF of
+        the user's that states looser limits than the profile is refused: it claims an arm
+        the maker does not sell.
+
+        Raises:
+            ConfigError: The URDF's joints are not the profile's, or (a user's URDF) a joint's
+                position range, speed or torque exceeds the profile's.
+        """
+        prof = self.profile
+        names = tuple(model.names[1:])
+        if names != prof.joints:
+            raise ConfigError(f"URDF joints {', '.join(names)} are not the {prof.model}'s "
+                              f"({', '.join(prof.joints)}); choose another arm profile")
+        published = {"speed": (model.velocityLimit, np.array(prof.qd_max), "rad/s"),
+                     "torque": (model.effortLimit, np.array(prof.u_max), "N·m"),
+                     "upper position": (model.upperPositionLimit, np.array(prof.q_range), "rad"),
+                     "lower position": (-model.lowerPositionLimit, np.array(prof.q_range), "rad")}
+        for what, (urdf, limit, unit) in published.items():
+            over = np.flatnonzero(urdf > limit * (1 + 1e-9))
+            if over.size and not default:
+                j = int(over[0])
+                raise ConfigError(f"URDF {self.urdf}: {names[j]}'s {what} limit {urdf[j]:.4g} "
+                                  f"{unit} exceeds the {prof.model}'s published {limit[j]:.4g} "
+                                  f"{unit}; give a URDF within the arm's limits")
+        model.velocityLimit = np.minimum(model.velocityLimit, prof.qd_max)
+        model.effortLimit = np.minimum(model.effortLimit, prof.u_max)
+        model.upperPositionLimit = np.minimum(model.upperPositionLimit, prof.q_range)
+        model.lowerPositionLimit = np.maximum(model.lowerPositionLimit, -np.array(prof.q_range))
 
     def qdd_bound(self, free_motion: bool) -> np.ndarray:
         """Joint acceleration bound (rad/s²) of a segment: :attr:`qdd_free` for a free

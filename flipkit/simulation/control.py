@@ -21,15 +21,10 @@ import pinocchio as pin
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.model.robot import Robot
-from flipkit.planning.plans.servo_command import (command_lead, servo_commands, smoothed,
-                                                  smooths)
+from flipkit.planning.plans.export_urscript import servo_stream
+from flipkit.planning.plans.servo_command import hold_torque, paused, smoothed
 from flipkit.simulation.modes import FEEDFORWARD, POSITION
 from flipkit.simulation.scene import ARM_JOINTS, Scene
-
-
-def paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
-    """Plan times of run times ``t`` (s) when the plan stops at ``t_pause`` for ``pause`` s."""
-    return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
 
 
 def pause_steps(wall_s: float, dt: float, lead_s: float = 0.0) -> float:
@@ -38,19 +33,6 @@ def pause_steps(wall_s: float, dt: float, lead_s: float = 0.0) -> float:
     0 if none."""
     excess = wall_s - lead_s
     return dt * np.ceil(excess / dt - 1e-9) if excess > 0 else 0.0
-
-
-def hold_torque(plan) -> np.ndarray:
-    """The torque (N·m) that holds the plan's final configuration at rest: gravity of the
-    model of its last segment (with the payload that segment carries).
-
-    A plan ends at rest (q̇ = 0), but its last node's torque includes M q̈ of an acceleration
-    that ends there; held after the plan, that torque moved the arm on (measured after a
-    serve's return home: 2.2 cm at the blade within 0.1 s, towards a rest Kp⁻¹ M q̈ away in
-    position mode, 0.04 rad at the elbow)."""
-    last = plan.segments[-1]
-    return np.asarray(plan.robot_for(last).inverse_dynamics(
-        last.q[-1], np.zeros_like(last.q[-1]), np.zeros_like(last.q[-1])), float)
 
 
 def desired(plan, t: np.ndarray, accelerations: bool = False, hold_u=None):
@@ -92,7 +74,9 @@ class References:
             velocities (rad/s), N×6. u_ff: The plan's torques (N·m), N×6. bounds:
             ``{segment: (t_start, t_end)}`` (s). q_cmd, qd_cmd: What the joint PD receives:
             the desired state (feed-forward mode) or position mode's delayed, servo-rate
-            commands (N×6).
+            commands (N×6). qdd_cmd: Position mode's commanded acceleration (rad/s², N×6),
+            the smoothed commands' own, which a ``model_based`` servo feeds forward; ``None``
+            in feed-forward mode.
     """
 
     t: np.ndarray
@@ -102,6 +86,7 @@ class References:
     bounds: dict
     q_cmd: np.ndarray
     qd_cmd: np.ndarray
+    qdd_cmd: np.ndarray | None = None
 
 
 def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: float,
@@ -129,25 +114,24 @@ def plan_references(plan, robot: Robot, physics, mode: str, command: str, dt: fl
     q_des, qd_des, u_ff, bounds = desired(plan, paused(t, t_pause, pause), hold_u=rest)
     bounds = {k: (a + pause if a >= t_pause - 1e-9 else a,
                   b + pause if b > t_pause + 1e-9 else b) for k, (a, b) in bounds.items()}
-    if mode == POSITION:  # servo-rate samples, arriving latency_s late, zero-order hold
-        sent = np.floor(np.maximum(t - physics.latency_s, 0.0) * physics.servo_rate_hz + 1e-9) \
-            / physics.servo_rate_hz
-        lead = command_lead(nominal) if command == "compensated" else 0.0
-        sent, held = np.unique(sent, return_inverse=True)  # one command per servo sample
-        at = paused(sent + lead, t_pause, pause)  # plan times the samples act at
-        # the cell sets its smoothing, so its commands are made for it (they need q̈)
-        q_s, qd_s, u_s, _, *qdd_s = desired(plan, at, smooths(nominal, command), hold_u=rest)
-        q_c, qd_c = servo_commands(plan, sent, at, q_s, qd_s, u_s, (qdd_s or [None])[0],
-                                   robot.model, nominal, command)
+    if mode == POSITION:  # the servoj stream as export writes it, arriving latency_s late
+        rate = physics.servo_rate_hz
+        _, q_c, qd_c = servo_stream(plan, rate, command, lookahead=physics.servo_lookahead_s,
+                                    servo=nominal, t_pause=t_pause, pause=pause)
+        held = np.floor(np.maximum(t - physics.latency_s, 0.0) * rate + 1e-9).astype(int)
+        held = np.minimum(held, len(q_c) - 1)  # after the stream: its last sample, at rest
         # The servo smooths the held stream (if it does), from what it held before the
         # plan: the plan's first state (at rest), not the first command, whose torque
         # compensation and lead the smoothing has yet to reach.
         tau = physics.servo_lookahead_s
         q_cmd = smoothed(q_c[held], dt, tau, start=q_des[0])
         qd_cmd = smoothed(qd_c[held], dt, tau, start=qd_des[0])
+        # the smoothed velocity's rate: the low-pass's own derivative (x − y)/τ, exact
+        qdd_cmd = ((qd_c[held] - qd_cmd) / tau if tau > 0
+                   else np.gradient(qd_cmd, dt, axis=0))
     else:
-        q_cmd, qd_cmd = q_des, qd_des
-    return References(t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd)
+        q_cmd, qd_cmd, qdd_cmd = q_des, qd_des, None
+    return References(t, q_des, qd_des, u_ff, bounds, q_cmd, qd_cmd, qdd_cmd)
 
 
 @dataclass(frozen=True)
@@ -156,10 +140,13 @@ class ArmController:
     control step.
 
     Attributes:
-        robot: The arm; position mode's gravity compensation uses its model.
+        robot: The arm; position mode's gravity compensation (or inverse dynamics) uses its
+            model.
         mode: ``"feedforward"`` or ``"position"``. kp, kd: Joint gains (N·m/rad, N·m s/rad),
             scaled by ``physics.servo_gain_scale``. u_max: Torque limits (N·m).
-        substeps: MuJoCo steps per control step.
+        substeps: MuJoCo steps per control step. form: ``physics.servo_form``.
+        bandwidth: The ``model_based`` servo's natural frequency (rad/s), scaled by
+            √``servo_gain_scale`` (its stiffness by the scale).
     """
 
     robot: Robot
@@ -168,6 +155,8 @@ class ArmController:
     kd: np.ndarray
     u_max: np.ndarray
     substeps: int
+    form: str = "pd_gravity"
+    bandwidth: float = 30.0
 
     @classmethod
     def of(cls, robot: Robot, physics, mode: str, rate_hz: float, timestep: float
@@ -175,10 +164,19 @@ class ArmController:
         """The controller at ``rate_hz`` (Hz) over a MuJoCo ``timestep`` (s)."""
         kp, kd = (np.asarray(g) * physics.servo_gain_scale for g in (physics.kp, physics.kd))
         return cls(robot, mode, kp, kd, robot.u_max,
-                   max(1, int(round(1.0 / (rate_hz * timestep)))))
+                   max(1, int(round(1.0 / (rate_hz * timestep)))), physics.servo_form,
+                   physics.servo_bandwidth * physics.servo_gain_scale ** 0.5)
 
     def torque(self, refs: References, k: int, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """Joint torques (N·m) at sample k of ``refs`` from the measured q (rad), q̇ (rad/s)."""
+        """Joint torques (N·m) at sample k of ``refs`` from the measured q (rad), q̇ (rad/s):
+        feed-forward mode's plan torque plus the PD; position mode's servo
+        (``physics.servo_form``): the PD plus gravity, or the model's inverse dynamics at
+        the commanded acceleration plus a critically damped correction at ``bandwidth``."""
+        if self.mode != FEEDFORWARD and self.form == "model_based":
+            w = self.bandwidth
+            a = refs.qdd_cmd[k] + w * w * (refs.q_cmd[k] - q) + 2 * w * (refs.qd_cmd[k] - qd)
+            u = pin.rnea(self.robot.model, self.robot.data, q, qd, a).copy()
+            return np.minimum(np.maximum(u, -self.u_max, out=u), self.u_max, out=u)
         ff = refs.u_ff[k] if self.mode == FEEDFORWARD else pin.computeGeneralizedGravity(
             self.robot.model, self.robot.data, q)
         u = ff + self.kp * (refs.q_cmd[k] - q) + self.kd * (refs.qd_cmd[k] - qd)

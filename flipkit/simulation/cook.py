@@ -8,8 +8,8 @@ burger–burger contact). On the cook's clock (s, the timeline's):
   before that it is parked out of the cell (below the floor, held against gravity);
 * the arm runs the timeline's motions at their start times, each plan stepped by
   :func:`~flipkit.simulation.control.step_references` with the controller of
-  :func:`~flipkit.simulation.execute.execute_plan` (default: position mode, compensated
-  commands — the robot's own servo; feed-forward as an option), from whatever state the
+  :func:`~flipkit.simulation.execute.execute_plan` (default: position mode, the plans'
+  own commands — the robot's own servo; feed-forward as an option), from whatever state the
   previous motion left (no reset: a burger lies where it landed, the arm where it stopped);
 * after a motion the arm holds its plan's last command for at least
   :data:`~flipkit.simulation.execute.HOLD_S` (less when the next motion starts sooner), then
@@ -52,7 +52,7 @@ import numpy as np
 from flipkit.config import CellConfig, SensingUncertainty
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
-from flipkit.planning.plans.servo_command import COMMANDS
+from flipkit.planning.plans.servo_command import COMMANDS, DEFAULT_COMMAND
 from flipkit.simulation.control import ArmController, plan_references, step_references
 from flipkit.simulation.cook_judges import BurgerResult, judge_burger
 from flipkit.simulation.cook_record import CookRecorder, Watch
@@ -146,7 +146,7 @@ def _check(timeline, mode: str, command: str, kinds_needed=("flip", "serve")) ->
     return list(timeline.motions)
 
 
-def simulate_cook(timeline, *, mode: str = POSITION, command: str = "compensated",
+def simulate_cook(timeline, *, mode: str = POSITION, command: str = DEFAULT_COMMAND,
                   cell: CellConfig | None = None, rate_hz: float = 1000.0,
                   film_fps: float = 0.0, step_idle: bool = False, sense_serve=None,
                   sense_blade=None, sensing_sigma: float = SENSING_SIGMA,

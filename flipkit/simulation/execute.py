@@ -13,9 +13,12 @@ decides how hard it pushes. Two controllers (``mode``):
   (``physics.servo_rate_hz``, zero-order hold) and arrive ``physics.latency_s`` late; the
   controller adds gravity compensation from *its own* model — the arm with the spatula as its
   configured payload, not the burger (a UR controller knows only the payload it is told) —
-  evaluated at the measured q, plus the same PD. The commands are the plan's (q, q̇)
-  pre-compensated for that servo (:mod:`flipkit.planning.plans.servo_command`), or as they are
-  (``command="raw"``).
+  evaluated at the measured q, plus the same PD (or, ``physics.servo_form`` "model_based",
+  its model's inverse dynamics). The commands are the stream the URScript export writes
+  (:func:`~flipkit.planning.plans.export_urscript.servo_stream`): the plan's (q, q̇) as they
+  are (``command="raw"``, the default), or pre-compensated for that servo
+  (:mod:`flipkit.planning.plans.servo_command`). The arm's safety system watches every step
+  (:mod:`flipkit.simulation.safety`).
 
 The plant's burger (mass, friction, placement, grill height) follows the trial's perturbation
 draw; the plan's feed-forward ignores it. After the plan the last desired state is held for
@@ -32,7 +35,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from flipkit.planning.plans.servo_command import COMMANDS
+from flipkit.planning.plans.servo_command import COMMANDS, DEFAULT_COMMAND
 from flipkit.simulation.run import BurgerRun
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
@@ -43,6 +46,7 @@ from flipkit.simulation.control import (ArmController, References, pause_steps,
 from flipkit.simulation.modes import FEEDFORWARD, MODES
 from flipkit.simulation.patty import scoop_heading
 from flipkit.simulation.scene import ARM_JOINTS, Scene, build_scene, place_burger
+from flipkit.simulation.safety import SafetyMonitor
 from flipkit.simulation.trace import BurgerTrace
 
 HOLD_S = 1.0  # s after the plan at most: the flipped burger lands
@@ -95,6 +99,8 @@ class Execution:
             sense (:data:`SENSE_LEAD`): a flip's whole replan time, a serve's beyond the
             lead, else 0. A replanned run holds the arm at rest that long (rounded up to a
             control step) at the sensed segment's end. ``None`` open loop.
+        safety: The safety system's record (:meth:`~flipkit.simulation.safety.SafetyMonitor.
+            record`): the preset, its limits, the run's peaks and the protective stop, if any.
     """
 
     run: BurgerRun
@@ -112,6 +118,7 @@ class Execution:
     replan_failure: str | None = None
     replan_time_s: float | None = None
     replan_wait_s: float | None = None
+    safety: dict | None = None
 
 
 def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> dict:
@@ -132,7 +139,8 @@ def _check(plan, mode: str, draw: dict | None, hold: float, rate_hz: float) -> d
 def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
                  cell: CellConfig | None = None, physics=None, hold: float = HOLD_S,
                  rate_hz: float = 1000.0, replan=None,
-                 command: str = "compensated", servo=None) -> Execution:
+                 command: str = DEFAULT_COMMAND, servo=None,
+                 safety_stop: bool = True) -> Execution:
     """Execute a flip or serve plan closed-loop in the MuJoCo cell with the burger on the grill.
 
     Args:
@@ -153,10 +161,11 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             ends sooner once the burger has settled (:data:`SETTLED_MOTION`).
         rate_hz: Joint controller rate (Hz); a multiple of it should be the MuJoCo rate.
         command: ``position`` mode's command stream, one of
-            :data:`~flipkit.planning.plans.servo_command.COMMANDS`: ``"compensated"`` (default) sends
-            q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by the modelled latency and half a servo period,
-            ``"raw"`` the plan's (q, q̇) as they are. Commands use ``servo``; the servo itself
-            follows ``cell.physics``.
+            :data:`~flipkit.planning.plans.servo_command.COMMANDS`: ``"raw"`` (default) the
+            plan's (q, q̇) as they are, ``"compensated"`` q_d + Kp⁻¹(u_d − g_c(q_d)) ahead by
+            the modelled latency and half a servo period; either is the stream the URScript
+            export writes (:func:`~flipkit.planning.plans.export_urscript.servo_stream`).
+            Commands use ``servo``; the servo itself follows ``cell.physics``.
         servo: The cell's model of its servo for position commands (a
             :class:`~flipkit.config.PhysicsConfig`: rate, latency, gains); default the plan's
             nominal one. A cell that knows a parameter (its controller's servo rate) passes
@@ -174,6 +183,9 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             runs on (``replan_failure`` says why). The arm holds at rest at the sensed
             segment's end for the replan's measured wall time beyond the lead (a flip's: all
             of it), in whole control steps, so the executed duration includes it.
+        safety_stop: The arm's safety system (:class:`~flipkit.simulation.safety.
+            SafetyMonitor`, the cell's preset) ends the run at the first excess, a protective
+            stop; ``False`` only records the peaks. Either way ``execution.safety`` holds them.
 
     Returns:
         The :class:`Execution`; ``execution.plan`` is the plan finally executed.
@@ -246,15 +258,24 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             raise ConfigError("the replanned run does not extend the executed one")
         return new_refs
 
+    safety = SafetyMonitor(robot, enabled=safety_stop)
+
     def record(k: int, q: np.ndarray, u: np.ndarray) -> None:
         qa[k], ua[k], qpos[k] = q, u, d.qpos
         trace(k)
+        safety(refs_now[0].t[k], q, d.qvel[:ARM_JOINTS], trace.fbg[k] + trace.fbt[k])
 
     w = max(1, int(round(SETTLED_WINDOW / dt)))
     plan_end = [None, 0.0]  # the references' bounds it was computed for, the plan's end (s)
 
+    refs_now = [refs]  # the references being run (a replan replaces them)
+
     def settled(k: int, refs: References) -> bool:
-        """After the plan's last segment and a window more: the burger has settled."""
+        """A protective stop ends the run; otherwise, after the plan's last segment and a
+        window more: the burger has settled."""
+        refs_now[0] = refs
+        if safety.tripped:
+            return True
         if plan_end[0] is not refs.bounds:  # a replan brings new references
             plan_end[:] = refs.bounds, max(b[1] for b in refs.bounds.values())
         if k <= w or refs.t[k] < plan_end[1] + SETTLED_WINDOW:
@@ -275,7 +296,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
     errors = _errors(robot, t, qa, q_des, bounds)
     return Execution(run, bounds, errors, qa, q_des, ua, qpos, tr.fbg, mode, scene, plan,
                      None if sensed is None else [float(v) for v in sensed], replan_failure,
-                     replan_time, sense["wait"])
+                     replan_time, sense["wait"], safety.record())
 
 
 def _errors(robot, t, q, q_des, bounds) -> dict:
@@ -285,6 +306,8 @@ def _errors(robot, t, q, q_des, bounds) -> dict:
     out = {}
     for name, (t0, t1) in bounds.items():
         sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
+        if not sel.any():  # a run stopped (protective stop) before the segment
+            continue
         out[name] = {"max_m": float(e[sel].max()), "sum_sq_m2": float(np.sum(e[sel] ** 2)),
                      "n": int(sel.sum())}
     return out

@@ -24,7 +24,7 @@ class BurgerTrace:
         sp, sr: The spatula frame's, the same shapes.
         ts, tg: Burger–blade and burger–grill contact flags (N,).
         fs, fg, fbg: Summed normal forces (N) of the burger–blade, burger–grill and
-            blade–grill contacts (N,).
+            blade–grill contacts (N,). fbt: The blade–table contacts' (N,).
 
     Args:
         scene: The scene whose ``data`` is read. n: Samples to hold.
@@ -38,11 +38,12 @@ class BurgerTrace:
         self._br, self._sr = np.zeros((n, 9)), np.zeros((n, 9))
         self.ts, self.tg = np.zeros(n, bool), np.zeros(n, bool)
         self.fs, self.fg, self.fbg = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.fbt = np.zeros(n)
         g, ngeom = scene.geoms, scene.model.ngeom
         # the slot of each geom pair: 0 not recorded, 1 blade-grill, 2 burger-blade,
-        # 3 burger-grill (every strip of the patty is the burger)
+        # 3 burger-grill (every strip of the patty is the burger), 4 blade-table
         self._slot = np.zeros((ngeom, ngeom), np.intp)
-        pairs = [(g["blade"], g["grill"], 1)]
+        pairs = [(g["blade"], g["grill"], 1), (g["blade"], g["table"], 4)]
         for part in scene.burger_geoms[0]:
             pairs += [(part, g["blade"], 2), (part, g["grill"], 3)]
         for a, b, slot in pairs:
@@ -70,9 +71,9 @@ class BurgerTrace:
         if d.ncon:
             pairs, force = self.scene.contact_arrays()
             slot = self._slot[pairs[:, 0], pairs[:, 1]]
-            sums = np.bincount(slot, weights=force, minlength=4)
-            seen = np.bincount(slot, minlength=4)
-            self.fbg[k], self.fs[k], self.fg[k] = sums[1:]
+            sums = np.bincount(slot, weights=force, minlength=5)
+            seen = np.bincount(slot, minlength=5)
+            self.fbg[k], self.fs[k], self.fg[k], self.fbt[k] = sums[1:]
             self.ts[k], self.tg[k] = seen[2] > 0, seen[3] > 0
         if k and self.sleeps and not d.body_awake[b]:
             self.ts[k], self.tg[k] = self.ts[k - 1], self.tg[k - 1]
@@ -80,6 +81,6 @@ class BurgerTrace:
 
     def trimmed(self, n: int) -> "BurgerTrace":
         """This trace cut to its first n samples (views, not copies)."""
-        for name in ("bp", "sp", "_br", "_sr", "ts", "tg", "fs", "fg", "fbg"):
+        for name in ("bp", "sp", "_br", "_sr", "ts", "tg", "fs", "fg", "fbg", "fbt"):
             setattr(self, name, getattr(self, name)[:n])
         return self

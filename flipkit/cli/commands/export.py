@@ -14,7 +14,8 @@ from flipkit.planning.plans.plan_file import Plan
 def run(args: argparse.Namespace) -> int:
     """Load, verify, resample, write; one line with the count written."""
     plan = Plan.load(args.plan)
-    common = {"force": args.force, "where": args.plan}
+    checks = []
+    common = {"force": args.force, "where": args.plan, "on_check": checks.append}
     if args.format == "urscript":
         options = ServoOptions(**args.servo)
         count = write_urscript(plan, args.out, args.rate, options, **common)
@@ -25,5 +26,6 @@ def run(args: argparse.Namespace) -> int:
         count, what = write_csv(plan, args.out, args.rate, **common), "rows"
     total = plan.duration
     print(f"flipkit export: wrote {count} {what} ({total:.3f} s at {args.rate:g} Hz) to "
-          f"{args.out}")
+          f"{args.out}; stream checked against the {plan.cell().robot.profile} profile: "
+          f"{checks[0].summary()}")
     return 0

@@ -13,6 +13,7 @@ from flipkit.experiments.pauses import format_pauses
 from flipkit.experiments.ratios import format_intervals
 from flipkit.experiments.slides import format_slides
 from flipkit.experiments.sweep import make_executor
+from flipkit.experiments.trial_jobs import format_safety
 from flipkit.experiments.trials import validate_locations, validate_plan_file
 from flipkit.planning.plans.verify import load_verified
 
@@ -26,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
                               f"{plan.behavior} plan")
     common = dict(progress=not args.no_progress, rate_hz=args.rate, mode=args.mode,
                   replan=args.replan, command=args.command,
-                  servo_lookahead_s=args.servo_lookahead,
+                  servo_lookahead_s=args.servo_lookahead, servo_form=args.servo_form,
                   **({"contingencies": True} if args.contingencies else {}))
     with make_executor(args.scheduler, args.workers) as executor:
         if args.plan is not None:
@@ -44,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
           f"{total['locations']} locations, "
           f"success {total['success']}; wrote {args.json}")
     print(format_intervals(total["interval_95"]))
+    print(format_safety(total.get("safety")))
     if out.get("replan") and "pause" in total:  # a flip validation's re-plans
         print(format_pauses(total["pause"]))
     if total.get("slide"):  # a flip validation's landings

@@ -1,36 +1,50 @@
-"""Resample a verified plan at a controller rate and write it as CSV.
+"""Resample a verified plan at a controller rate, check the stream as written, write it as CSV.
 
-A controller only gets verified plans: :func:`write_csv` runs
-:func:`flipkit.planning.plans.verify.verify_plan` first and writes nothing if the plan fails it
-(``--force`` waives the plan's *status*, never the verification).
+A controller only gets verified plans and verified streams: :func:`write_csv` runs
+:func:`flipkit.planning.plans.verify.verify_plan` first, then makes the file's text, reads it
+back (:mod:`~flipkit.planning.plans.stream_parse`) and checks it against the arm's published
+limits (:func:`check_written`, :mod:`~flipkit.planning.plans.stream_check`); it writes nothing
+if either fails (``--force`` waives the plan's *status*, never a check).
 
 Within a segment the collocation fixes (q, q̇, q̈) at the nodes; between two consecutive
-nodes q is the cubic Hermite interpolant of (q, q̇) and q̇ that of (q̇, q̈)
+nodes q is the cubic Hermite interpolant of (q, q̇)
 (:class:`scipy.interpolate.CubicHermiteSpline`), so a trajectory that is cubic in time —
-which Hermite–Simpson collocation represents exactly — is reproduced exactly. Segments are
+which Hermite–Simpson collocation represents exactly — is reproduced exactly, and q̇ and q̈
+are its derivatives: a stream's (q, q̇) are one C¹ trajectory, which a controller's spline
+through them reproduces (a q̇ interpolated on its own disagrees with q's slope between nodes,
+and a spline through both then swings), and the one :func:`flipkit.planning.plans.verify`
+bounds. Segments are
 concatenated on a global clock; a sample on a segment boundary is taken from the later
 segment (both agree on a continuous plan). Samples are at t_j = j / rate, j = 0 ..
-⌊T_total · rate⌋; the last one is at most 1/rate before the end. :func:`evaluate` gives the
-same interpolant (and u, linear between nodes) at any times; the URScript and ROS 2 writers
+⌊T_total · rate⌋, and then at T_total itself when the last of those falls before it, so that a
+stream ends where the plan does, at rest. :func:`evaluate` gives the same interpolant (and u,
+linear between nodes) at any times; the URScript and ROS 2 writers
 (:mod:`~flipkit.planning.plans.export_urscript`, :mod:`~flipkit.planning.plans.export_ros2`)
-build on these two.
+build on these.
 """
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
-from flipkit.errors import FlipkitError
+from flipkit.errors import ConfigError, FlipkitError
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.fileio import replace_with
+from flipkit.fileio import write_text
+from flipkit.planning.plans.stream_check import StreamCheck, check_stream, require_stream
+from flipkit.planning.plans.stream_parse import PARSERS
 from flipkit.planning.plans.verify import TOL, require_verified
 
 MAX_ROWS = 10_000_000  # refuse absurd rates rather than fill the disk
-RATE_RANGE = (1.0, 10_000.0)  # Hz: controller rates accepted
+RATE_RANGE = (1.0, 10_000.0)  # Hz: rates a plan is resampled at
+STREAM_RATES = {"csv": (100.0, 1000.0), "ros2": (100.0, 1000.0)}
+"""Hz: the rates each sampled format is written at, a controller's (ros2_control and UR's
+own run between 125 and 500 Hz); URScript's are its servo periods
+(:data:`flipkit.planning.plans.export_urscript.SERVO_RATES`)."""
 _EPS = 1e-9  # s, slack on the last sample time (floating-point T_total · rate)
 
 
@@ -71,19 +85,47 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
         raise FlipkitError(f"export would write {n} rows ({total:.3f} s at {rate:g} Hz); "
                            f"the limit is {MAX_ROWS}")
     t = np.arange(n) / rate
+    if t[-1] < total - _EPS:
+        t = np.append(t, total)
     q, qd, _ = evaluate(plan, t)
     return t, q, qd
+
+
+def check_rate(fmt: str, rate) -> float:
+    """``rate`` (Hz) if the format ``fmt`` takes it (:data:`STREAM_RATES`), else ConfigError:
+    a rate outside them is refused before any work."""
+    rate = _check_rate(rate)
+    lo, hi = STREAM_RATES[fmt]
+    if not lo <= rate <= hi:
+        raise ConfigError(f"{fmt} rate must be in [{lo:g}, {hi:g}] Hz (a controller's rate), "
+                          f"got {rate:g}")
+    return rate
+
+
+def check_written(plan: Plan, fmt: str, text: str, where: str, robot=None) -> StreamCheck:
+    """The stream of an export's ``text`` (format ``fmt``) read back and checked against the
+    plan and the arm's published limits (:func:`~flipkit.planning.plans.stream_check.
+    check_stream`).
+
+    Raises:
+        ExportError: A check fails (the message names the joint, the time and the amount).
+    """
+    stream = PARSERS[fmt](text)
+    report = check_stream(plan, stream.t, stream.q, stream.qd,
+                          interpolation=stream.interpolation, q_start=stream.q_start,
+                          robot=robot, evaluate=evaluate)
+    return require_stream(report, where)
 
 
 def evaluate(plan: Plan, t, accelerations: bool = False):
     """The plan's interpolant at times ``t`` (s, from the plan's start).
 
-    q and q̇ are as in :func:`resample`, u (N·m) is linear between nodes (as the simulation's
-    feed-forward). A time outside [0, T_total] takes the first or last node's values.
+    q is the cubic Hermite of (q, q̇) and q̇ its derivative (module docstring), u (N·m) is
+    linear between nodes (as the simulation's feed-forward). A time outside [0, T_total] takes the first or last node's values.
 
     Args:
         plan: The plan. t: Times (n,) (s), any order.
-        accelerations: Also return q̈ (n, nq) (rad/s²), the derivative of q̇'s interpolant.
+        accelerations: Also return q̈ (n, nq) (rad/s²), q's second derivative.
 
     Returns:
         (q, qd, u): positions (n, nq) (rad), velocities (n, nq) (rad/s), torques (n, nq) (N·m);
@@ -101,17 +143,16 @@ def evaluate(plan: Plan, t, accelerations: bool = False):
         if not rows.any():
             continue
         local = np.clip(t[rows] - starts[k], 0.0, seg.T)
-        q[rows] = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)(local)
-        rate = CubicHermiteSpline(seg.t, seg.qd, seg.qdd, axis=0)
-        qd[rows] = rate(local)
+        spline = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0)
+        q[rows], qd[rows] = spline(local), spline(local, 1)
         if accelerations:
-            qdd[rows] = rate(local, 1)
+            qdd[rows] = spline(local, 2)
         u[rows] = np.column_stack([np.interp(local, seg.t, seg.u[:, j]) for j in range(nq)])
     return (q, qd, u, qdd) if accelerations else (q, qd, u)
 
 
 def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL,
-              where=None) -> int:
+              where=None, on_check=None) -> int:
     """Verify ``plan``, then write ``t,q1..qn,qd1..qdn`` (s, rad, rad/s) at ``rate`` to
     ``path``; return the row count.
 
@@ -121,19 +162,30 @@ def write_csv(plan: Plan, path, rate: float, *, force: bool = False, tol: float 
         plan: The plan. path: Output CSV. rate: Controller rate (Hz).
         force: Export even a plan whose status is not ``solved`` (it must still verify).
         tol: Verification tolerance (scaled units, :data:`flipkit.planning.plans.verify.TOL`).
+        on_check: Called with the stream's check
+            (:class:`~flipkit.planning.plans.stream_check.StreamCheck`) once it passed.
         where: How messages name the plan (its file); default ``"plan"``.
 
     Raises:
         VerificationError: The plan is not solved (without ``force``) or fails the
             independent check (the message names the worst
             check group, its segment and amount); nothing is written.
-        FlipkitError: As :func:`resample`, or the file cannot be written.
+        ExportError: The stream as written fails its check (:func:`check_written`); nothing
+            is written.
+        FlipkitError: As :func:`resample`, a rate outside :data:`STREAM_RATES`, or the file
+            cannot be written.
     """
-    t, q, qd = resample(plan, rate, force=force)
-    require_verified(plan, "plan" if where is None else where, force=force, tol=tol)
+    where = "plan" if where is None else str(where)
+    t, q, qd = resample(plan, check_rate("csv", rate), force=force)
+    require_verified(plan, where, force=force, tol=tol)
     nq = q.shape[1]
     header = ",".join(["t"] + [f"q{j + 1}" for j in range(nq)] + [f"qd{j + 1}" for j in range(nq)])
-    replace_with(Path(path), lambda tmp: np.savetxt(tmp, np.column_stack([t, q, qd]),
-                                                    delimiter=",", header=header, comments="",
-                                                    fmt="%.17g"))
+    buffer = io.StringIO()
+    np.savetxt(buffer, np.column_stack([t, q, qd]), delimiter=",", header=header, comments="",
+               fmt="%.17g")
+    text = buffer.getvalue()
+    checked = check_written(plan, "csv", text, where)
+    if on_check is not None:
+        on_check(checked)
+    write_text(Path(path), text)
     return t.size

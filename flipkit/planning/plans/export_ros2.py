@@ -11,9 +11,10 @@ The document is the message as ``ros2 topic pub`` and the ``trajectory`` field o
       time_from_start: {sec: s, nanosec: ns}
 
 The points are the samples of :func:`flipkit.planning.plans.export.resample` (t_j = j / rate on
-the plan's own clock), and, when the last sample falls before the plan's end, the plan's last
-node (its final q and q̇, the arm at rest) at T_total, so the trajectory ends where the plan
-does. Positions and velocities are the plan's as planned: the servo compensation of the
+the plan's own clock, and the plan's end at T_total, the arm at rest), so the trajectory ends
+where the plan does. The message is read back from its own text and checked against the
+arm's published limits, with the controller's cubic spline between points, before it is
+written (:func:`~flipkit.planning.plans.export.check_written`). Positions and velocities are the plan's as planned: the servo compensation of the
 URScript export (:mod:`flipkit.planning.plans.servo_command`) is not applied, since the
 controller that follows the message interpolates between points itself. Numbers are written
 in full (``repr``, round-trip exact).
@@ -28,7 +29,7 @@ import yaml
 from flipkit.errors import ExportError
 from flipkit.fileio import write_text
 from flipkit.model.robot import Robot
-from flipkit.planning.plans.export import resample
+from flipkit.planning.plans.export import check_rate, check_written, resample
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify import TOL, require_verified
 
@@ -53,17 +54,12 @@ def trajectory(plan: Plan, rate: float, *, force: bool = False) -> dict:
         ExportError: The plan's URDF names its joints otherwise than :data:`JOINT_NAMES`.
         FlipkitError: As :func:`~flipkit.planning.plans.export.resample`.
     """
-    t, q, qd = resample(plan, rate, force=force)
+    t, q, qd = resample(plan, check_rate("ros2", rate), force=force)
     names = tuple(Robot(plan.cell(), with_burger=False).model.names[1:])
     if names != JOINT_NAMES:
         raise ExportError(f"ros2 export needs the joints {', '.join(JOINT_NAMES)}; the plan's "
                           f"URDF has {', '.join(names)}")
-    stamps = [round(x * 1e9) for x in t]
-    last = plan.segments[-1]
-    end = round(plan.duration * 1e9)
-    samples = list(zip(stamps, q, qd))
-    if end > stamps[-1]:
-        samples.append((end, last.q[-1], last.qd[-1]))
+    samples = list(zip((round(x * 1e9) for x in t), q, qd))
     points = [{"positions": [float(x) for x in pos], "velocities": [float(x) for x in vel],
                "time_from_start": duration(ns / 1e9)} for ns, pos, vel in samples]
     return {"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""},
@@ -84,21 +80,28 @@ def ros2_text(plan: Plan, message: dict, rate: float, where: str) -> str:
 
 
 def write_ros2(plan: Plan, path, rate: float, *, force: bool = False, tol: float = TOL,
-               where=None) -> int:
+               where=None, on_check=None) -> int:
     """Verify ``plan``, then write its JointTrajectory YAML to ``path``; return the point count.
 
     Args:
         plan: The plan. path: Output file (.yaml). rate: Sampling rate (Hz).
         force: Export even a plan whose status is not ``solved`` (it must still verify).
         tol: Verification tolerance (:data:`flipkit.planning.plans.verify.TOL`).
+        on_check: Called with the stream's check
+            (:class:`~flipkit.planning.plans.stream_check.StreamCheck`) once it passed.
         where: How messages and the file's header name the plan; default ``"plan"``.
 
     Raises:
         VerificationError: The plan fails verification; nothing is written.
-        ExportError, FlipkitError: As :func:`trajectory`, or the file cannot be written.
+        ExportError: The message as written fails its stream check; nothing is written.
+        FlipkitError: As :func:`trajectory`, or the file cannot be written.
     """
     where = "plan" if where is None else str(where)
     message = trajectory(plan, rate, force=force)
     require_verified(plan, where, force=force, tol=tol)
-    write_text(Path(path), ros2_text(plan, message, rate, Path(where).name))
+    text = ros2_text(plan, message, rate, Path(where).name)
+    checked = check_written(plan, "ros2", text, where)
+    if on_check is not None:
+        on_check(checked)
+    write_text(Path(path), text)
     return len(message["points"])

@@ -77,6 +77,27 @@ def _created_by() -> dict:
 _ROBOT_KEYS = ("urdf", "base_in_world", "tool_parent_frame", "spatula_in_parent", "payload",
                "q_home")
 _BURGER_KEYS = ("location", "diameter", "thickness", "mass", "mu")
+ARM_KEYS = ("profile", "speed_margin", "safety_preset")
+
+
+def arm_record(record) -> dict:
+    """The plan's ``robot.arm`` record checked: ``{"profile", "speed_margin",
+    "safety_preset"}`` (:class:`~flipkit.config.RobotConfig`'s fields); a file written
+    without it gets the defaults, against which ``flipkit verify`` then checks it."""
+    if record is None:
+        rc = RobotConfig.__dataclass_fields__
+        return {k: rc[k].default for k in ARM_KEYS}
+    if not isinstance(record, dict) or sorted(record) != sorted(ARM_KEYS):
+        got = sorted(record) if isinstance(record, dict) else type(record).__name__
+        raise ConfigError(f"robot.arm: expected the keys {', '.join(ARM_KEYS)}, got {got}")
+    for key in ("profile", "safety_preset"):
+        if not isinstance(record[key], str):
+            raise ConfigError(f"robot.arm.{key}: expected a name, got {record[key]!r}")
+    try:
+        RobotConfig(**record, urdf=None)  # the profile, preset and margin checked there
+    except ConfigError as exc:
+        raise ConfigError(f"robot.arm: {exc}") from None
+    return dict(record)
 
 
 def segment_span(segments, name: str) -> tuple[float, float] | None:
@@ -147,6 +168,7 @@ class Plan:
                                     and all(c in "0123456789abcdef" for c in sha)):
             raise ConfigError(f"robot.urdf_sha256: expected 64 lowercase hex digits, got {sha!r}")
         r["urdf_sha256"] = sha
+        r["arm"] = arm_record(self.robot.get("arm"))
         self.robot = {**self.robot, **r}
         self.gravity = check_array("gravity", self.gravity, (3,))
         self.grill_height = check_number("grill_height", self.grill_height)
@@ -221,7 +243,9 @@ class Plan:
             "base_in_world": np.asarray(cell.robot.base_in_world, float),
             "tool_parent_frame": cell.robot.tool_frame,
             "spatula_in_parent": robot.spatula_in_parent, "payload": robot.payload_json(),
-            "q_home": robot.q_home},
+            "q_home": robot.q_home, "arm": arm_record({
+                "profile": cell.robot.profile, "speed_margin": cell.robot.speed_margin,
+                "safety_preset": cell.robot.safety_preset})},
             np.asarray(cell.gravity, float), cell.grill.height,
             {"length": cell.spatula.length, "width": cell.spatula.width},
             {"location": None if location is None else list(location),
@@ -262,7 +286,7 @@ class Plan:
             return CellConfig(
                 robot=RobotConfig(urdf=r["urdf"], tool_frame=r["tool_parent_frame"],
                                   base_in_world=tuple(map(tuple, r["base_in_world"])),
-                                  q_home=tuple(r["q_home"]), **accel),
+                                  q_home=tuple(r["q_home"]), **r["arm"], **accel),
                 spatula=SpatulaConfig(self.spatula["length"], w, np.sqrt(max(thickness2, 0.0)),
                                       float(r["spatula_in_parent"][2, 3]), m),
                 burger=BurgerConfig(**{k: self.burger[k] for k in _BURGER_KEYS[1:]}),
@@ -346,7 +370,8 @@ class Plan:
             except ConfigError as exc:
                 raise PlanFileError(f"robot.urdf: {exc}") from None
         robot = {"urdf": robot["urdf"], "urdf_sha256": sha,
-                 **{k: v for k, v in robot.items() if k != "urdf"}}
+                 **{k: v for k, v in robot.items() if k != "urdf"},
+                 "arm": dict(self.robot["arm"])}
         loc = self.burger["location"]
         doc = {"format": FORMAT, "behavior": self.behavior, "status": self.status,
                "created_by": dict(self.created_by), "robot": robot,

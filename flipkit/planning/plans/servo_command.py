@@ -36,8 +36,34 @@ from scipy.signal import lfilter
 
 from flipkit.errors import ConfigError, InvalidChoiceError
 
-COMMANDS = ("compensated", "raw")
-"""``compensated``: q_c as in the module docstring; ``raw``: the plan's (q, q̇) as they are."""
+COMMANDS = ("raw", "compensated")
+"""``raw``: the plan's (q, q̇) as they are; ``compensated``: q_c as in the module docstring."""
+
+DEFAULT_COMMAND = "raw"
+"""The command a controller is sent unless told otherwise: the plan's (q, q̇), as the paper
+sends them (its footnote 2). The compensated stream asks a UR10 for more than its published
+joint speeds where the plan's torque steps (segment joins; docs/arm-profile.md), and the
+stream check refuses it there."""
+
+
+def paused(t: np.ndarray, t_pause: float, pause: float) -> np.ndarray:
+    """Plan times of run times ``t`` (s) when the plan stops at ``t_pause`` for ``pause`` s."""
+    return np.where(t < t_pause, t, np.maximum(t - pause, t_pause))
+
+
+def hold_torque(plan) -> np.ndarray:
+    """The torque (N·m) that holds the plan's final configuration at rest: gravity of the
+    model of its last segment (with the payload that segment carries).
+
+    A plan ends at rest (q̇ = 0), but its last node's torque includes M q̈ of an acceleration
+    that ends there; held after the plan, that torque moved the arm on (measured after a
+    serve's return home: 2.2 cm at the blade within 0.1 s, towards a rest Kp⁻¹ M q̈ away in
+    position mode, 0.04 rad at the elbow)."""
+    last = plan.segments[-1]
+    return np.asarray(plan.robot_for(last).inverse_dynamics(
+        last.q[-1], np.zeros_like(last.q[-1]), np.zeros_like(last.q[-1])), float)
+
+
 
 
 def lookahead_command(q_c, qd_c, qdd, t, physics, pieces=None) -> tuple[np.ndarray, np.ndarray]:
@@ -169,5 +195,5 @@ def servo_commands(plan, t, at, q_d, qd_d, u_d, qdd, controller_model, physics,
     return q_c, qd_c
 
 
-__all__ = ["COMMANDS", "command_lead", "lookahead_command", "position_command",
+__all__ = ["COMMANDS", "DEFAULT_COMMAND", "command_lead", "hold_torque", "paused", "lookahead_command", "position_command",
            "segment_labels", "servo_commands", "smoothed", "smooths"]

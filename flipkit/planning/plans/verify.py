@@ -15,9 +15,11 @@ time_grid          t_i = iT/N; T within the spec's bounds (upper × T_STRETCH) (
 dynamics           RNEA(q_i, q̇_i, q̈_i) − u_i, payload per segment (N·m)        tol·u_max/10
 defects            Hermite–Simpson interpolation and Simpson defects (rad,     tol
                    rad/s) at the odd nodes, x = (q, q̇), ẋ = (q̇, q̈)
-q/qd/qdd/u_limits  joint limits of the URDF and the acceleration limit (free    tol, tol,
-                   motions: the cell's free_accel_limit, none by default)      10·tol,
-                                                                               tol·u_max/10
+q/qd/qdd/u_limits  joint limits: positions and torques within the URDF's and the  tol, tol,
+                   arm profile's, speeds within the profile's published speed   10·tol,
+                   × its speed_margin (:mod:`flipkit.config.arm`), and the      tol·u_max/10
+                   acceleration limit (free motions: the cell's
+                   free_accel_limit, none by default)
 interpolant        q̇ and q̈ limits between the nodes, on the cubic Hermite        100·tol,
                    interpolant of (q, q̇) the controller follows: exact extremes  1000·tol
                    of each interval's polynomial (scipy's coefficients)
@@ -50,6 +52,9 @@ arm_clearance      every link (URDF collision hull), the handle and the blade  t
                    but the pairs the segment exempts (the spec's exempt);
                    coal distances, :mod:`flipkit.planning.plans.verify_clearance` (m)
 orientation        pitch o_y within cell.limits.pitch_range (rad), eq. (4)     tol
+safety_limits      the blade's and flange's fastest speed and the arm's momentum tol·limit
+                   within the cell's safety preset, at the nodes and inside
+                   each interval (:mod:`flipkit.planning.plans.verify_safety`)
 singularity        q3 and q5 at every node within the band of q_home held      tol
                    SINGULARITY_MARGIN (0.2 rad) from sin q = 0: the planner's
                    bounds (:func:`flipkit.model.singular.branch_bounds`) (rad)
@@ -91,6 +96,7 @@ from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
 from flipkit.planning.plans.verify_flight import check_flight
+from flipkit.planning.plans.verify_safety import check_safety
 # the report's types, importable from here as before
 from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
 from flipkit.planning.plans.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
@@ -159,6 +165,7 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
         _check_segment(report, k, seg, robots[bodies], plan, cell, tol)
         geometry.robot = robots[bodies]
         check_space(report, k, seg, robots[bodies], cell, geometry, tol)
+        check_safety(report, k, seg, robots[bodies], tol)
         if k:
             prev = plan.segments[k - 1]
             jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))

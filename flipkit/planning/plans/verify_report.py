@@ -18,7 +18,7 @@ GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_lim
           "endpoints": "m | rad | rad/s", "behavior_path": "m | 1", "continuity": "rad | rad/s",
           "cone": "m/s²", "release": "m/s²", "grill_clearance": "m", "landing": "m | deg | s",
           "landing_scenarios": "m | deg | s", "flight_clearance": "m", "placing": "m",
-          "arm_clearance": "m", "orientation": "rad",
+          "arm_clearance": "m", "orientation": "rad", "safety_limits": "m/s | kg·m/s",
           "singularity": "rad", "completeness": "segments"}
 
 
