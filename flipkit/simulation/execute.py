@@ -172,7 +172,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
             :func:`~flipkit.config.known_physics` of it.
         replan: Sense, plan, act: ``None`` runs the plan open loop; a callable
             ``replan(plan, on_blade) -> Plan`` is called when the scoop ends (the arm at
-            rest, blade flat on the grill; a serve plan: when the carry ends, at rest, blade
+            rest, blade on the grill; a serve plan: when the carry ends, at rest, blade
             flat above the table, :data:`SENSE_AFTER`; a serve's burger is seen
             :data:`SENSE_LEAD` before the carry ends) with the burger's centre measured in
             the blade frame (x, y) (m), e.g. :func:`flipkit.planning.planners.planner.replan_flip`
