@@ -128,9 +128,11 @@ def servo_stream(plan: Plan, rate: float, command: str = DEFAULT_COMMAND, *,
     q_d, qd_d, u_d, qdd_d = evaluate(plan, at, accelerations=True)
     past = at >= plan.duration - 1e-12  # after the plan: at rest, held against gravity
     qd_d[past], qdd_d[past] = 0.0, 0.0
-    model = Robot(cell, with_burger=False).model  # the controller's: arm and spatula
-    if past.any():
-        u_d[past] = hold_torque(plan)
+    model = None
+    if command == "compensated":  # the torques and the controller's model enter its offset
+        model = Robot(cell, with_burger=False).model  # the controller's: arm and spatula
+        if past.any():
+            u_d[past] = hold_torque(plan)
     q_c, qd_c = servo_commands(plan, t, at, q_d, qd_d, u_d, qdd_d, model, nominal, command)
     return t, q_c, qd_c
 

@@ -34,6 +34,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from flipkit.errors import ExportError
+from flipkit.planning.plans.hermite import hermite_extremes
 from flipkit.model.robot import Robot
 
 DEVIATION_M = 0.002  # m, the blade's distance from the verified plan
@@ -81,13 +82,11 @@ def _worst(ratio: np.ndarray):
 
 
 def plan_peak_accel(plan) -> np.ndarray:
-    """The verified plan's largest |q̈| on each joint (rad/s²), over its interpolant: q̈ of a
-    cubic Hermite is linear between nodes, so its extremes are at the intervals' ends."""
+    """The verified plan's largest |q̈| on each joint (rad/s²), over its interpolant (linear
+    between nodes: its extremes at the intervals' ends, :func:`hermite_extremes`)."""
     peak = np.zeros(plan.segments[0].q.shape[1])
     for seg in plan.segments:
-        c = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0).c
-        h = np.diff(seg.t)[:, None]
-        for qdd in (2 * c[1], 6 * c[0] * h + 2 * c[1]):
+        for qdd in hermite_extremes(seg.t, seg.q, seg.qd)[:2]:
             peak = np.maximum(peak, np.abs(qdd).max(axis=0))
     return peak
 
@@ -121,16 +120,10 @@ def _motion(interpolation: str, t, q, qd):
         v = np.diff(q, axis=0) / dt
         a = np.diff(v, axis=0) / dt[1:]
         return v, a, t[:-1] + dt[:, 0] / 2, (q[:-1] + q[1:]) / 2
-    spline = CubicHermiteSpline(t, q, qd, axis=0)
-    c = spline.c
-    h = dt
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.clip(np.nan_to_num(-c[1] / (3 * c[0]), nan=0.0, posinf=0.0, neginf=0.0), 0, h)
-    vertex = 3 * c[0] * tau**2 + 2 * c[1] * tau + c[2]
-    v = np.concatenate([qd, vertex])
-    a = np.concatenate([2 * c[1], 6 * c[0] * h + 2 * c[1]])
+    start, end, vertex = hermite_extremes(t, q, qd)
     mid = t[:-1] + dt[:, 0] / 2
-    return v, a, mid, spline(mid)
+    return (np.concatenate([qd, vertex]), np.concatenate([start, end]), mid,
+            CubicHermiteSpline(t, q, qd, axis=0)(mid))
 
 
 def check_stream(plan, t, q, qd=None, *, interpolation: str = "hold", q_start=None,

@@ -94,6 +94,7 @@ from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.plans.hermite import hermite_extremes
 from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
 from flipkit.planning.plans.verify_flight import check_flight
 from flipkit.planning.plans.verify_safety import check_safety
@@ -101,7 +102,6 @@ from flipkit.planning.plans.verify_safety import check_safety
 from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
 from flipkit.planning.plans.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
 from flipkit.errors import VerificationError
-from scipy.interpolate import CubicHermiteSpline
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
@@ -231,19 +231,14 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
 
 
 def _check_interpolant(report, k, seg, robot, qdd_max, tol) -> None:
-    """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly: on
-    interval i, q = c0 τ³ + c1 τ² + c2 τ + c3 (τ ∈ [0, h]), so q̈ is linear (extremes at the
-    ends) and q̇ a parabola (extremes at the ends or at τ* = −c1 / (3 c0))."""
-    c = CubicHermiteSpline(seg.t, seg.q, seg.qd, axis=0).c  # (4, N, nq)
-    h = np.diff(seg.t)[:, None]
+    """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly, at
+    its extremes (:func:`~flipkit.planning.plans.hermite.hermite_extremes`)."""
+    start, end, qd = hermite_extremes(seg.t, seg.q, seg.qd)
     n = np.arange(seg.N)
-    for i, qdd in enumerate((2 * c[1], 6 * c[0] * h + 2 * c[1])):
+    for i, qdd in enumerate((start, end)):
         # node of the interval's start (i = 0) or end (i = 1)
         report.add_nodes("interpolant", k, _outside(qdd, -qdd_max, qdd_max),
                          INTERPOLANT_TOL[1] * tol, n + i)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.clip(np.nan_to_num(-c[1] / (3 * c[0]), nan=0.0, posinf=0.0, neginf=0.0), 0, h)
-    qd = 3 * c[0] * tau**2 + 2 * c[1] * tau + c[2]
     report.add_nodes("interpolant", k, _outside(qd, -robot.qd_max, robot.qd_max),
                      INTERPOLANT_TOL[0] * tol, n)
 
