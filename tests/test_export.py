@@ -70,8 +70,8 @@ def test_cli(plan, tmp_path, capsys):
     path = plan.to_json(tmp_path / "plan.json")
     out = tmp_path / "traj.csv"
     assert main(["export", str(path), "--rate", "250", "--csv", str(out)]) == 0
-    assert "wrote 451 rows" in capsys.readouterr().out
-    assert _read(out)[1].shape == (451, 13)
+    assert "wrote 461 rows" in capsys.readouterr().out  # 451 on the grid, 10 nodes off it
+    assert _read(out)[1].shape == (461, 13)
     assert main(["export", str(path), "--rate", "-1", "--csv", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("flipkit: error:") and "rate must be" in err and "\n" not in err

@@ -210,7 +210,7 @@ def test_a_stream_over_the_arms_speed_is_refused_with_nothing_written(plan, tmp_
 # ------------------------------------------------------------------ ROS 2
 def test_ros2_yaml_is_the_resampled_trajectory(plan, robot, tmp_path):
     path = tmp_path / "flip.yaml"
-    assert write_ros2(plan, path, 126.0) == 228  # 227 samples to 1.794 s and the plan's end
+    assert write_ros2(plan, path, 126.0) == 265  # 227 on the grid, 37 nodes off it, the end
     doc = yaml.safe_load(path.read_text())
     assert list(doc) == ["header", "joint_names", "points"]
     assert doc["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}

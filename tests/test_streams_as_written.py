@@ -22,7 +22,8 @@ from flipkit.simulation.safety import SafetyMonitor
 PUBLISHED = np.radians([120, 120, 180, 180, 180, 180])  # rad/s, UR10 (CB3) and UR10e
 
 
-@pytest.mark.parametrize("fmt, rate, suffix", [("urscript", "125", ".script"),
+@pytest.mark.parametrize("fmt, rate, suffix", [("urscript", "125", ".script"), ("csv", "125", ".csv"),
+                                               ("ros2", "125", ".yaml"),
                                                ("urscript", "500", ".script"),
                                                ("ros2", "500", ".yaml"), ("csv", "500", ".csv")])
 def test_each_format_of_a_flip_is_within_the_arm_as_written(flip_plan, tmp_path, capsys, fmt,
