@@ -194,3 +194,31 @@ def test_anchored_guess_starts_at_the_segment_start_and_keeps_the_turn_back_end(
         else:  # the end is the neighbour's, at rest
             assert np.abs(g[-1, 0] - nodes0[-1, 0]).max() < 0.02
             np.testing.assert_allclose(g[-1, 1], 0.0, atol=1e-9)
+
+
+def test_a_segment_the_atlas_solved_stretched_is_solved_stretched_first(monkeypatch):
+    """Where the nearest atlas entry's turn back ran past its duration bound (the planner's
+    stretch), the turn back is first solved warm with the bound stretched; the within-bound
+    NLP, which would only be proved infeasible, is never solved there."""
+    from flipkit.planning.planners import chain
+
+    if not default_path().exists():
+        pytest.skip("no atlas shipped")
+    atlas = Atlas.load(default_path(), CellConfig(), SegmentOptions())
+    loc = (0.69, -0.16, 0.072)
+    calls, solve = [], chain.solve_segment
+
+    def spy(nlp, solver, x0=None, **kw):
+        i = nlp.layout.T_index
+        calls.append((nlp.name, float(nlp.x_ub[i]), x0 is not None))
+        return solve(nlp, solver, x0, **kw)
+
+    monkeypatch.setattr(chain, "solve_segment", spy)
+    plan = plan_flip(loc, atlas=atlas)
+    assert plan.status == "solved" and verify_plan(plan, space=CellConfig().space).ok
+    turn = [c for c in calls if c[0] == "turn_back"]
+    d = np.linalg.norm(atlas.locations[:, :2] - np.array(loc[:2]), axis=1)
+    nearest_T = atlas.solutions["turn_back"][int(np.argmin(d)), -1]
+    assert nearest_T > turn[0][1] / 1.5 + 1e-6  # the shipped atlas stretched it here
+    assert len(turn) == 1 and turn[0][2], turn  # one warm solve, stretched
+    assert plan.segments[-1].T > turn[0][1] / 1.5  # longer than the unstretched bound

@@ -165,6 +165,19 @@ class Atlas:
         return atlas
 
     # ----------------------------------------------------------------- lookup
+    def stretched(self, name: str, location, nlp) -> bool:
+        """Whether the atlas's nearest entry to ``location`` solved segment ``name`` with its
+        duration bound stretched (its T above ``nlp``'s upper bound): the planner then tries
+        the stretched bound first, since the warm SQP within the bound spends 0.6–1.1 s
+        proving it infeasible where the stretched solve takes 0.06–0.12 s
+        (docs/benchmarks/2026-11-29-atlas-stretch.md)."""
+        X = self.solutions.get(name)
+        if X is None or self.structure.get(name) != nlp.structure_key:
+            return False
+        d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
+        i = nlp.layout.T_index
+        return bool(X[int(np.argmin(d)), i] > nlp.x_ub[i] + 1e-6)
+
     def guess(self, name: str, location, nlp, start=None) -> np.ndarray:
         """Initial guess of segment ``name`` of the chain at ``location`` for ``nlp``.
 
@@ -212,14 +225,26 @@ def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
                          "rebuild it with `flipkit atlas build`")
 
 
+class Seeding:
+    """A :meth:`~flipkit.planning.planners.chain.Planner.chain` ``guess`` from an atlas for
+    the burger at ``location``: called as ``guess(name, nlp, q, qd)``, the atlas's
+    interpolated solution for the segments it holds (:data:`SEEDED`), else ``None``;
+    :meth:`stretched` tells the planner to try the stretched bound first."""
+
+    def __init__(self, atlas: Atlas, location):
+        self.atlas, self.location = atlas, location
+
+    def __call__(self, name: str, nlp, q, qd):
+        return self.atlas.guess(name, self.location, nlp, (q, qd)) if name in SEEDED else None
+
+    def stretched(self, name: str, nlp) -> bool:
+        return name in SEEDED and self.atlas.stretched(name, self.location, nlp)
+
+
 def seeding(atlas, location):
-    """A :meth:`~flipkit.planning.planners.chain.Planner.chain` ``guess`` from ``atlas`` for the
-    burger at ``location``: the atlas's interpolated solution for the segments it holds
-    (:data:`SEEDED`); ``None`` without an atlas."""
-    if atlas is None:
-        return None
-    return lambda name, nlp, q, qd: (atlas.guess(name, location, nlp, (q, qd))
-                                     if name in SEEDED else None)
+    """A :class:`Seeding` from ``atlas`` for the burger at ``location``; ``None`` without an
+    atlas."""
+    return None if atlas is None else Seeding(atlas, location)
 
 
 def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
@@ -240,4 +265,4 @@ def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:
     return fit_guess(L, robot, waypoints, T, qd_start, rest_at_end=how == "blend")
 
 
-__all__ = ["ANCHORED", "Atlas", "FORMAT", "SEEDED", "anchored_guess", "check_atlas", "seeding", "default_atlas", "default_path", "options_hash"]
+__all__ = ["ANCHORED", "Atlas", "FORMAT", "SEEDED", "Seeding", "anchored_guess", "check_atlas", "seeding", "default_atlas", "default_path", "options_hash"]

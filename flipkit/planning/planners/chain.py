@@ -95,7 +95,8 @@ def solver_failure(name: str, nlp, result) -> str:
     return f"{name}: {group} violated by {amount:.3g} ({result.solver}: {result.status}{budget})"
 
 
-def solve_stretched(build, options: SegmentOptions, solver: str, guess=None, **sqp_kwargs):
+def solve_stretched(build, options: SegmentOptions, solver: str, guess=None, *,
+                    stretch_first=lambda nlp: False, **sqp_kwargs):
     """Build and solve a segment (``build(options) -> NLP``); if it has no solution within its
     duration bound, build and solve it once more with the bound stretched (SegmentOptions
     ``stretch``, :data:`~flipkit.behaviors.options.T_STRETCH`). Returns (nlp, result): the
@@ -113,10 +114,29 @@ def solve_stretched(build, options: SegmentOptions, solver: str, guess=None, **s
     solution's active bounds is slow (measured: a Table I chain with IPOPT from the atlas was
     stopped after 10 CPU-minutes).
 
+    ``stretch_first(nlp) -> bool`` (with a ``guess``): whether the guess comes from a solution
+    with the bound stretched; then the stretched segment is solved warm first, and only if
+    that fails is the segment solved as above. The result's wall time counts every solve.
+
     Raises:
         FlipkitError: The first build fails (e.g. its initial guess), or ``guess`` raises.
     """
-    nlp = build(options)
+    nlp, first = build(options), None
+    if guess is not None and solver != "ipopt" and not options.stretch and stretch_first(nlp):
+        try:
+            longer = build(replace(options, stretch=True))
+        except FlipkitError:
+            longer = None
+        if longer is not None:
+            first = solve_segment(longer, "sqp", guess(longer), **sqp_kwargs)
+            if first.success:
+                return longer, first
+    nlp, result = _within_then_stretched(nlp, build, options, solver, guess, **sqp_kwargs)
+    return nlp, result if first is None else _counting(result, first)
+
+
+def _within_then_stretched(nlp, build, options, solver, guess, **sqp_kwargs):
+    """:func:`solve_stretched` without ``stretch_first``, ``nlp`` built within the bound."""
     x0 = None if guess is None or solver == "ipopt" else guess(nlp)
     deferred = False  # the cold solve within the bound, put off until the stretch fails
     if x0 is None:
@@ -239,7 +259,11 @@ class Planner:
             nlp = build(self.options)
             return nlp, solve_segment(nlp, self.solver, **own)
         seed = None if guess is None else (lambda nlp: guess(spec.name, nlp, q, qd))
-        return solve_stretched(build, self.options, self.solver, seed, **own)
+        stretched = getattr(guess, "stretched", None)  # atlas seeds know (Seeding.stretched)
+        first = (lambda nlp: False) if stretched is None else \
+            (lambda nlp: stretched(spec.name, nlp))
+        return solve_stretched(build, self.options, self.solver, seed, stretch_first=first,
+                               **own)
 
 
 __all__ = ["SOLVERS", "Planner", "finish_plan", "solve_segment", "solve_stretched",
