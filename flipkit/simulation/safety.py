@@ -48,23 +48,30 @@ class SafetyMonitor:
         self.joints = robot.profile.joints
         self.qd_limit = robot.qd_limit
         self.enabled = enabled
-        self.peaks = dict.fromkeys(QUANTITIES, 0.0)
+        self._limits = np.array([self.limits[k] for k in QUANTITIES])
+        self._peaks = np.zeros(len(QUANTITIES))
         self.stop: dict | None = None
+
+    @property
+    def peaks(self) -> dict:
+        """The largest value of each of :data:`QUANTITIES` so far."""
+        return {k: float(v) for k, v in zip(QUANTITIES, self._peaks)}
 
     def __call__(self, t: float, q: np.ndarray, qd: np.ndarray, force: float) -> None:
         """Watch the state at time ``t`` (s): joint positions (rad) and speeds (rad/s), and
         the steel's normal force on the blade (N)."""
+        ratio = np.abs(qd) / self.qd_limit
         speed = self.tool.tcp_speed(q, qd)
-        values = {"joint_speed": float(np.max(np.abs(qd) / self.qd_limit)),
-                  "tcp_speed": speed, "tcp_force": float(force),
-                  "momentum": self.tool.momentum(q, qd), "power": float(force) * speed}
-        for name, value in values.items():
-            self.peaks[name] = max(self.peaks[name], value)
-            if self.stop is None and value > self.limits[name]:
-                joint = (self.joints[int(np.argmax(np.abs(qd) / self.qd_limit))]
-                         if name == "joint_speed" else None)
-                self.stop = {"time_s": float(t), "quantity": name, "value": value,
-                             "limit": self.limits[name], "joint": joint}
+        values = np.array([ratio.max(), speed, force, self.tool.momentum(q, qd),
+                           force * speed])  # in the order of QUANTITIES
+        np.maximum(self._peaks, values, out=self._peaks)
+        if self.stop is None and (values > self._limits).any():
+            i = int(np.argmax(values > self._limits))  # the first quantity over its limit
+            name = QUANTITIES[i]
+            self.stop = {"time_s": float(t), "quantity": name, "value": float(values[i]),
+                         "limit": self.limits[name],
+                         "joint": self.joints[int(np.argmax(ratio))]
+                         if name == "joint_speed" else None}
 
     @property
     def tripped(self) -> bool:
@@ -75,7 +82,7 @@ class SafetyMonitor:
         """``{"preset", "limits", "peaks", "stop"}`` (SI units; ``stop`` ``None`` or the
         first excess: ``time_s``, ``quantity``, ``value``, ``limit``, ``joint``)."""
         return {"preset": self.preset.name, "limits": dict(self.limits),
-                "peaks": {k: float(v) for k, v in self.peaks.items()}, "stop": self.stop}
+                "peaks": self.peaks, "stop": self.stop}
 
 
 __all__ = ["QUANTITIES", "SafetyMonitor"]
