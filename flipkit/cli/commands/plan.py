@@ -4,6 +4,7 @@ numbers, the burger, the start configuration and the outputs, plan, write and su
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import math
@@ -241,15 +242,11 @@ def run_batch(args: argparse.Namespace) -> int:
                             "summary.csv"])
     atlas = _atlas(args, SegmentOptions())
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    executor = None
-    if workers > 1 and len(locations) > 1:
-        executor = make_executor(workers=workers)
-    try:
+    pool = (make_executor(workers=workers) if workers > 1 and len(locations) > 1
+            else contextlib.nullcontext())
+    with pool as executor:  # its workers end with the run, however it ends
         plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
                            executor=executor, atlas=atlas)
-    finally:
-        if executor is not None:
-            executor.shutdown(cancel_futures=True)
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)
