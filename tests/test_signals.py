@@ -101,3 +101,22 @@ def test_farewell_names_the_signal():
     assert farewell(KeyboardInterrupt()) == ("flipkit: interrupted", 130)
     assert farewell(Terminated(signal.SIGTERM)) == ("flipkit: terminated", 143)
     assert farewell(Terminated(signal.SIGHUP)) == ("flipkit: hung up", 129)
+
+
+def test_a_pool_left_by_an_exception_ends_its_workers():
+    """Workers an hour into their work end at once, and no traceback of the pool's manager
+    thread is printed for the work the caller cancelled."""
+    from flipkit.experiments.sweep import make_executor
+
+    pool = make_executor(workers=2)
+    t0 = time.monotonic()
+    with pytest.raises(RuntimeError, match="stop"):
+        with pool:
+            futures = [pool.submit(time.sleep, 3600) for _ in range(4)]
+            while not any(f.running() for f in futures):
+                time.sleep(0.05)
+            for f in futures:
+                f.cancel()
+            raise RuntimeError("stop")
+    assert time.monotonic() - t0 < 60
+    assert all(f.done() for f in futures)
