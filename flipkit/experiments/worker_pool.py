@@ -1,9 +1,10 @@
-"""Local worker processes that end with the run: :class:`WorkerPool`, the
-:class:`~concurrent.futures.ProcessPoolExecutor` that :func:`flipkit.experiments.sweep.make_executor`
-makes. A run that fails or is stopped (Ctrl-C, or SIGTERM and SIGHUP turned into exceptions
-by :mod:`flipkit.cli.signals`) terminates its workers instead of waiting for them, so that
-none goes on computing, or holds the caller's standard output open, after it; the forkserver
-and the resource tracker then end with the main process."""
+"""Local worker processes that end with the run: :class:`WorkerPool`, the process pool
+(:class:`~concurrent.futures.ProcessPoolExecutor`) that
+:func:`flipkit.experiments.sweep.make_executor` makes. A run that fails or is stopped
+(Ctrl-C, or SIGTERM and SIGHUP turned into exceptions by :mod:`flipkit.cli.signals`)
+terminates its workers instead of waiting for them, so that none goes on computing, or holds
+the caller's standard output open, after it; the forkserver and the resource tracker then
+end with the main process."""
 
 from __future__ import annotations
 

@@ -19,6 +19,7 @@ from flipkit.behaviors.serve import check_table_spot
 from flipkit.cli.common import MAX_WORKERS, check_int
 from flipkit.config import CellConfig
 from flipkit.config.task import R_LAND_RANGE
+from flipkit.decimal_text import decimal
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.experiments.sweep import make_executor
 from flipkit.fileio import (InputFileError, check_output, check_output_dir, data_lines, read_text,
@@ -39,9 +40,10 @@ def _numbers(what: str, values, count: int | None = None) -> list[float]:
     if count is not None and len(values) != count:
         raise ConfigError(f"{what} takes {count} numbers, got {len(values)}")
     try:
-        out = [float(v) for v in values]
+        out = [decimal(v) for v in values]
     except ValueError:
-        raise ConfigError(f"{what}: not a number in {' '.join(values)}") from None
+        raise ConfigError(f"{what}: not a decimal number in {' '.join(values)} (digits, an "
+                          "optional point and exponent; no separators)") from None
     if not all(math.isfinite(v) for v in out):
         raise ConfigError(f"{what} must be finite, got {' '.join(values)}")
     return out
