@@ -4,9 +4,10 @@ written atomically.
 An input is read only if it is a regular file of bounded size (a device such as
 ``/dev/zero`` or a directory is refused by name, not reported as missing); text is decoded
 as UTF-8 with an optional byte-order mark. An output path is checked before anything is
-computed: its directory exists and is writable, its suffix names a format the command
-writes, and it is neither an input of the same command (same file after resolving links)
-nor another of its outputs. Outputs are written to a temporary file in the same directory
+computed: its file names fit the file system (:data:`NAME_MAX`), its directory exists and a
+file can be created in it (the permission bits, then a probe file created and removed), its
+suffix names a format the command writes, and it is neither an input of the same command
+(same file after resolving links) nor another of its outputs. Outputs are written to a temporary file in the same directory
 and renamed over the target (:func:`os.replace`), so an interrupted run leaves the old file
 or the new one, never a part.
 """
@@ -22,6 +23,7 @@ from typing import Callable, Iterable
 from flipkit.errors import ConfigError
 
 MAX_INPUT_BYTES = 256 * 2**20  # bytes: the largest input file read (plans are < 1 MB)
+NAME_MAX = 255  # bytes in one file name: Linux's file systems (ext4, xfs, btrfs, tmpfs)
 
 
 class InputFileError(ConfigError):
@@ -94,11 +96,37 @@ def _same_file(a: Path, b) -> bool:
     return a.resolve() == b.resolve()
 
 
+def _shown(path) -> str:
+    """``path`` as a message shows it: at most 80 characters."""
+    text = str(path)
+    return text if len(text) <= 80 else f"{text[:60]}...({len(text)} characters)"
+
+
+def _name_fits(p: Path, what: str) -> None:
+    """Refuse a path with a component longer than the file system takes (NAME_MAX bytes,
+    255 on Linux's file systems)."""
+    for part in p.parts:
+        size = len(os.fsencode(part))
+        if size > NAME_MAX:
+            raise OutputPathError(f"{what} {_shown(p)}: a file name of {size} bytes, longer "
+                                  f"than the {NAME_MAX} bytes a file system takes")
+
+
 def _writable_dir(directory: Path, what: str, path) -> None:
+    """Refuse a directory that does not exist or where no file can be created: the
+    permission bits (``os.access``), then a probe file created and removed (root passes
+    the bits everywhere, and /proc, /sys or a read-only mount refuse only the creation)."""
     if not directory.is_dir():
-        raise OutputPathError(f"{what} {path}: directory {directory} does not exist")
+        raise OutputPathError(f"{what} {_shown(path)}: directory {directory} does not exist")
     if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputPathError(f"{what} {path}: directory {directory} is not writable")
+        raise OutputPathError(f"{what} {_shown(path)}: directory {directory} is not writable")
+    try:
+        fd, probe = tempfile.mkstemp(dir=directory, prefix=".flipkit-probe-")
+    except OSError as exc:
+        raise OutputPathError(f"{what} {_shown(path)}: directory {directory} is not writable "
+                              f"({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def check_output(path, what: str, suffixes: Iterable[str] | None, inputs: Iterable = (),
@@ -116,6 +144,7 @@ def check_output(path, what: str, suffixes: Iterable[str] | None, inputs: Iterab
         OutputPathError: One line naming ``what``, the path and what to change.
     """
     p = Path(path)
+    _name_fits(p, what)
     if suffixes is not None:
         suffixes = tuple(suffixes)
         if p.suffix.lower() not in suffixes:
@@ -147,6 +176,9 @@ def check_output_dir(path, what: str, inputs: Iterable = (), names: Iterable[str
         OutputPathError: One line naming ``what``, the path and what to change.
     """
     p = Path(path)
+    _name_fits(p, what)
+    for name in names:
+        _name_fits(p / name, what)
     if p.exists() and not p.is_dir():
         raise OutputPathError(f"{what} {p}: exists and is not a directory; give a directory")
     base = p

@@ -214,7 +214,9 @@ def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
 
 @pytest.mark.parametrize("extra, message", [
     (["--land", "2", "0"], "landing spot (2.000, 0.000) is outside the grill"),
-    (["--r-land", "0"], "r_land must be in (0, 0.1] m"),
+    (["--r-land", "0"], "--r-land must be in [0.0001, 0.1] m"),
+    (["--r-land", "1e-9"], "landing's spread"),
+    (["--r-land", "0.2"], "--r-land must be in [0.0001, 0.1] m"),
     (["--land", "0.7"], "--land"),
 ])
 def test_cli_landing_options_fail_in_one_line(tmp_path, capsys, extra, message):

@@ -289,8 +289,12 @@ def test_free_motions_are_bounded_by_the_torques_alone(models):
 
 def test_verify_holds_each_segment_to_its_own_acceleration_bound(flip_plan, tmp_path):
     """A flip plan's free motions accelerate beyond the planner's 20 rad/s²: verify passes them
-    under the recorded bound (none), and fails them where the record bounds them (a file
-    without the record: the planner's bound for every segment)."""
+    in the default cell (no bound for free motions), and fails them in a cell that bounds
+    them; a record of such a bound (or a file without the record: the planner's bound for
+    every segment) is a plan for another cell, refused in the default one."""
+    from dataclasses import replace
+
+    from flipkit.planning.plans.cell_in_use import CellMismatchError
     from flipkit.planning.plans.verify import verify_plan
 
     go = flip_plan.segment("go_to_burger")
@@ -303,6 +307,11 @@ def test_verify_holds_each_segment_to_its_own_acceleration_bound(flip_plan, tmp_
         else:
             doc["cell_geometry"]["free_accel_limit"] = record
         (tmp_path / "b.json").write_text(json.dumps(doc))
-        report = verify_plan(Plan.load(tmp_path / "b.json"))
+        plan = Plan.load(tmp_path / "b.json")
+        with pytest.raises(CellMismatchError, match="cell_geometry.free_accel_limit"):
+            verify_plan(plan)
+        bound = 20.0 if record == "absent" else record
+        cell = replace(CellConfig(), robot=replace(CellConfig().robot, free_accel_limit=bound))
+        report = verify_plan(plan, cell=cell)
         worst = report.groups["qdd_limits"]
         assert not worst.ok and report.segments[worst.segment] in ("go_to_burger", "turn_back")

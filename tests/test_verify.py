@@ -170,10 +170,21 @@ def test_paper_cone_form_is_used_when_recorded(models):
 
 
 def test_grill_above_the_blade_fails_clearance(models):
+    """Checked in a cell whose grill is at 0.35 m (the blade rides at 0.30 m); a plan that
+    claims that grill is refused in the default cell, as planned for another."""
+    from dataclasses import replace
+
+    from flipkit.planning.plans.cell_in_use import CellMismatchError
+    from flipkit.planning.plans.cell_record import cell_geometry
+
     plan = translate_plan(models)
-    plan.grill_height = 0.35  # m, the blade rides at 0.30 m
-    assert _fails(plan, "grill_clearance").groups["grill_clearance"].violation == pytest.approx(
-        0.05, abs=0.01)
+    cell = replace(models.cell, grill=replace(models.cell.grill, height=0.35))
+    plan.grill_height, plan.cell_geometry = 0.35, cell_geometry(cell)
+    report = verify_plan(plan, cell=cell)
+    assert not report.groups["grill_clearance"].ok, report.table()
+    assert report.groups["grill_clearance"].violation == pytest.approx(0.05, abs=0.01)
+    with pytest.raises(CellMismatchError, match="cell_geometry.grill.height, grill_height"):
+        verify_plan(plan)
 
 
 def test_uneven_time_grid(models):

@@ -14,7 +14,8 @@ from flipkit.model.contact import make_cone
 from flipkit.model.singular import SINGULARITY_MARGIN
 
 from flipkit.config.task import (BRAKING_FRACTION, FLIGHT_MARGIN, MU_PLAN,  # noqa: F401
-                                 MU_SAFETY, R_LAND, R_SCENARIO, RELEASE_FRACTION,
+                                 MU_SAFETY, R_LAND, R_LAND_RANGE, R_SCENARIO,
+                                 RELEASE_FRACTION,
                                  RELEASE_PRESS, SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND,
                                  SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH)
 
@@ -75,10 +76,13 @@ class SegmentOptions:
     def __post_init__(self):
         if self.epsilon <= 0 or not np.isfinite(self.epsilon):
             raise ConfigError(f"epsilon must be positive, got {self.epsilon!r}")
-        if not (np.isfinite(self.r_land) and 0 < self.r_land <= 0.1):
-            raise ConfigError(f"r_land must be in (0, 0.1] m, got {self.r_land!r}")
-        if not (np.isfinite(self.r_scenario) and self.r_land <= self.r_scenario <= 0.1):
-            raise ConfigError(f"r_scenario must be in [r_land, 0.1] m, got {self.r_scenario!r}")
+        lo, hi = R_LAND_RANGE
+        if not (np.isfinite(self.r_land) and lo <= self.r_land <= hi):
+            raise ConfigError(f"r_land must be in [{lo:g}, {hi:g}] m, got {self.r_land!r}: below "
+                              f"{lo:g} m is within the landing's spread, its prediction and "
+                              "check agree only to that")
+        if not (np.isfinite(self.r_scenario) and self.r_land <= self.r_scenario <= hi):
+            raise ConfigError(f"r_scenario must be in [r_land, {hi:g}] m, got {self.r_scenario!r}")
         if not (np.isfinite(self.mu_safety) and 0 < self.mu_safety <= 1):
             raise ConfigError(f"mu_safety must be in (0, 1], got {self.mu_safety!r}")
         if not (np.isfinite(self.mu_plan) and 0 < self.mu_plan <= 2):

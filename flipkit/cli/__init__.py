@@ -1,7 +1,9 @@
 """The ``flipkit`` command line.
 
 Each sub-command lives in :mod:`flipkit.cli` as a module with ``register(subparsers)``;
-errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit 2.
+errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit 2. SIGINT,
+SIGTERM and SIGHUP stop a command with everything it started (:mod:`flipkit.cli.signals`):
+one line (``flipkit: interrupted``, ``terminated``, ``hung up``) and exit 130, 143 or 129.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ import argparse
 import importlib
 import sys
 
+from flipkit.cli.signals import farewell, signals_raise
 from flipkit.errors import FlipkitError
 
 COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate",
@@ -28,13 +31,15 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.run(args) or 0)
+        with signals_raise():  # SIGTERM and SIGHUP end the command as Ctrl-C does
+            return int(args.run(args) or 0)
     except FlipkitError as exc:
         print(f"flipkit: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("flipkit: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        line, status = farewell(exc)
+        print(line, file=sys.stderr)
+        return status
 
 
 if __name__ == "__main__":

@@ -67,7 +67,8 @@ def register(subparsers) -> None:
     f.add_argument("--land", nargs="+", metavar="X",
                    help="landing spot X Y (m) on the grill; default where the burger lies")
     f.add_argument("--r-land", default=None, metavar="M",
-                   help="radius (m) of the landing disc about the spot, in (0, 0.1] "
+                   help="radius (m) of the landing disc about the spot, in [0.0001, 0.1] "
+                        "(below 0.1 mm is within the landing's spread) "
                         "(default: the planner's R_LAND, which the package's atlas serves)")
     atlas_arguments(f)
     common(f)

@@ -1,6 +1,7 @@
 """``flipkit verify``: independent residual check of a plan file.
 
-Exit status: 0 the plan passes, 1 it fails (one line names the worst group and amount),
+Exit status: 0 the plan passes, 1 it fails (one line names the worst group and amount) or
+was planned for another cell than the one checked (one line names the fields that differ),
 2 the file is unreadable or malformed (printed by :mod:`flipkit.cli`).
 """
 
@@ -9,7 +10,8 @@ from __future__ import annotations
 import argparse
 
 from flipkit.cli.common import check_float, deferred, precheck_plan
-from flipkit.fileio import check_output
+from flipkit.fileio import check_input, check_output
+from flipkit.planning.plans.verify_report import TOL, TOL_RANGE
 
 
 def register(subparsers) -> None:
@@ -23,8 +25,15 @@ def register(subparsers) -> None:
     parser.add_argument("plan", metavar="PLAN.json", help="plan file (flipkit-plan/2; /1 is read too)")
     parser.add_argument("--json", metavar="OUT", help="also write the report as JSON to OUT (.json; not the plan)")
     parser.add_argument("--tol", type=float, metavar="TOL",
-                        help="tolerance in the solver's scaled units, in [1e-12, 1] (default: "
-                             "flipkit.planning.plans.verify.TOL, 10x the SQP feasibility tolerance)")
+                        help=f"tolerance in the solver's scaled units, in [{TOL_RANGE[0]:g}, "
+                             f"{TOL_RANGE[1]:g}] (default: {TOL:g}, 10x the SQP feasibility "
+                             "tolerance; at most 10x looser, so that no pose centimetres off "
+                             "passes)")
+    parser.add_argument("--cell", metavar="CELL.json",
+                        help="the cell the plan will run in: a JSON object with the plan "
+                             "file's cell_geometry (and optionally arm) layout (default: "
+                             "flipkit's default cell); the plan's own record of its cell must "
+                             "match it")
     parser.set_defaults(run=run)
 
 
@@ -34,6 +43,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         check_output(args.json, "--json", (".json",), inputs=[args.plan])
     if args.tol is not None:
-        check_float("--tol", args.tol, 1e-12, 1.0, "(scaled units)")
+        check_float("--tol", args.tol, *TOL_RANGE, "(scaled units)")
+    if args.cell is not None:
+        check_input(args.cell, "--cell")
     precheck_plan(args.plan)
     return deferred("verify")(args)

@@ -48,6 +48,12 @@ RELEASE_FRACTION = 0.7  # release node r = ceil(0.7 N): contact on 70 % of the f
 # The nominal landing aims within R_LAND of the spot, which leaves the whole of the paper's
 # 5 cm success square for what the plan cannot know.
 R_LAND = 0.005  # m
+# The landing radii accepted (plan flip --r-land, SegmentOptions, verify). The landing point
+# is predicted by the NLP's flight rows and recomputed by verify's ODE to within 0.1 mm of it
+# (verify_flight.LANDING_TOL): a disc smaller than that spread can be neither planned to nor
+# checked (at 1e-9 m IPOPT ran 93.6 s and failed; at 0.1 mm the SQP solves in 3.7 s). Above
+# 0.1 m the disc is wider than the burger's own diameter and the paper's success square.
+R_LAND_RANGE = (1e-4, 0.1)  # m
 # Every scenario of the burger's place on the blade lands within R_SCENARIO: 1 cm inside the
 # paper's success square (5 cm in x and y), which holds the disc.
 R_SCENARIO = 0.04  # m

@@ -38,9 +38,15 @@ def resolve_urdf(name: str) -> str:
     """
     if not name.startswith(ERD_PREFIX):
         path = Path(name)
-        if not path.exists():
+        try:
+            found, regular = path.exists(), path.is_file()
+        except OSError as exc:  # a name too long for the file system, a loop of links
+            shown = name if len(name) <= 80 else name[:60] + "..."
+            raise ConfigError(f"URDF {shown}: cannot be looked up "
+                              f"({exc.strerror or exc})") from None
+        if not found:
             raise ConfigError(f"URDF file not found: {name}")
-        if not path.is_file():
+        if not regular:
             raise ConfigError(f"URDF {name}: not a regular file; give the path of a .urdf file")
         return str(path.resolve())
     rel = PurePosixPath(name[len(ERD_PREFIX):])

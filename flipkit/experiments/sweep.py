@@ -27,6 +27,7 @@ from tqdm import tqdm
 from flipkit import __version__
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError
+from flipkit.experiments.worker_pool import WorkerPool
 
 SINGLE_THREAD_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -85,8 +86,8 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> c
         return _dask_executor(scheduler)
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    return cf.ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
-                                  initializer=_single_threaded)
+    return WorkerPool(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
+                      initializer=_single_threaded)
 
 
 def jsonable(obj):
@@ -246,4 +247,4 @@ def grill_grid(cell: CellConfig | None = None, nx: int = 5, ny: int = 5) -> list
     return [(round(float(x), 6), round(float(y), 6), float(g.height)) for y in ys for x in xs]
 
 
-__all__ = ["make_executor", "run_sweep", "grill_grid", "stable_hash", "jsonable"]
+__all__ = ["WorkerPool", "make_executor", "run_sweep", "grill_grid", "stable_hash", "jsonable"]

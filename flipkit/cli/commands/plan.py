@@ -4,6 +4,7 @@ numbers, the burger, the start configuration and the outputs, plan, write and su
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import math
@@ -17,6 +18,8 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.serve import check_table_spot
 from flipkit.cli.common import MAX_WORKERS, check_int
 from flipkit.config import CellConfig
+from flipkit.config.task import R_LAND_RANGE
+from flipkit.decimal_text import decimal
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.experiments.sweep import make_executor
 from flipkit.fileio import (InputFileError, check_output, check_output_dir, data_lines, read_text,
@@ -37,9 +40,10 @@ def _numbers(what: str, values, count: int | None = None) -> list[float]:
     if count is not None and len(values) != count:
         raise ConfigError(f"{what} takes {count} numbers, got {len(values)}")
     try:
-        out = [float(v) for v in values]
+        out = [decimal(v) for v in values]
     except ValueError:
-        raise ConfigError(f"{what}: not a number in {' '.join(values)}") from None
+        raise ConfigError(f"{what}: not a decimal number in {' '.join(values)} (digits, an "
+                          "optional point and exponent; no separators)") from None
     if not all(math.isfinite(v) for v in out):
         raise ConfigError(f"{what} must be finite, got {' '.join(values)}")
     return out
@@ -80,6 +84,19 @@ def _start_q(values, cell):
     q = check_joint_vector("--start-q", q, robot.q_min, robot.q_max, "rad")
     check_start(q, robot.q_home, "--start-q")
     return q
+
+
+def _r_land(value) -> float:
+    """``--r-land`` (m) within R_LAND_RANGE: a smaller disc is within the landing's spread
+    (its prediction and verify's recomputation agree only to R_LAND_RANGE[0])."""
+    r = _numbers("--r-land", value)[0]
+    lo, hi = R_LAND_RANGE
+    if not lo <= r <= hi:
+        raise ConfigError(f"--r-land must be in [{lo:g}, {hi:g}] m, got {value}: "
+                          + (f"the landing's spread (prediction against verify's check) is "
+                             f"{lo:g} m, a smaller disc cannot be planned to"
+                             if r < lo else "a wider disc is larger than the burger"))
+    return r
 
 
 def _json_out(args, inputs=()) -> None:
@@ -170,7 +187,7 @@ def run_flip(args: argparse.Namespace) -> int:
     location = _burger(args.burger, cell)
     land = None if args.land is None else _numbers("--land", args.land, 2)
     options = SegmentOptions() if args.r_land is None else SegmentOptions(
-        r_land=_numbers("--r-land", args.r_land)[0])
+        r_land=_r_land(args.r_land))
     q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, options)
     plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
@@ -227,15 +244,11 @@ def run_batch(args: argparse.Namespace) -> int:
                             "summary.csv"])
     atlas = _atlas(args, SegmentOptions())
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    executor = None
-    if workers > 1 and len(locations) > 1:
-        executor = make_executor(workers=workers)
-    try:
+    pool = (make_executor(workers=workers) if workers > 1 and len(locations) > 1
+            else contextlib.nullcontext())
+    with pool as executor:  # its workers end with the run, however it ends
         plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
                            executor=executor, atlas=atlas)
-    finally:
-        if executor is not None:
-            executor.shutdown(cancel_futures=True)
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)

@@ -6,6 +6,7 @@ its ``--film``), report."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
 import sys
@@ -65,8 +66,8 @@ def run(args: argparse.Namespace) -> int:
         check_output_dir(plans, "--plans", inputs=[p for p in (args.burgers,) if p]
                          + [args.json, args.figure, getattr(args, "film", None)])
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
-    executor = make_executor(workers=workers) if workers > 1 else None
-    try:
+    pool = make_executor(workers=workers) if workers > 1 else contextlib.nullcontext()
+    with pool as executor:  # its workers end with the run, however it ends
         if stream and not args.plan:
             return _modelled_stream(args, cell, atlas, executor, timeline_path)
         order = check_cook(burgers, cell)
@@ -92,9 +93,6 @@ def run(args: argparse.Namespace) -> int:
         except CookConflictError as exc:  # refused before any motion runs: nothing written
             print(f"flipkit: error: {args.policy}: {exc}", file=sys.stderr)
             return 1
-    finally:
-        if executor is not None:
-            executor.shutdown(cancel_futures=True)
     breach = worst_break(timeline.burgers, args.windows)
     if timeline.ok and breach is not None:  # refused before any motion runs: nothing written
         why = ("the greedy schedule; --policy cpsat searches the others"

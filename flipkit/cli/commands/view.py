@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 import webbrowser
 
@@ -21,11 +20,6 @@ def has_display() -> bool:
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def _stop(signum, frame):
-    """SIGTERM ends the view as Ctrl-C does (the server is stopped on the way out)."""
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
     """Write the page (``--html``), or serve the view and wait for Ctrl-C."""
     plan = Plan.load(args.plan)
@@ -36,14 +30,12 @@ def run(args: argparse.Namespace) -> int:
               "a self-contained page, open it in a browser)")
         return 0
     vis = view_plan(plan, where=args.plan, meshes=args.meshes)
-    previous = signal.signal(signal.SIGTERM, _stop)
-    try:
+    try:  # SIGTERM ends the view as Ctrl-C does (flipkit.cli.signals), the server stopped
         print(f"flipkit view: {plan.behavior} plan, {total:.2f} s, at {vis.url()} "
               "(Ctrl-C to stop)", flush=True)
         if not args.no_browser and has_display():
             webbrowser.open(vis.url(), new=2)
         wait(vis)
     finally:
-        signal.signal(signal.SIGTERM, previous)
         close_visualizer(vis)
     return 0

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import CellConfig
+from flipkit.decimal_text import decimal
 from flipkit.errors import ConfigError
 from flipkit.fileio import InputFileError, data_lines, read_text
 
@@ -157,9 +158,9 @@ def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
             raise CookOrderError(f"{path}: line {n}: expected {len(CSV_HEADER)} values "
                                  f"(burger,t_drop,x,y), got {len(cells)}")
         try:
-            t_drop, x, y = (float(c) for c in cells[1:])
+            t_drop, x, y = (decimal(c) for c in cells[1:])
         except ValueError:
-            raise CookOrderError(f"{path}: line {n}: t_drop, x and y must be numbers, got "
+            raise CookOrderError(f"{path}: line {n}: t_drop, x and y must be decimal numbers, got "
                                  f"{','.join(cells[1:])}") from None
         burgers.append(CookBurger(cells[0], t_drop, x, y))
     return check_cook(burgers, cell, where=str(path))

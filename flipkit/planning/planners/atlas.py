@@ -35,6 +35,7 @@ from flipkit.config.physics import SIMULATION_ONLY
 from flipkit.errors import AtlasError
 from flipkit.fileio import InputFileError, check_input
 from flipkit.fileio import replace_with
+from flipkit.jsonread import strict_loads
 from flipkit.transcription.guess import fit_guess
 
 FORMAT = "flipkit-atlas/1"
@@ -142,7 +143,7 @@ class Atlas:
                              "written by `flipkit atlas build`, or --no-atlas")
         try:
             with np.load(Path(path), allow_pickle=False) as data:
-                header = json.loads(str(data["header"]))
+                header = strict_loads(str(data["header"]))
                 locations = data["locations"]
                 solutions = {k[2:]: data[k] for k in data.files if k.startswith("x_")}
         except (OSError, ValueError, KeyError, RecursionError) as exc:

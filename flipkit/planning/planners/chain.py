@@ -74,9 +74,9 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
 
 
 def finish_plan(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
-    """Verify ``plan`` (against the space limits of ``cell``, which the file does not record);
-    set status, ``failure``, ``report`` and ``wall_time_s``."""
-    plan.report = verify_plan(plan, space=None if cell is None else cell.space)
+    """Verify ``plan`` in ``cell``, the cell it was planned in (default the defaults); set
+    status, ``failure``, ``report`` and ``wall_time_s``."""
+    plan.report = verify_plan(plan, cell=cell)
     if failure is None and not plan.report.ok:
         group, k, amount = plan.report.worst()
         failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"

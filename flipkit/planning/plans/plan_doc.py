@@ -5,11 +5,11 @@ jsonschema), so a malformed file is refused at once. :meth:`Plan.load
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from flipkit.errors import PlanFileError
 from flipkit.fileio import InputFileError, read_text
+from flipkit.jsonread import DuplicateKeyError, strict_loads
 
 FORMAT = "flipkit-plan/2"
 FORMATS = ("flipkit-plan/1", FORMAT)  # readable; /1: before per-segment payloads and portable URDFs
@@ -23,8 +23,9 @@ def read_plan_doc(path) -> dict:
 
     Raises:
         PlanFileError: Missing, not a regular file, larger than :data:`MAX_PLAN_BYTES`, not
-            UTF-8, not JSON (nested too deeply included), not an object, an unknown format
-            or a missing top-level key — one line naming the file.
+            UTF-8, not JSON (nested too deeply included; a key repeated in one object,
+            :func:`flipkit.jsonread.strict_loads`), not an object, an unknown
+            format or a missing top-level key — one line naming the file.
     """
     path = Path(path)
     try:
@@ -33,7 +34,9 @@ def read_plan_doc(path) -> dict:
         reason = str(exc).split(": ", 1)[-1]
         raise PlanFileError(f"{path}: cannot read plan file ({reason})") from None
     try:
-        doc = json.loads(text)
+        doc = strict_loads(text)
+    except DuplicateKeyError as exc:
+        raise PlanFileError(f"{path}: {exc}") from None
     except RecursionError:
         raise PlanFileError(f"{path}: not a JSON file (nested too deeply to read)") from None
     except ValueError as exc:

@@ -67,11 +67,17 @@ rows by 0.01 and its acceleration rows by 0.001, and leaves everything else unsc
 duration bounds are today's specs' (``duration``): a plan written under other bounds fails
 ``time_grid``.
 Task-space position, velocity and acceleration bounds (cell.limits) are not checked. The
-pitch range, the cell's boxes and margin and the side table come from the plan's
-``cell_geometry`` record (:mod:`flipkit.planning.plans.cell_record`): ``arm_clearance``,
-``orientation`` and ``placing`` check against the cell the plan was made in (an older file
-without the record, against today's defaults of :class:`~flipkit.config.CellConfig`, as
-``time_grid`` checks against today's duration bounds).
+checks run in the cell the plan will run in — :class:`~flipkit.config.CellConfig`'s
+defaults, or the ``cell`` given (``flipkit verify --cell FILE``) — never in the plan's own
+record of its cell, which is only compared with it: a record that differs is refused by
+field (:mod:`flipkit.planning.plans.cell_in_use`). The pitch range, the cell's boxes and
+margin, the side table, the grill, the acceleration bounds and the arm's profile are that
+cell's.
+
+``tol`` is bounded to :data:`TOL_RANGE` (at most 10 × :data:`TOL`): a looser tolerance would
+pass a burger or a pose centimetres off. The landing's own bounds do not scale with it: a
+flip's ``target`` lies on the grill and its ``r_land`` within :data:`~flipkit.config.task.R_LAND_RANGE`,
+every scenario's within [r_land, R_LAND_RANGE[1]] (group ``landing``).
 """
 
 from __future__ import annotations
@@ -93,6 +99,8 @@ from flipkit.model.contact import make_cone, specific_force
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.model.orientation import rpy
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
+from flipkit.config import CellConfig
+from flipkit.planning.plans.cell_in_use import check_record, checked_cell
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.hermite import hermite_extremes
 from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
@@ -100,10 +108,10 @@ from flipkit.planning.plans.verify_flight import check_flight
 from flipkit.planning.plans.verify_safety import check_safety
 # the report's types, importable from here as before
 from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
-from flipkit.planning.plans.verify_report import GROUPS, GroupResult, VerificationReport  # noqa: F401
+from flipkit.planning.plans.verify_report import (GROUPS, TOL, TOL_RANGE,  # noqa: F401
+                                                  GroupResult, VerificationReport)
 from flipkit.errors import VerificationError
 
-TOL = 1e-5  # scaled units: 10 × SQPOptions.tol
 TIME_TOL = 1e-9  # s, node times against i T / N
 INTERPOLANT_TOL = (100.0, 1000.0)  # × tol: the solver's row scales 0.01 (q̇) and 0.001 (q̈)
 def _outside(x, lo, hi) -> np.ndarray:
@@ -126,25 +134,34 @@ def _point_height(st, r_local) -> float:
     return float(_point(st, r_local)[2])
 
 
-def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
-    """Check every segment of ``plan`` and the joints between them.
+def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
+                where: str = "plan") -> VerificationReport:
+    """Check every segment of ``plan`` and the joints between them, in the cell it will run in.
 
     Args:
         plan: The plan (e.g. :meth:`Plan.load`).
-        tol: Tolerance in the solver's scaled units (see the module docstring).
-        space: The cell's walls and margin (:class:`~flipkit.config.space.SpaceConfig`) to
-            check ``arm_clearance`` against; default the plan's own (``cell_geometry``, or
-            today's defaults for a file without it).
+        tol: Tolerance in the solver's scaled units, within :data:`TOL_RANGE` (see the
+            module docstring).
+        space: Walls and margin (:class:`~flipkit.config.space.SpaceConfig`) to check
+            ``arm_clearance`` against in place of the cell's: a what-if check of the plan in
+            another space, whose record's space is then not compared.
+        cell: The cell the plan will run in (:class:`~flipkit.config.CellConfig`); default
+            the defaults. The plan's record of its cell must match it.
+        where: How a refusal names the plan (its file).
 
     Raises:
+        CellMismatchError: The plan's record of its cell differs from ``cell`` (one line
+            naming the fields).
         PlanFileError: The plan's model cannot be rebuilt (URDF missing, payload mismatch).
-        ConfigError: ``tol`` is not positive and finite.
+        ConfigError: ``plan`` is not a :class:`Plan`, ``tol`` is not a number in
+            :data:`TOL_RANGE` or ``cell`` not a CellConfig.
     """
-    if not (math.isfinite(tol) and tol > 0):
-        raise ConfigError(f"tol must be a positive finite number, got {tol!r}")
-    cell = plan.cell()
-    if space is not None:
+    check_arguments(plan, tol, cell)
+    cell = cell or CellConfig()
+    if space is not None:  # a what-if space: the record's own is not compared with it
         cell = replace(cell, space=space)
+    check_record(plan, cell, where, compare_space=space is None)
+    cell = checked_cell(plan, cell)
     report = VerificationReport(tol, [s.name for s in plan.segments])
     if plan.cone == "paper":
         report.groups["cone"].unit = "1"  # cosine margin, dimensionless
@@ -171,6 +188,19 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None) -> VerificationReport:
             jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))
             report.add("continuity", k, jump, tol, 0)
     return report
+
+
+def check_arguments(plan, tol, cell) -> None:
+    """Refuse arguments of :func:`verify_plan` of the wrong type or range (one line)."""
+    if (isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating))
+            or not (math.isfinite(tol) and TOL_RANGE[0] <= tol <= TOL_RANGE[1])):
+        raise ConfigError(f"tol must be a number in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}] "
+                          f"(scaled units), got {tol!r}")
+    if not isinstance(plan, Plan):
+        raise ConfigError(f"plan: expected a Plan (Plan.load(path)), got "
+                          f"{type(plan).__name__}")
+    if cell is not None and not isinstance(cell, CellConfig):
+        raise ConfigError(f"cell: expected a CellConfig, got {type(cell).__name__}")
 
 
 def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
@@ -328,7 +358,7 @@ def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
 
 
 def require_verified(plan: Plan, where, behaviors=None, *, force: bool = False,
-                     tol: float = TOL) -> VerificationReport:
+                     tol: float = TOL, cell=None) -> VerificationReport:
     """The gate before anything runs a plan (simulates, renders, exports it): the plan is of
     one of ``behaviors``, ``solved`` (unless ``force``) and passes :func:`verify_plan`.
 
@@ -337,20 +367,23 @@ def require_verified(plan: Plan, where, behaviors=None, *, force: bool = False,
         behaviors: The behaviours accepted (``None``: any).
         force: Accept a plan whose status is not ``solved`` (it must still verify).
         tol: Verification tolerance (scaled units, :data:`TOL`).
+        cell: The cell the plan will run in (:func:`verify_plan`); default the defaults.
 
     Returns:
         The passing report.
 
     Raises:
-        VerificationError: The plan is of another behaviour, not solved, or fails a check
-            group (one line naming the file, the group, its segment and amount).
+        VerificationError: The plan is of another behaviour, not solved, was planned for
+            another cell (:class:`~flipkit.planning.plans.cell_in_use.CellMismatchError`)
+            or fails a check group (one line naming the file, the group, its segment and
+            amount).
     """
     wanted = "" if behaviors is None else " " + " or ".join(behaviors)
     if (behaviors is not None and plan.behavior not in behaviors) or (
             plan.status != "solved" and not force):
         raise VerificationError(f"{where}: plan status is {plan.status!r}, behavior "
                                 f"{plan.behavior!r}; this needs a solved{wanted} plan")
-    report = verify_plan(plan, tol=tol)
+    report = verify_plan(plan, tol=tol, cell=cell, where=str(where))
     if not report.ok:
         raise VerificationError(f"{where}: {report.summary()}; refused (`flipkit verify "
                                 f"{where}` lists every check)")

@@ -10,11 +10,14 @@ query between the blade (a box of the spatula's length, width and thickness unde
 carrying face) and the burger (a cylinder) with coal, the collision library shipped with
 pinocchio.
 
-Rows of group ``landing``: the recomputed landing offset beyond ``r_land`` (m), the tilt
+Rows of group ``landing``: the target's distance outside the grill area (m), ``r_land``
+outside :data:`~flipkit.config.task.R_LAND_RANGE` (m), the recomputed landing offset beyond
+``r_land`` (m), the tilt
 short of :data:`~flipkit.config.task.TILT_MIN_DEG` (deg), and the recorded prediction against
 the recomputed one (point m, tilt deg, time of flight s; tolerances :data:`LANDING_TOL`).
 Group ``landing_scenarios`` (robust flips): the same rows for every recorded scenario of the
-burger's place on the blade, each against its own ``r_land``. Group
+burger's place on the blade, each against its own ``r_land`` (which lies in [r_land,
+R_LAND_RANGE[1]]). Group
 ``flight_clearance``: penetration depth (m) of the blade into the flying burger at the nodes
 after the release.
 """
@@ -27,10 +30,11 @@ import coal
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from flipkit.config.task import TILT_MIN_DEG  # the task's bound: the check is this module's own
+# the task's bounds; the check itself is this module's own
+from flipkit.config.task import R_LAND_RANGE, TILT_MIN_DEG
 from flipkit.model.collision import pin_box_support
 
-LANDING_TOL = {"m": 1e-4, "deg": 1e-2, "s": 1e-4}
+LANDING_TOL = {"m": R_LAND_RANGE[0], "deg": 1e-2, "s": 1e-4}  # the smallest r_land: 0.1 mm
 
 
 def _disc_inertia(cell) -> np.ndarray:
@@ -117,7 +121,13 @@ def check_flight(report, k, seg, robot, cell, states) -> None:
         add("landing", k, [math.inf], tol["m"], seg.release["node"] if seg.release else None)
         return
     r = seg.release["node"]
-    offset = float(np.linalg.norm(pred["point"][:2] - np.asarray(rec["target"])))
+    g, (lo, hi) = cell.grill, R_LAND_RANGE
+    target = np.asarray(rec["target"], float)  # on the grill, the disc within the range
+    add("landing", k, np.maximum(np.concatenate([np.array([g.x_range[0], g.y_range[0]]) - target,
+                                                 target - np.array([g.x_range[1], g.y_range[1]])]),
+                                 0.0), tol["m"], r)
+    add("landing", k, [max(lo - rec["r_land"], rec["r_land"] - hi, 0.0)], tol["m"], r)
+    offset = float(np.linalg.norm(pred["point"][:2] - target))
     add("landing", k, [max(offset - rec["r_land"], 0.0)], tol["m"], r)
     add("landing", k, [max(TILT_MIN_DEG - pred["tilt_deg"], 0.0)], tol["deg"], r)
     add("landing", k, np.abs(pred["point"] - np.asarray(rec["point"])), tol["m"], r)
@@ -129,7 +139,9 @@ def check_flight(report, k, seg, robot, cell, states) -> None:
         if alt is None:
             add("landing_scenarios", k, [math.inf], tol["m"], r)
             continue
-        miss = float(np.linalg.norm(alt["point"][:2] - np.asarray(rec["target"])))
+        add("landing_scenarios", k, [max(rec["r_land"] - row["r_land"], row["r_land"] - hi, 0.0)],
+            tol["m"], r)
+        miss = float(np.linalg.norm(alt["point"][:2] - target))
         add("landing_scenarios", k, [max(miss - row["r_land"], 0.0)], tol["m"], r)
         add("landing_scenarios", k, [max(TILT_MIN_DEG - alt["tilt_deg"], 0.0)], tol["deg"], r)
         add("landing_scenarios", k, np.abs(alt["point"] - np.asarray(row["point"])), tol["m"], r)

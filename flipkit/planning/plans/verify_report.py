@@ -1,5 +1,6 @@
 """The result of :func:`flipkit.planning.plans.verify.verify_plan`: per check group, the worst row
-relative to its tolerance, where it is, and whether the group passes."""
+relative to its tolerance, where it is, and whether the group passes; and the tolerance's
+default and range (:data:`TOL`, :data:`TOL_RANGE`), light to import for the command line."""
 
 from __future__ import annotations
 
@@ -11,6 +12,11 @@ import numpy as np
 
 from flipkit.errors import VerificationError
 from flipkit.fileio import write_text
+
+TOL = 1e-5  # scaled units: 10 × SQPOptions.tol (verify's module docstring)
+# scaled units: tighter than TOL down to 1e-9, looser at most 10 ×, so that no pose or burger
+# centimetres off passes (at 1, a burger moved 5 cm did)
+TOL_RANGE = (1e-9, 1e-4)
 
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",
           "qd_limits": "rad/s", "qdd_limits": "rad/s²", "u_limits": "N·m",
@@ -99,12 +105,15 @@ class VerificationReport:
 
     def table(self) -> str:
         """The groups as a text table: unit, max violation, tolerance, where, ok/FAIL."""
-        rows = [f"{'group':<16}{'unit':<16}{'max violation':>14}{'tolerance':>11}  "
+        # each column as wide as its longest entry and two spaces apart
+        name_w = max(len("group"), *(len(g.name) for g in self.groups.values())) + 2
+        unit_w = max(len("unit"), *(len(g.unit) for g in self.groups.values())) + 2
+        rows = [f"{'group':<{name_w}}{'unit':<{unit_w}}{'max violation':>14}{'tolerance':>11}  "
                 f"{'segment':<16}status"]
         for g in self.groups.values():
             where = "-" if g.segment is None else f"{g.segment}:{self.segments[g.segment]}"
             tol = "-" if math.isinf(g.tolerance) else f"{g.tolerance:.2e}"
-            rows.append(f"{g.name:<16}{g.unit:<16}{g.violation:>14.3e}{tol:>11}  "
+            rows.append(f"{g.name:<{name_w}}{g.unit:<{unit_w}}{g.violation:>14.3e}{tol:>11}  "
                         f"{where:<16}{'ok' if g.ok else 'FAIL'}")
         return "\n".join(rows)
 
@@ -126,4 +135,4 @@ class VerificationReport:
             raise VerificationError(self.summary())
 
 
-__all__ = ["GROUPS", "GroupResult", "VerificationReport"]
+__all__ = ["GROUPS", "TOL", "TOL_RANGE", "GroupResult", "VerificationReport"]
