@@ -1,12 +1,16 @@
 """The ``flipkit`` command line.
 
 Each sub-command lives in :mod:`flipkit.cli` as a module with ``register(subparsers)``;
-errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit 2.
+errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit with the
+error's status (2: bad input; 1: work that could not be done, such as sweep items whose
+worker died on every attempt). A worker process that dies outside a sweep (the executors
+of ``plan batch`` and ``schedule``) ends the command the same way, one line and exit 1.
 """
 
 from __future__ import annotations
 
 import argparse
+import concurrent.futures as cf
 import importlib
 import sys
 
@@ -31,7 +35,10 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.run(args) or 0)
     except FlipkitError as exc:
         print(f"flipkit: error: {exc}", file=sys.stderr)
-        return 2
+        return exc.exit_status
+    except cf.BrokenExecutor as exc:
+        print(f"flipkit: error: a worker process died ({exc})", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("flipkit: interrupted", file=sys.stderr)
         return 130

@@ -38,7 +38,7 @@ from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
-                                            trial_key)
+                                            trial_key, trial_label)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
@@ -308,7 +308,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     records = {}
     if contingencies and replan:
         jobs, records = attach(jobs, executor, cache_dir)
-    results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
+    results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials",
+                        label_fn=trial_label)
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
