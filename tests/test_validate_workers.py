@@ -29,16 +29,22 @@ def pool_workers(pid) -> list[int]:
     return [c.pid for s in servers for c in s.children()]
 
 
-def run_killing(argv, cache: Path, rng, workers) -> tuple[subprocess.CompletedProcess, int]:
-    """Run ``argv``; once its first trial is in ``cache``, wait a random moment (up to
-    0.5 s) and SIGKILL one of ``workers(pid)``. Returns the finished run and the pid killed."""
+def started(argv, cache: Path, rng) -> subprocess.Popen:
+    """``argv`` running, a random moment (up to 0.5 s) after its first trial is in ``cache``."""
     proc = subprocess.Popen(argv, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+                            text=True, start_new_session=True)
     deadline = time.monotonic() + 60
     while not list(cache.glob("*.json")) and time.monotonic() < deadline:
         assert proc.poll() is None, proc.communicate()[1]
         time.sleep(0.02)
     time.sleep(float(rng.uniform(0.0, 0.5)))
+    return proc
+
+
+def run_killing(argv, cache: Path, rng, workers) -> tuple[subprocess.CompletedProcess, int]:
+    """Run ``argv``; a random moment after its first trial is in ``cache``, SIGKILL one of
+    ``workers(pid)``. Returns the finished run and the pid killed."""
+    proc = started(argv, cache, rng)
     victim = workers(proc.pid)[0]
     os.kill(victim, signal.SIGKILL)
     out, err = proc.communicate(timeout=120)
@@ -72,6 +78,20 @@ def test_a_killed_local_worker_without_cache(flip_plan_file, undisturbed, tmp_pa
     assert any(line.startswith("flipkit: a worker died running location (0.690, -0.160, "
                                "0.072) trial ") for line in lines)
     assert not (tmp_path / "k.run-cache").exists()  # removed once the command succeeded
+
+
+def test_a_stopped_command_resumes_from_its_run_cache(flip_plan_file, undisturbed, tmp_path):
+    out, run_cache = tmp_path / "k.json", tmp_path / "k.run-cache"
+    argv = command(flip_plan_file, out, "--workers", "2")
+    proc = started(argv, run_cache, np.random.default_rng(4))
+    os.killpg(proc.pid, signal.SIGKILL)  # the command and its workers, as a reboot would
+    proc.communicate(timeout=60)
+    kept = len(list(run_cache.glob("*.json")))
+    assert 1 <= kept < TRIALS and not out.exists()
+    again = subprocess.run(argv, env=ENV, capture_output=True, text=True, timeout=120)
+    check(again, out, undisturbed)
+    assert again.stderr.startswith(f"flipkit validate: resuming from the run cache {run_cache}/")
+    assert not run_cache.exists()
 
 
 def test_a_killed_local_worker_with_cache(flip_plan_file, undisturbed, tmp_path):

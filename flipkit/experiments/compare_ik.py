@@ -49,6 +49,12 @@ def plan_filename(location, solver: str) -> str:
     return "plan_" + "_".join(f"{v:+.3f}" for v in location) + f"_{solver}.json"
 
 
+def location_label(job: dict) -> str:
+    """A planning job (``location`` m, ``solver``) as messages name it."""
+    x, y, z = job["location"]
+    return f"location ({x:.3f}, {y:.3f}, {z:.3f}) solver {job['solver']}"
+
+
 def _collocation(location, solver: str, plans_dir) -> dict:
     t0 = time.perf_counter()
     try:
@@ -205,7 +211,7 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
     jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir, "judge_rate": RATE,
              "ik": IK, "ee": EE} for loc in locs]  # judge and IK in the job: caches of other setups miss
     records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
-                        desc="compare-ik")
+                        desc="compare-ik", label_fn=location_label)
     entries = [{"location": r["location"],
                 "collocation": {k: r["collocation"][k]
                                 for k in ("status", "reason", "time_s", "judge")},
@@ -232,5 +238,4 @@ def format_summary(summary: dict) -> str:
 
 
 __all__ = ["compare_location", "compare_ik", "summarize", "format_summary",
-           "worst_class",
-           "plan_filename"]
+           "worst_class", "location_label", "plan_filename"]

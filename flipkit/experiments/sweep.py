@@ -172,7 +172,8 @@ def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, ke
     if failed:
         names = "; ".join(label(i) for i in failed[:3])
         more = f" and {len(failed) - 3} more" if len(failed) > 3 else ""
-        kept = f", kept in {cache_dir}" if cache_dir is not None else ""
+        kept = (f", kept in {cache_dir} (the same sweep resumes from there)"
+                if cache_dir is not None else "")
         lost = sum(1 + len(copies.get(i, ())) for i in failed)
         raise SweepError(f"{desc}: {names}{more}: worker died on each of {retries + 1} "
                          f"attempts; the {len(items) - lost} other items finished{kept}")

@@ -28,7 +28,7 @@ from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.config.checks import whole
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
-from flipkit.experiments.compare_ik import plan_filename
+from flipkit.experiments.compare_ik import location_label, plan_filename
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.ratios import success_intervals
 from flipkit.experiments.perturbations import Perturbations, check_seed, trial_rng
@@ -382,10 +382,10 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold}
                 for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
-                          desc="plans")
+                          desc="plans", label_fn=location_label)
         stale = [i for i, r in enumerate(infos) if r["path"] and not Path(r["path"]).is_file()]
         for i, r in zip(stale, run_sweep(plan_location, [jobs[i] for i in stale], executor,
-                                         None, progress=False)):
+                                         None, progress=False, label_fn=location_label)):
             infos[i] = r  # a cached result whose plan file was deleted: plan again
         targets = [(loc, {k: r[k] for k in ("status", "reason", "time_s")},
                     Path(r["path"]).read_text() if r["status"] == "solved" else None)
