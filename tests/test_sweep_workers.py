@@ -6,6 +6,7 @@ import os
 import signal
 import threading
 import time
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -131,3 +132,23 @@ def test_a_dask_cluster_that_loses_a_worker_finishes_the_sweep(tmp_path):
     assert killed and killed[0][1] in before  # a Dask worker was killed mid-item
     assert got == [square(x) for x in range(N)]
     assert attempts(tmp_path, killed[0][0]) == 2  # Dask ran the killed item again
+
+
+@pytest.mark.parametrize("error", [
+    SweepError("trials: location (0.750, 0.000, 0.073) trial 3 seed 9: worker died on each of "
+               "3 attempts; the 99 other items finished"),
+    BrokenProcessPool("A process in the process pool was terminated abruptly"),
+])
+def test_the_command_line_ends_a_lost_item_with_one_line_and_exit_1(error, monkeypatch, capsys,
+                                                                     tmp_path):
+    from flipkit.cli import main
+    from flipkit.cli.commands import validate
+
+    def run(args):
+        raise error
+
+    monkeypatch.setattr(validate, "run", run)
+    code = main(["validate", "--locations", "table1", "--trials", "1", "--no-progress",
+                 "--json", str(tmp_path / "k.json")])
+    (line,) = capsys.readouterr().err.splitlines()
+    assert code == 1 and line.startswith("flipkit: error: ") and str(error) in line

@@ -9,7 +9,7 @@ import argparse
 from flipkit.cli.common import write_json
 from flipkit.cli.run_cache import sweep_cache
 from flipkit.config import LOCATION_SETS
-from flipkit.experiments.compare_ik import compare_ik, format_summary
+from flipkit.experiments.compare_ik import check_locations, compare_ik, format_summary
 from flipkit.experiments.sweep import grill_grid, make_executor
 
 
@@ -19,8 +19,9 @@ def run(args: argparse.Namespace) -> int:
     if args.grid is not None:
         locations += grill_grid(nx=args.grid[0], ny=args.grid[1])
     locations += [tuple(b) for b in args.burger or ()]
-    with sweep_cache(args.cache, args.json, "compare-ik") as cache, \
-            make_executor(args.scheduler, args.workers) as executor:
+    check_locations(locations)  # refused before the run cache is named
+    with make_executor(args.scheduler, args.workers) as executor, \
+            sweep_cache(args.cache, args.json, "compare-ik") as cache:
         out = compare_ik(locations, args.solver, executor, cache, args.plans,
                          progress=not args.no_progress)
         write_json(args.json, out)

@@ -31,8 +31,8 @@ def run(args: argparse.Namespace) -> int:
                   replan=args.replan, command=args.command,
                   servo_lookahead_s=args.servo_lookahead, servo_form=args.servo_form,
                   **({"contingencies": True} if args.contingencies else {}))
-    with sweep_cache(args.cache, args.json, "validate") as cache, \
-            make_executor(args.scheduler, args.workers) as executor:
+    with make_executor(args.scheduler, args.workers) as executor, \
+            sweep_cache(args.cache, args.json, "validate") as cache:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
                                      cache_dir=cache, **common)
