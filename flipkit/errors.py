@@ -10,7 +10,13 @@ from typing import Any, Iterable
 
 
 class FlipkitError(Exception):
-    """Root of every flipkit error."""
+    """Root of every flipkit error.
+
+    Attributes:
+        exit_status: The command line's exit status for it: 2, bad input refused.
+    """
+
+    exit_status = 2
 
 
 class ConfigError(FlipkitError, ValueError):
@@ -97,3 +103,11 @@ class ExportError(FlipkitError):
     """A verified plan that cannot be written in the asked export format: a streamed joint
     command outside the model's position limits, or a robot whose joints the format cannot
     name."""
+
+
+class SweepError(FlipkitError):
+    """Sweep items that could not be computed although their input was accepted: their
+    worker died on every attempt, or the executor was lost. The items that finished are kept
+    (in the sweep's cache), so the same command resumes."""
+
+    exit_status = 1

@@ -92,9 +92,11 @@ def test_validate_with_two_workers_ends_on_sigterm(flip_plan_file, tmp_path):
     argv = ["validate", "--plan", flip_plan_file, "--trials", "20", "--workers", "2",
             "--no-progress", "--json", tmp_path / "v.json"]
     code, err, took, survivors = _run_and_signal(argv, signal.SIGTERM, 4, tmp_path)
-    assert code == 143 and err.strip() == "flipkit: terminated", err
+    lines = err.strip().splitlines()  # the run cache's line, then the farewell
+    assert code == 143 and lines[-1] == "flipkit: terminated" and len(lines) == 2, err
+    assert "run the same command again to resume" in lines[0], err
     assert not survivors and took < 10
-    assert os.listdir(tmp_path) == []
+    assert os.listdir(tmp_path) == ["v.run-cache"]  # kept for the resume; no result file
 
 
 def test_farewell_names_the_signal():

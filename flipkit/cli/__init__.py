@@ -1,14 +1,19 @@
 """The ``flipkit`` command line.
 
 Each sub-command lives in :mod:`flipkit.cli` as a module with ``register(subparsers)``;
-errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit 2. SIGINT,
-SIGTERM and SIGHUP stop a command with everything it started (:mod:`flipkit.cli.signals`):
-one line (``flipkit: interrupted``, ``terminated``, ``hung up``) and exit 130, 143 or 129.
+errors derived from :class:`~flipkit.errors.FlipkitError` print one line and exit with the
+error's status (2: bad input; 1: work that could not be done, such as sweep items whose
+worker died on every attempt). A worker process that dies outside a sweep (the executors
+of ``plan batch`` and ``schedule``) ends the command the same way, one line and exit 1.
+SIGINT, SIGTERM and SIGHUP stop a command with everything it started
+(:mod:`flipkit.cli.signals`): one line (``flipkit: interrupted``, ``terminated``, ``hung
+up``) and exit 130, 143 or 129.
 """
 
 from __future__ import annotations
 
 import argparse
+import concurrent.futures as cf
 import importlib
 import sys
 
@@ -35,7 +40,10 @@ def main(argv: list[str] | None = None) -> int:
             return int(args.run(args) or 0)
     except FlipkitError as exc:
         print(f"flipkit: error: {exc}", file=sys.stderr)
-        return 2
+        return exc.exit_status
+    except cf.BrokenExecutor as exc:
+        print(f"flipkit: error: a worker process died ({exc})", file=sys.stderr)
+        return 1
     except KeyboardInterrupt as exc:
         line, status = farewell(exc)
         print(line, file=sys.stderr)

@@ -5,7 +5,8 @@ and single burgers (``--burger X Y Z``, repeatable), in that order; at least one
 
 Exit status: 0 the comparison ran (whatever the methods' outcomes); 2 bad input (no location
 given, a grid size below 1, a location off the grill, an unreachable scheduler, an unwritable
-output) — one line on stderr.
+output) — one line on stderr; 1 a location whose worker died on every attempt (one line;
+the finished locations stay in the cache).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 stops it.
 
 Python turns SIGINT into :class:`KeyboardInterrupt`, and everything a command started —
-worker pools (:class:`~flipkit.experiments.sweep.WorkerPool` terminates its workers when an
+worker pools (:class:`~flipkit.experiments.worker_pool.WorkerPool` terminates its workers when an
 exception leaves it), the CP-SAT child (closed at exit) — is stopped on the way out. SIGTERM
 and SIGHUP would kill the process at once, leaving those children running with the
 caller's standard output and error open. :func:`signals_raise` makes them raise

@@ -3,9 +3,10 @@
 Exit status: 0 the trials ran (whatever their outcomes); 2 bad input (missing or malformed
 plan file, a plan that is not a solved flip or serve plan or fails ``flipkit verify``,
 ``--contingencies`` without ``--replan`` or with a serve plan, trials outside [1, 10000], a
-rate outside [10, 100000] Hz, a location off the grill, an unreachable scheduler, an output
-that is not a writable ``.json`` file or is the plan) — one line on stderr, checked before
-any trial runs, nothing written.
+negative seed, a rate outside [10, 100000] Hz, a location off the grill, an unreachable
+scheduler, an output that is not a writable ``.json`` file or is the plan) — one line on
+stderr, checked before any trial runs, nothing written; 1 a sweep item whose worker died on
+every attempt (one line; the finished items stay in the cache).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import argparse
 from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES,
                                 add_sweep_arguments, check_float, check_int, deferred,
                                 precheck_plan)
+from flipkit.config.checks import whole
 from flipkit.config.physics import servo_lookahead
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
@@ -107,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
     """Check the options, the outputs and the plan file cheaply, then verify the plan and run
     the trials (:mod:`flipkit.cli.commands.validate`)."""
     check_int("--trials", args.trials, 1, MAX_TRIALS)
+    whole("seed", args.seed)
     if args.contingencies and not args.replan:
         raise ConfigError("--contingencies needs --replan: they are re-plans made ahead")
     check_float("--rate", args.rate, *RATE_RANGE, "Hz")

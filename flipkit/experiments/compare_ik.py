@@ -49,6 +49,12 @@ def plan_filename(location, solver: str) -> str:
     return "plan_" + "_".join(f"{v:+.3f}" for v in location) + f"_{solver}.json"
 
 
+def location_label(job: dict) -> str:
+    """A planning job (``location`` m, ``solver``) as messages name it."""
+    x, y, z = job["location"]
+    return f"location ({x:.3f}, {y:.3f}, {z:.3f}) solver {job['solver']}"
+
+
 def _collocation(location, solver: str, plans_dir) -> dict:
     t0 = time.perf_counter()
     try:
@@ -169,6 +175,21 @@ def summarize(records: list) -> dict:
             "median_time_s": {"collocation": coll, "ee_ik": ee}}
 
 
+def check_locations(locations, cell: CellConfig | None = None) -> list[list[float]]:
+    """``locations`` (m) as lists of floats, each checked to lie on ``cell``'s grill.
+
+    Raises:
+        UnreachableError: A location off the grill (named by its index, from 1).
+    """
+    cell, locs = cell or CellConfig(), []
+    for k, loc in enumerate(locations, 1):
+        try:
+            locs.append([float(v) for v in tg.check_location(cell, loc)])
+        except UnreachableError as exc:
+            raise UnreachableError(f"location {k}: {exc}") from None
+    return locs
+
+
 def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, plans_dir=None,
                progress: bool = True, cell: CellConfig | None = None) -> dict:
     """Run both methods at every location and summarise.
@@ -193,19 +214,14 @@ def compare_ik(locations, solver: str = "sqp", executor=None, cache_dir=None, pl
     """
     if solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
-    cell, locs = cell or CellConfig(), []
-    for k, loc in enumerate(locations, 1):
-        try:
-            locs.append([float(v) for v in tg.check_location(cell, loc)])
-        except UnreachableError as exc:
-            raise UnreachableError(f"location {k}: {exc}") from None
+    locs = check_locations(locations, cell)
     if plans_dir is not None:
         Path(plans_dir).mkdir(parents=True, exist_ok=True)
         plans_dir = str(Path(plans_dir).resolve())
     jobs = [{"location": loc, "solver": solver, "plans_dir": plans_dir, "judge_rate": RATE,
              "ik": IK, "ee": EE} for loc in locs]  # judge and IK in the job: caches of other setups miss
     records = run_sweep(compare_location, jobs, executor, cache_dir, progress=progress,
-                        desc="compare-ik")
+                        desc="compare-ik", label_fn=location_label)
     entries = [{"location": r["location"],
                 "collocation": {k: r["collocation"][k]
                                 for k in ("status", "reason", "time_s", "judge")},
@@ -232,5 +248,4 @@ def format_summary(summary: dict) -> str:
 
 
 __all__ = ["compare_location", "compare_ik", "summarize", "format_summary",
-           "worst_class",
-           "plan_filename"]
+           "worst_class", "location_label", "plan_filename", "check_locations"]

@@ -20,7 +20,8 @@ from flipkit.config import PHYSICAL_RANGES, with_parameter
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import run_sweep
-from flipkit.experiments.trial_jobs import TRACK_RATE_HZ, plan_from_text, trial_jobs, trial_key
+from flipkit.experiments.trial_jobs import (TRACK_RATE_HZ, plan_from_text, trial_jobs, trial_key,
+                                            trial_label)
 from flipkit.experiments.trials import STAGES, run_trial
 from flipkit.simulation.modes import FEEDFORWARD
 
@@ -106,7 +107,7 @@ def run_sensitivity(plan_texts, trials: int = 2, parameters=None, seed: int = 0,
                              None if same else {name: value}, servo_form=servo_form)
             jobs, owner = jobs + new, owner + [k] * len(new)
     results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress,
-                        desc="sensitivity", dedupe=True)
+                        desc="sensitivity", dedupe=True, label_fn=trial_label)
     out = {"plans": len(plan_texts), "trials": int(trials), "seed": int(seed), "mode": mode,
            "replan": bool(replan), "servo_form": servo_form, "nominal": None,
            "parameters": {}}

@@ -29,7 +29,7 @@ from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
-                                            trial_key)
+                                            trial_key, trial_label)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.planning.planners.serve import replan_serve, table_spot
@@ -123,7 +123,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
                       replan, servo_physics(servo_lookahead_s), command=command,
                       servo_form=servo_form)
     results = run_sweep(run_serve_trial, jobs, executor, cache_dir, trial_key, progress,
-                        desc="trials")
+                        desc="trials", label_fn=trial_label)
     entry = {"location": plan.burger["location"].tolist(),
              "spot": table_spot(plan).tolist(), "plan": {"status": plan.status,
                                                         "file": str(path)},

@@ -1,12 +1,12 @@
 """Sweeps: one picklable function mapped over many items on an Executor, cached and resumable.
 
-The project's Executor is a :class:`concurrent.futures.Executor`: local worker processes by
-default (:class:`~concurrent.futures.ProcessPoolExecutor`, forkserver start method, so no
-worker inherits a half-initialised solver by forking), or a Dask cluster when a scheduler
-address is given (``dask.distributed.Client(address)``'s executor). :func:`run_sweep` caches
-every result as one JSON file under ``cache_dir`` as soon as it arrives, keyed by a stable
-hash of the item, the function's name and the flipkit version, so a sweep interrupted
-half-way recomputes only what is missing when it is run again.
+The project's Executor (:func:`~flipkit.experiments.executors.make_executor`) is a
+:class:`concurrent.futures.Executor`: local worker processes by default, whose pool is
+replaced when a worker dies, or a Dask cluster when a scheduler address is given.
+:func:`run_sweep` caches every result as one JSON file under ``cache_dir`` as soon as it
+arrives, keyed by a stable hash of the item, the function's name and the flipkit version, so
+a sweep interrupted half-way recomputes only what is missing when it is run again; an item
+whose worker dies is retried (:mod:`flipkit.experiments.retries`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ import concurrent.futures as cf
 import dataclasses
 import hashlib
 import json
-import multiprocessing
 import os
 import re
 import sys
@@ -26,69 +25,9 @@ from tqdm import tqdm
 
 from flipkit import __version__
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, FlipkitError
-from flipkit.experiments.worker_pool import WorkerPool
-
-SINGLE_THREAD_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-
-
-def _single_threaded() -> None:
-    """Worker initializer: one BLAS/OpenMP thread per worker process (unless set)."""
-    for name in SINGLE_THREAD_ENV:
-        os.environ.setdefault(name, "1")
-
-
-def _dask_executor(scheduler: str) -> cf.Executor:
-    """The executor of a Dask client connected to ``scheduler``; it closes the client when
-    shut down."""
-    import distributed.cfexecutor  # Dask takes ~0.5 s to import; only --scheduler needs it
-
-    try:
-        client = distributed.Client(scheduler, timeout="10s", set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise FlipkitError(f"cannot connect to the Dask scheduler at {scheduler}: "
-                           f"{msg}") from None
-
-    class DaskExecutor(distributed.cfexecutor.ClientExecutor):
-        """A Dask client's executor that also closes the client when shut down."""
-
-        def shutdown(self, wait: bool = True) -> None:
-            try:
-                super().shutdown(wait=wait)
-            finally:
-                self._client.close()
-
-    return DaskExecutor(client, pure=False)
-
-
-def make_executor(scheduler: str | None = None, workers: int | None = None) -> cf.Executor:
-    """The executor of a sweep.
-
-    Args:
-        scheduler: Address of a Dask scheduler (e.g. ``tcp://host:8786``); ``None`` for
-            local worker processes.
-        workers: Number of local worker processes (default: the CPU count). Ignored with a
-            scheduler: the cluster decides.
-
-    Returns:
-        An executor; call ``shutdown()`` (or use it in a ``with`` block) when done. A Dask
-        executor closes its client on shutdown.
-
-    Raises:
-        ConfigError: ``workers`` is not a positive integer.
-        FlipkitError: The scheduler cannot be reached (10 s timeout).
-    """
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise ConfigError(f"workers must be a positive integer, got {workers!r}")
-    if scheduler:
-        return _dask_executor(scheduler)
-    methods = multiprocessing.get_all_start_methods()
-    ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    return WorkerPool(max_workers=workers or os.cpu_count() or 1, mp_context=ctx,
-                      initializer=_single_threaded)
-
+from flipkit.errors import ConfigError, FlipkitError, SweepError
+from flipkit.experiments.executors import make_executor
+from flipkit.experiments.retries import RETRIES, run_items
 
 def jsonable(obj):
     """``obj`` as plain JSON values: dataclasses → dicts, tuples and arrays → lists,
@@ -142,34 +81,48 @@ def _write_cache(path: Path, name: str, key, result) -> None:
         raise FlipkitError(f"cannot write the sweep cache {path}: {exc.strerror or exc}") from None
 
 
+def default_label(key) -> str:
+    """An item's name in messages: its key's compact JSON, cut to 80 characters."""
+    text = json.dumps(jsonable(key), sort_keys=True, separators=(",", ":"))
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, key_fn=None,
               progress: bool = True, *, name: str | None = None, desc: str = "sweep",
-              dedupe: bool = False) -> list:
+              dedupe: bool = False, label_fn=None, retries: int = RETRIES) -> list:
     """``[fn(item) for item in items]``, in input order, run on ``executor`` and cached.
 
     Each result is stored as JSON as soon as it arrives, so the function must return JSON
     values (dicts, lists, numbers, strings, ``None``); every result, computed or read back,
-    is returned as its JSON round trip (tuples come back as lists).
+    is returned as its JSON round trip (tuples come back as lists). An item whose worker
+    dies is run again, up to ``retries`` times (:func:`flipkit.experiments.retries.run_items`);
+    the results do not depend on it.
 
     Args:
         fn: A picklable top-level function of one argument.
         items: The arguments; each must be picklable.
-        executor: Where to run; ``None`` runs in this process, one item after the other.
+        executor: Where to run (:func:`~flipkit.experiments.executors.make_executor`);
+            ``None`` runs in this process, one item after the other.
         cache_dir: Directory of the cache (created if missing); ``None`` disables caching.
         key_fn: ``item -> key`` with a JSON form (:func:`jsonable`) identifying the work;
             default the item itself.
         progress: Show a tqdm progress bar on stderr.
         name: Cache namespace of ``fn``; default ``"<module>.<qualname>"``.
-        desc: Progress-bar label.
+        desc: Progress-bar label, and the sweep's name in error messages.
         dedupe: Compute items of equal keys once and give each the same result (the
             function must be deterministic in its key, as the cache assumes).
+        label_fn: ``item -> str`` naming an item in error messages; default
+            :func:`default_label` of its key.
+        retries: Attempts of an item after the first whose worker died.
 
     Returns:
         The results, one per item, in input order.
 
     Raises:
         Whatever ``fn`` raises for an item (pending work is cancelled; results that already
-        arrived stay cached). FlipkitError: The cache cannot be written.
+        arrived stay cached). FlipkitError: The cache cannot be written. SweepError: Items
+        whose worker died on every attempt (raised once every other item finished), or an
+        executor that was lost.
     """
     items = list(items)
     name = name or f"{fn.__module__}.{fn.__qualname__}"
@@ -204,24 +157,26 @@ def run_sweep(fn, items, executor: cf.Executor | None = None, cache_dir=None, ke
             _write_cache(paths[i], name, keys[i], results[i])
         for j in copies.get(i, ()):
             results[j] = json.loads(json.dumps(results[i]))
-            bar.update()
+        bar.update(1 + len(copies.get(i, ())))
+
+    def label(i):
+        return label_fn(items[i]) if label_fn is not None else default_label(keys[i])
 
     with tqdm(total=len(items), initial=cached, desc=desc, unit="item",
               disable=not progress, file=sys.stderr) as bar:
         if executor is None:
             for i in pending:
                 store(i, fn(items[i]))
-                bar.update()
             return results
-        futures = {executor.submit(fn, items[i]): i for i in pending}
-        try:
-            for future in cf.as_completed(futures):
-                store(futures[future], future.result())
-                bar.update()
-        except BaseException:
-            for future in futures:
-                future.cancel()
-            raise
+        failed = run_items(executor, fn, items, pending, store, label, retries)
+    if failed:
+        names = "; ".join(label(i) for i in failed[:3])
+        more = f" and {len(failed) - 3} more" if len(failed) > 3 else ""
+        kept = (f", kept in {cache_dir} (the same sweep resumes from there)"
+                if cache_dir is not None else "")
+        lost = sum(1 + len(copies.get(i, ())) for i in failed)
+        raise SweepError(f"{desc}: {names}{more}: worker died on each of {retries + 1} "
+                         f"attempts; the {len(items) - lost} other items finished{kept}")
     return results
 
 
@@ -247,4 +202,4 @@ def grill_grid(cell: CellConfig | None = None, nx: int = 5, ny: int = 5) -> list
     return [(round(float(x), 6), round(float(y), 6), float(g.height)) for y in ys for x in xs]
 
 
-__all__ = ["WorkerPool", "make_executor", "run_sweep", "grill_grid", "stable_hash", "jsonable"]
+__all__ = ["default_label", "make_executor", "run_sweep", "grill_grid", "stable_hash", "jsonable"]

@@ -107,6 +107,14 @@ def trial_key(job: dict) -> dict:
     return key
 
 
+def trial_label(job: dict) -> str:
+    """A trial job as messages name it: its plan's burger location (m), trial and seed, and
+    the simulated physics it sets, if any."""
+    x, y, z = json.loads(job["plan_text"])["burger"]["location"]
+    physics = "".join(f" {k}={v:g}" for k, v in (job.get("physics") or {}).items())
+    return f"location ({x:.3f}, {y:.3f}, {z:.3f}) trial {job['trial']} seed {job['seed']}{physics}"
+
+
 def judged(judge, run, span, *args):
     """``judge(run, span, *args)``, or ``None`` when the run ended before the span began (the
     arm's safety system stopped it): a stage that never ran is not judged, it failed."""
@@ -207,4 +215,4 @@ def merge_tracking(errors: list) -> dict:
 
 
 __all__ = ["DRAWS", "HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "lookahead_of", "merge_tracking",
-           "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key"]
+           "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key", "trial_label"]

@@ -28,7 +28,7 @@ from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.config.checks import whole
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
-from flipkit.experiments.compare_ik import plan_filename
+from flipkit.experiments.compare_ik import location_label, plan_filename
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.ratios import success_intervals
 from flipkit.experiments.perturbations import Perturbations, check_seed, trial_rng
@@ -38,7 +38,7 @@ from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
-                                            trial_key)
+                                            trial_key, trial_label)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
@@ -308,7 +308,8 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     records = {}
     if contingencies and replan:
         jobs, records = attach(jobs, executor, cache_dir)
-    results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials")
+    results = run_sweep(run_trial, jobs, executor, cache_dir, trial_key, progress, desc="trials",
+                        label_fn=trial_label)
     per = [[r for k2, r in zip(owner, results) if k2 == k] for k in range(len(targets))]
     entries = [location_entry(loc, int(trials), per[k], info)
                for k, (loc, info, _) in enumerate(targets)]
@@ -381,10 +382,10 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold}
                 for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
-                          desc="plans")
+                          desc="plans", label_fn=location_label)
         stale = [i for i, r in enumerate(infos) if r["path"] and not Path(r["path"]).is_file()]
         for i, r in zip(stale, run_sweep(plan_location, [jobs[i] for i in stale], executor,
-                                         None, progress=False)):
+                                         None, progress=False, label_fn=location_label)):
             infos[i] = r  # a cached result whose plan file was deleted: plan again
         targets = [(loc, {k: r[k] for k in ("status", "reason", "time_s")},
                     Path(r["path"]).read_text() if r["status"] == "solved" else None)

@@ -1,11 +1,13 @@
 """``flipkit validate`` once its arguments passed :mod:`flipkit.cli.validate`: verify the
-plan, run the trials on the executor, write the JSON, print the table."""
+plan, run the trials on the executor (cached in ``--cache`` or the run cache,
+:mod:`flipkit.cli.run_cache`), write the JSON, print the table."""
 
 from __future__ import annotations
 
 import argparse
 
 from flipkit.cli.common import write_json
+from flipkit.cli.run_cache import sweep_cache
 from flipkit.cli.validate import format_table
 from flipkit.errors import ConfigError
 from flipkit.config import LOCATION_SETS
@@ -29,16 +31,17 @@ def run(args: argparse.Namespace) -> int:
                   replan=args.replan, command=args.command,
                   servo_lookahead_s=args.servo_lookahead, servo_form=args.servo_form,
                   **({"contingencies": True} if args.contingencies else {}))
-    with make_executor(args.scheduler, args.workers) as executor:
+    with make_executor(args.scheduler, args.workers) as executor, \
+            sweep_cache(args.cache, args.json, "validate") as cache:
         if args.plan is not None:
             out = validate_plan_file(args.plan, args.trials, args.seed, executor=executor,
-                                     cache_dir=args.cache, **common)
+                                     cache_dir=cache, **common)
         else:
             out = validate_locations(LOCATION_SETS[args.locations], args.trials, args.solver,
-                                     args.seed, executor=executor, cache_dir=args.cache,
+                                     args.seed, executor=executor, cache_dir=cache,
                                      plans_dir=args.plans, atlas=not args.no_atlas,
                                      **common)
-    write_json(args.json, out)
+        write_json(args.json, out)
     print(format_table(out))
     total = out["summary"]
     print(f"flipkit validate ({out['mode']}): {total['trials']} trials at "
