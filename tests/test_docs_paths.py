@@ -5,6 +5,7 @@
   ``docs/*.md``, ``README.md`` and ``notebooks/README.md`` exists.
 * ``docs/adding-a-behaviour.md`` quotes the code: its declarations are the code's, and the
   numbers in its prose are the code's.
+* ``notebooks/README.md`` lists every notebook, and every notebook names the project's kernel.
 
 ``docs/benchmarks/`` is left out: its notes are dated records of a run and name the paths of
 their day.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import json
 import os
 import re
 from pathlib import Path, PurePosixPath
@@ -216,3 +218,24 @@ def test_a_changed_bound_is_not_the_code():
     tampered = ast.parse(block.replace("duration=(0.6, 1.2)", "duration=(0.6, 1.6)")).body[0]
     assert ast.dump(tampered) not in code_statements()
 
+
+# ---------------------------------------------------------------- notebooks
+NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
+
+
+def test_the_notebooks_readme_lists_every_notebook():
+    text = (REPO / "notebooks" / "README.md").read_text(encoding="utf-8")
+    listed = set(re.findall(r"^\| `([\w-]+\.ipynb)` \|", text, re.M))
+    assert len(NOTEBOOKS) >= 16
+    assert listed == {p.name for p in NOTEBOOKS}
+
+
+def test_every_notebook_names_the_projects_kernel():
+    """The kernel ``make lab`` registers and :func:`flipkit.figures.kernel_name` installs."""
+    from flipkit.figures.execute import KERNEL_DISPLAY_NAME, KERNEL_NAME
+
+    makefile = (REPO / "Makefile").read_text(encoding="utf-8")
+    assert f'--name {KERNEL_NAME} --display-name "{KERNEL_DISPLAY_NAME}"' in makefile
+    for path in NOTEBOOKS:
+        spec = json.loads(path.read_text(encoding="utf-8"))["metadata"]["kernelspec"]
+        assert (spec["name"], spec["display_name"]) == (KERNEL_NAME, KERNEL_DISPLAY_NAME), path.name
