@@ -97,8 +97,9 @@ def _guess_coeffs(bez: Bezier, s: np.ndarray, start: EEState, goal: tg.Pose) -> 
     return pinv @ P, pinv @ O
 
 
-class Task:
-    """The task data of one subbehaviour at one location (all SI)."""
+class ScpSegment:
+    """One subbehaviour at one location as the SCP states it: its goal pose, the blade's
+    floors and edges, the cone's nodes and friction, gravity (all SI)."""
 
     def __init__(self, name: str, cell: CellConfig, pb: np.ndarray, start: EEState,
                  home: tg.Pose | None):
@@ -160,7 +161,7 @@ def _mapped_landing(k: int):
     return landing_function().map(k)
 
 
-def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
+def violations(task: ScpSegment, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
     """Largest scaled violation of each linearised (nonconvex) constraint group at the
     samples (≤ 0: satisfied): edge heights, tip band and landing in cm, cone rows in g, axes
     and cos tilt unitless."""
@@ -186,7 +187,7 @@ def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> d
     return out
 
 
-def violation(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> float:
+def violation(task: ScpSegment, B: list, C: np.ndarray, D: np.ndarray, T: float) -> float:
     """The largest of :func:`violations`, or 0 when all hold."""
     return float(max(0.0, *violations(task, B, C, D, T).values()))
 
@@ -205,14 +206,14 @@ def _objective(B, C, D, T, w_o) -> float:
 _CACHE: dict = {}  # (name, samples, cone samples) -> SCPProblem
 
 
-def _problem(task: Task, n: int) -> SCPProblem:
+def _problem(task: ScpSegment, n: int) -> SCPProblem:
     key = (task.name, n, len(task.cone_idx(n)))
     if key not in _CACHE:
         _CACHE[key] = SCPProblem(task.name, n, DEGREE, task.cone_idx(n), task.release)
     return _CACHE[key]
 
 
-def _meet_ends(task: Task, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
+def _meet_ends(task: ScpSegment, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
     """Copies of (C0, D0) whose end control points meet the start state at duration T and
     the end pose (and rest), so that a trust region about them admits the end rows."""
     C, D, st, d = C0.copy(), D0.copy(), task.start, len(C0) - 1
@@ -225,7 +226,7 @@ def _meet_ends(task: Task, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
     return C, D
 
 
-def scp_at_duration(task: Task, T: float, C0: np.ndarray, D0: np.ndarray,
+def scp_at_duration(task: ScpSegment, T: float, C0: np.ndarray, D0: np.ndarray,
                     trust: float = TRUST0) -> dict:
     """The SCP at a fixed duration T (s) from the iterate (C0, D0), trust region ``trust`` (rad).
 
@@ -355,7 +356,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
         if value.shape != (3,) or not np.all(np.isfinite(value)):
             raise ConfigError(f"start.{field_name} must be 3 finite numbers, got {value.tolist()}")
     tic = time.perf_counter()
-    task = Task(name, cell, tg.check_location(cell, location), start, home)
+    task = ScpSegment(name, cell, tg.check_location(cell, location), start, home)
     qp = _problem(task, SAMPLES)
     C, D = _guess_coeffs(qp.bez, np.linspace(0, 1, SAMPLES), start, task.guess_goal)
     evals: dict = {}
@@ -378,7 +379,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
     return _sampled(task, qp.bez, best, T, rate, elapsed, len(evals))
 
 
-def _sampled(task: Task, bez: Bezier, sol: dict, T: float, rate: float, elapsed: float,
+def _sampled(task: ScpSegment, bez: Bezier, sol: dict, T: float, rate: float, elapsed: float,
              n_durations: int) -> EETrajectory:
     t = sample_times(T, rate)
     s = t / T
@@ -394,4 +395,4 @@ def _sampled(task: Task, bez: Bezier, sol: dict, T: float, rate: float, elapsed:
                         durations_tried=n_durations)
 
 
-__all__ = ["plan_segment_scp", "scp_at_duration", "search_duration", "violation", "Task", "DEGREE", "SAMPLES"]
+__all__ = ["plan_segment_scp", "scp_at_duration", "search_duration", "violation", "ScpSegment", "DEGREE", "SAMPLES"]

@@ -129,7 +129,7 @@ class SCPProblem:
             self.par[key].value = np.asarray(value, dtype=float).reshape(self.par[key].shape)
 
     def set_task(self, task, T: float) -> None:
-        """Task and duration Parameters (``task``: :class:`flipkit.baseline.ee_scp.Task`)."""
+        """Task and duration Parameters (``task``: :class:`flipkit.baseline.ee_scp.ScpSegment`)."""
         cell, st = task.cell, task.start
         lim, ds = cell.limits, 1.0 / (self.n - 1)
         w_o = ORIENTATION_WEIGHT

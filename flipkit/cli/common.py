@@ -14,7 +14,6 @@ from flipkit.errors import ConfigError
 from flipkit.fileio import write_text
 from flipkit.planning.plans.plan_doc import read_plan_doc
 
-SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 LOCATION_SET_CHOICES = ("table1", "more")  # flipkit.config.LOCATION_SETS
 
 
