@@ -25,6 +25,18 @@ class Pose:
     o: tuple
 
 
+BURGER_HEIGHT_TOL = 0.01  # m: |z − h_g| of a burger location accepted as on the grill
+
+
+def check_burger_height(cell: CellConfig, z: float, what: str = "burger location") -> None:
+    """Refuse a burger height ``z`` (m) more than :data:`BURGER_HEIGHT_TOL` from the grill's
+    surface h_g, with :class:`UnreachableError` naming ``what`` and the height to give."""
+    h = cell.grill.height
+    if abs(z - h) > BURGER_HEIGHT_TOL:
+        raise UnreachableError(f"{what}: z = {z:g} m is not on the grill surface: give z = "
+                               f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
+
+
 def check_location(cell: CellConfig, location) -> np.ndarray:
     """The burger location as an array, or :class:`UnreachableError` if not on the grill."""
     loc = np.asarray(location, dtype=float)
@@ -35,9 +47,7 @@ def check_location(cell: CellConfig, location) -> np.ndarray:
         raise UnreachableError(
             f"burger location ({loc[0]:.3f}, {loc[1]:.3f}) is outside the grill area "
             f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
-    if abs(loc[2] - g.height) > 0.01:
-        raise UnreachableError(
-            f"burger height {loc[2]:.3f} m is not on the grill surface (h_g = {g.height} m)")
+    check_burger_height(cell, float(loc[2]))
     return loc
 
 

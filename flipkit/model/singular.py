@@ -85,25 +85,5 @@ def branch_violation(q, q_home, margin: float = SINGULARITY_MARGIN) -> np.ndarra
     return np.maximum(np.maximum(band[:, 0] - x, x - band[:, 1]), 0.0)
 
 
-def check_start(q, q_home, what: str = "start configuration",
-                margin: float = SINGULARITY_MARGIN) -> None:
-    """Refuse a start configuration whose q3 or q5 lies within ``margin`` of its singular
-    value (or on the other side of it): every plan from there would fail
-    ``verify`` (group ``singularity``).
-
-    Raises:
-        ConfigError: One line naming ``what``, the joint, its value and the band to use.
-    """
-    v = branch_violation(q, q_home, margin)[0]
-    band = branch_band(q_home, margin)
-    for col, (j, name) in enumerate(((ELBOW, "q3 (elbow)"), (WRIST, "q5 (wrist)"))):
-        if v[col] > 0:
-            lo, hi = band[col]
-            raise ConfigError(
-                f"{what}: {name} = {float(np.asarray(q, float)[j]):.3f} rad is within "
-                f"{margin:g} rad of its singularity (or past it); give {name.split()[0]} in "
-                f"[{lo:.3f}, {hi:.3f}] rad, the side of q_home")
-
-
 __all__ = ["ELBOW", "SINGULARITY_MARGIN", "WRIST", "branch_band", "branch_bounds",
-           "branch_violation", "check_start"]
+           "branch_violation"]

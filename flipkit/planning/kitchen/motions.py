@@ -11,7 +11,7 @@ durations.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable, Mapping, Protocol
 
 import numpy as np
@@ -123,7 +123,7 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
     return PlannedMotion(ok=ok, duration_s=duration, event_s=float(event),
                          q_end=np.asarray(last.q[-1], float), planning_time_s=planning_time_s,
                          landing=landing, plan=plan,
-                         failure=None if ok else getattr(plan, "failure", "plan failed"))
+                         failure=None if ok else plan.failure or "plan failed")
 
 
 def refused(job: MotionJob, q_start, exc: UnreachableError, t0: float) -> PlannedMotion:
