@@ -239,3 +239,35 @@ def test_every_notebook_names_the_projects_kernel():
     for path in NOTEBOOKS:
         spec = json.loads(path.read_text(encoding="utf-8"))["metadata"]["kernelspec"]
         assert (spec["name"], spec["display_name"]) == (KERNEL_NAME, KERNEL_DISPLAY_NAME), path.name
+
+
+# ---------------------------------------------------------------- the code's comments
+# What a dated note looks like in a comment or docstring: a date, an issue number, a benchmark
+# note, or a measurement ("(measured", "measured:", "Measured on ..."). A burger "measured on
+# the blade" (sensed) is not one.
+DIARY = re.compile(r"20\d\d-\d\d-\d\d|[Ii]ssue \d+|docs/benchmarks/|\(measured|[Mm]easured[:,)]"
+                   r"|Measured (?:on|at|in)\b|measured (?:on|at|in) (?:a |one |Table|MuJoCo)"
+                   r"|measured \d")
+MAX_DIARY_LINES = 5  # sources: a UR client-library thread, a newspaper, a parameter's range
+
+
+def diary_lines(root: Path) -> list[str]:
+    return [f"{path.relative_to(root.parent)}:{k}: {line.strip()}"
+            for path in sorted(root.rglob("*.py"))
+            for k, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+            if DIARY.search(line)]
+
+
+def test_the_code_keeps_its_measurements_in_the_docs():
+    """Comments say what the code does and why; the measurements behind a choice are in
+    ``docs/history.md`` ("Measurements behind the code's choices")."""
+    found = diary_lines(PACKAGE)
+    assert len(found) <= MAX_DIARY_LINES, "\n".join(found)
+
+
+def test_a_diary_comment_is_found(tmp_path):
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "m.py").write_text("# solves in 3 s (measured 2026-11-23)\n"
+                              "# the burger measured on the blade\nx = 1  # issue 13\n")
+    assert [d.split(":")[1] for d in diary_lines(pkg)] == ["1", "3"]

@@ -1,5 +1,5 @@
 """The strong end-effector-space optimisation of one subbehaviour: position, orientation and
-duration free, by sequential convex programming (issue 14).
+duration free, by sequential convex programming.
 
 What it keeps of the paper's reference [8] (Tsuji et al., dynamic object manipulation with a
 tool, planned in task space): the motion is planned for the tool alone — blade-centre
@@ -34,9 +34,8 @@ and doubles when by more than three quarters at its edge. The cost
 is ∫ |p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT`
 (m²/rad²): a radian of blade rotation weighs as much as a translation by the arm's reach,
 ≈ 1 m, both being about a radian of joint motion. (With w_o = (l/2)², a blade-tip
-displacement, rotations were so cheap that the go-to-burger pitched back 0.34 rad and
-forward again to keep the tip off the grill, and wrist 1 reached 8 rad/s; measured at
-Table I location 6.) The duration is chosen by a search of the converged cost over the bounds
+displacement, rotations were so cheap that the go-to-burger pitched back and forward again
+to keep the tip off the grill, driving wrist 1 far past its speed limit.) The duration is chosen by a search of the converged cost over the bounds
 (infeasible durations cost +∞), each solve warm-started from the best so far: the upper bound
 and a probe just below it, and a golden-section search only when the probe costs less
 (:data:`PROBE_FRACTION`). At each duration the SCP returns the best feasible point it met, and stops
@@ -82,8 +81,8 @@ GOLDEN_STEPS = 3  # golden-section reductions of the duration interval
 # The duration search first solves at the upper bound and just below it (PROBE_FRACTION of the
 # range): when the cost is no lower there, the minimum of a unimodal cost lies within that
 # tenth of the range, finer than the golden section's final bracket (0.618⁴ = 0.15), and the
-# search stops. Measured (2026-11-23, Table I location 6): the cost fell with T in all five
-# subbehaviours, and the golden section spent 3.7 of the flip's 4.3 s on shorter durations.
+# search stops. The cost usually falls with T, and the golden section would spend most of its
+# time on shorter durations.
 PROBE_FRACTION = 0.1
 EDGES = np.array([[0.5, 0, 0], [-0.5, 0, 0], [0, 0.5, 0], [0, -0.5, 0]])  # × (l, w, ·)
 
@@ -285,9 +284,8 @@ def scp_at_duration(task: ScpSegment, T: float, C0: np.ndarray, D0: np.ndarray,
     ok = feasible_linear and viol <= FEAS_TOL
     if best is not None and (not ok or best[0] < obj):
         # the ℓ∞ merit may trade a violation above FEAS_TOL for objective, and rejects
-        # feasible trial points: keep the best feasible point seen (measured: the flip at
-        # Table I location 6, T = 0.6 s, had feasible trials at iterations 14–17 and ended
-        # 2e-4 outside at iteration 30)
+        # feasible trial points: keep the best feasible point seen (an SCP can pass feasible
+        # trials and end just outside)
         obj, C, D, viol = best
         ok = True
     return {"C": C, "D": D, "objective": obj if ok else math.inf,

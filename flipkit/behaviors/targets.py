@@ -65,9 +65,9 @@ def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
     """Scoop nodes with the friction cone: where the burger's centre is over the blade.
 
     The scoop ends at rest with the burger on the blade, so the blade brakes under it; braked
-    harder than friction allows, the burger slides on toward the tip (measured in MuJoCo at
-    (0.84, 0.12): 4.7 cm of a 7 cm drag happened in the last 0.15 s of the scoop, after the
-    blade was under it). The blade's tip passes under the burger's centre once the blade
+    harder than friction allows, the burger slides on toward the tip (in the simulated cell
+    most of a scoop's drag happens in its last instants, after the blade is under the
+    burger). The blade's tip passes under the burger's centre once the blade
     centre is within l/2 of p^b; on the straight scoop path of length
     d/2 + SCOOP_START_MARGIN + (l/2) cos o_y* that is the last (l/2)/length of the path,
     which the smoothstep timing of the initial guess (and of the Bezier outputs near it)

@@ -50,7 +50,7 @@ def register(subparsers) -> None:
                         help="with --locations: plan from cold starts, not from the package's "
                              "atlas; the two reach different local optima of the same NLPs, "
                              "and comparing them shows how much a result owes to the one "
-                             "found (docs/benchmarks/2026-11-28-free-motion-probe.md)")
+                             "found")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",

@@ -164,7 +164,7 @@ def landing_target(plan) -> np.ndarray:
                       float)[:2]
 
 
-SERVE_TOL = 0.03  # m: the burger's centre rests within 3 cm of the table spot (issue 13)
+SERVE_TOL = 0.03  # m: the burger's centre rests within 3 cm of the table spot (ours)
 UPRIGHT_Z = 0.9  # up-axis z above this: top face up (within ~26°, as UPSIDE_DOWN_Z)
 REST_WINDOW = 0.1  # s: "resting" = moved less than REST_MOTION over the run's last 0.1 s
 REST_MOTION = 0.001  # m

@@ -159,7 +159,7 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
     job's table spot, placing the burger as if it lay at the blade centre (``plan_serve``'s
     default: planned for the scoop model's predicted place, serves rested farther from their
-    spots in simulation, docs/benchmarks/2026-11-26-kitchen.md), coming in above the other
+    spots in simulation), coming in above the other
     burgers as the flip does; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to
     burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
