@@ -12,8 +12,8 @@ from flipkit.behaviors.options import MU_SAFETY, R_LAND, SCOOP_PRESS, SCOOP_TIP_
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline import run_baseline
 from flipkit.baseline.ee_opt import EEState, orientation_profile
-from flipkit.baseline.ee_scp import (PROBE_FRACTION, SAMPLES, Task, _problem, plan_segment_scp,
-                                     scp_at_duration, search_duration)
+from flipkit.baseline.ee_scp import (PROBE_FRACTION, SAMPLES, ScpSegment, _problem,
+                                     plan_segment_scp, scp_at_duration, search_duration)
 from flipkit.behaviors import targets as tg
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
@@ -145,7 +145,7 @@ def test_orientation_and_duration_are_free(chain, cell):
     # the duration is searched (the bound and a probe below it at least), and the SCP
     # converges at it: warm-started at its own solution it stays feasible and does not move far
     assert flip.durations_tried >= 2 and math.isfinite(flip.objective)
-    task = Task("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
+    task = ScpSegment("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
     again = scp_at_duration(task, flip.T, flip.coeffs, flip.o_coeffs, 0.05)
     assert math.isfinite(again["objective"]) and again["objective"] <= flip.objective * 1.05
     lo, hi = SUBBEHAVIORS["flip"].duration
@@ -176,7 +176,7 @@ def test_duration_search(cost, want, calls):
 def test_linearisation_is_first_order_exact(chain, cell, h):
     """The subproblem's linear models of the edge heights, the cone and the landing at an
     iterate: errors fall ~4x when the step halves (second-order remainder)."""
-    task = Task("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
+    task = ScpSegment("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
     qp = _problem(task, SAMPLES)
     flip = chain["flip"]
     C, D, T = flip.coeffs, flip.o_coeffs, flip.T

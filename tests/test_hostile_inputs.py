@@ -244,8 +244,7 @@ def test_a_burger_height_off_the_grill_states_the_tolerance(tmp_path, capsys):
 
 
 def test_the_height_tolerance_is_the_planners(cell):
-    from flipkit.behaviors.targets import check_location
-    from flipkit.cli.commands.plan import BURGER_HEIGHT_TOL
+    from flipkit.behaviors.targets import BURGER_HEIGHT_TOL, check_location
     from flipkit.errors import UnreachableError
 
     h = cell.grill.height

@@ -6,14 +6,13 @@ import numpy as np
 import pytest
 
 from flipkit.behaviors.options import SegmentOptions
-from flipkit.simulation.judges import LANDING_TOL, judge_flip, judge_scoop
+from flipkit.simulation.judges import LANDING_TOL, judge_flip, judge_scoop, landing_target
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.simulation.execute import execute_plan
 from flipkit.config import SensingUncertainty
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.planner import (keeps_promise, plan_flip, replan_flip,
                                                sensed_scenarios)
-from flipkit.experiments.trials import landing_target
 from flipkit.planning.plans.verify import verify_plan
 
 

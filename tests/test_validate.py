@@ -156,7 +156,8 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
     from dataclasses import replace
 
     from flipkit.behaviors import targets as tg
-    from flipkit.experiments.trials import landing_target, plan_from_text
+    from flipkit.experiments.trials import plan_from_text
+    from flipkit.simulation.judges import landing_target
 
     flip = flip_plan.segment("flip")
     assert flip.landing is not None

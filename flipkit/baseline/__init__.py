@@ -5,7 +5,7 @@ inverse kinematics at a controller rate (:mod:`.analytic_track`: the UR10's clos
 
 Two end-effector optimisations (``ee``):
 
-* ``scp`` (default, issue 14): position, orientation and duration free
+* ``scp`` (default): position, orientation and duration free
   (:mod:`.ee_scp`, sequential convex programming over the rpy Bezier; the duration by a
   golden-section search within collocation's bounds the specs' ``duration``),
   with collocation's task-space endpoint constraints, friction cone and flip landing.

@@ -1,7 +1,7 @@
 """Inverse kinematics along an end-effector trajectory in closed form: the UR10's eight
 branches at every sample, following the branch continuous with the start configuration.
 
-This is the IK step that does not give up early (issue 14): at each sample every branch of
+This is the IK step that does not give up early: at each sample every branch of
 :class:`~flipkit.model.ur_ik.URAnalyticIK` is computed and the one nearest to the previous
 configuration (max joint distance, 2π shifts inside the joint limits) is taken. The tracker
 never lags behind the pose: a sample whose pose has no branch inside the joint limits keeps

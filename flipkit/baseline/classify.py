@@ -52,7 +52,7 @@ CLASSES = {"ee_infeasible": "ee", "unreachable": "kinematic", "singularity": "ki
            "configuration_jump": "kinematic", "below_grill": "kinematic",
            "joint_velocity": "dynamic", "joint_acceleration": "dynamic", "torque": "dynamic"}
 FAILURE_CLASSES = ("ee", "kinematic", "dynamic", "time_scalable")
-MAX_TIME_SCALING = 2.0  # issue 14: "slowing the EE trajectory by at most 2x makes it pass"
+MAX_TIME_SCALING = 2.0  # time-scalable: slowing the EE trajectory by at most 2x makes it pass
 UNITS = {"ee_infeasible": "", "unreachable": "s", "singularity": "1",
          "tracking_error": "m or rad", "joint_limit": "rad",
          "configuration_jump": "rad", "joint_velocity": "rad/s",
@@ -73,8 +73,8 @@ class Thresholds:
         rate_tolerance: Relative tolerance on the velocity, acceleration and torque limits,
             for the error of their finite differences: at h = 2 ms (500 Hz) the one-sided
             difference at a segment's end is off by up to h²|q⃛|/3, 4e-4 rad/s for a jerk of
-            300 rad/s³ (measured 2026-11-23: a turn back that starts exactly at q̇_max = 3.2
-            rad/s reads 3.20012 rad/s there). The IK holds a saturated joint at qd_max; its
+            300 rad/s³ (a turn back that starts exactly at q̇_max reads about 1e-4 rad/s
+            above it there). The IK holds a saturated joint at qd_max; its
             finite difference is qd_max to rounding.
         sigma_min: Smallest singular value of the 6×6 spatula Jacobian (linear part in m/rad,
             angular in rad/rad) below which a sample counts as singular. Our choice: 0.01, a

@@ -1,5 +1,5 @@
 """The strong end-effector-space optimisation of one subbehaviour: position, orientation and
-duration free, by sequential convex programming (issue 14).
+duration free, by sequential convex programming.
 
 What it keeps of the paper's reference [8] (Tsuji et al., dynamic object manipulation with a
 tool, planned in task space): the motion is planned for the tool alone — blade-centre
@@ -34,9 +34,8 @@ and doubles when by more than three quarters at its edge. The cost
 is ∫ |p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT`
 (m²/rad²): a radian of blade rotation weighs as much as a translation by the arm's reach,
 ≈ 1 m, both being about a radian of joint motion. (With w_o = (l/2)², a blade-tip
-displacement, rotations were so cheap that the go-to-burger pitched back 0.34 rad and
-forward again to keep the tip off the grill, and wrist 1 reached 8 rad/s; measured at
-Table I location 6.) The duration is chosen by a search of the converged cost over the bounds
+displacement, rotations were so cheap that the go-to-burger pitched back and forward again
+to keep the tip off the grill, driving wrist 1 far past its speed limit.) The duration is chosen by a search of the converged cost over the bounds
 (infeasible durations cost +∞), each solve warm-started from the best so far: the upper bound
 and a probe just below it, and a golden-section search only when the probe costs less
 (:data:`PROBE_FRACTION`). At each duration the SCP returns the best feasible point it met, and stops
@@ -82,8 +81,8 @@ GOLDEN_STEPS = 3  # golden-section reductions of the duration interval
 # The duration search first solves at the upper bound and just below it (PROBE_FRACTION of the
 # range): when the cost is no lower there, the minimum of a unimodal cost lies within that
 # tenth of the range, finer than the golden section's final bracket (0.618⁴ = 0.15), and the
-# search stops. Measured (2026-11-23, Table I location 6): the cost fell with T in all five
-# subbehaviours, and the golden section spent 3.7 of the flip's 4.3 s on shorter durations.
+# search stops. The cost usually falls with T, and the golden section would spend most of its
+# time on shorter durations.
 PROBE_FRACTION = 0.1
 EDGES = np.array([[0.5, 0, 0], [-0.5, 0, 0], [0, 0.5, 0], [0, -0.5, 0]])  # × (l, w, ·)
 
@@ -97,8 +96,9 @@ def _guess_coeffs(bez: Bezier, s: np.ndarray, start: EEState, goal: tg.Pose) -> 
     return pinv @ P, pinv @ O
 
 
-class Task:
-    """The task data of one subbehaviour at one location (all SI)."""
+class ScpSegment:
+    """One subbehaviour at one location as the SCP states it: its goal pose, the blade's
+    floors and edges, the cone's nodes and friction, gravity (all SI)."""
 
     def __init__(self, name: str, cell: CellConfig, pb: np.ndarray, start: EEState,
                  home: tg.Pose | None):
@@ -160,7 +160,7 @@ def _mapped_landing(k: int):
     return landing_function().map(k)
 
 
-def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
+def violations(task: ScpSegment, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
     """Largest scaled violation of each linearised (nonconvex) constraint group at the
     samples (≤ 0: satisfied): edge heights, tip band and landing in cm, cone rows in g, axes
     and cos tilt unitless."""
@@ -186,7 +186,7 @@ def violations(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> d
     return out
 
 
-def violation(task: Task, B: list, C: np.ndarray, D: np.ndarray, T: float) -> float:
+def violation(task: ScpSegment, B: list, C: np.ndarray, D: np.ndarray, T: float) -> float:
     """The largest of :func:`violations`, or 0 when all hold."""
     return float(max(0.0, *violations(task, B, C, D, T).values()))
 
@@ -205,14 +205,14 @@ def _objective(B, C, D, T, w_o) -> float:
 _CACHE: dict = {}  # (name, samples, cone samples) -> SCPProblem
 
 
-def _problem(task: Task, n: int) -> SCPProblem:
+def _problem(task: ScpSegment, n: int) -> SCPProblem:
     key = (task.name, n, len(task.cone_idx(n)))
     if key not in _CACHE:
         _CACHE[key] = SCPProblem(task.name, n, DEGREE, task.cone_idx(n), task.release)
     return _CACHE[key]
 
 
-def _meet_ends(task: Task, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
+def _meet_ends(task: ScpSegment, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
     """Copies of (C0, D0) whose end control points meet the start state at duration T and
     the end pose (and rest), so that a trust region about them admits the end rows."""
     C, D, st, d = C0.copy(), D0.copy(), task.start, len(C0) - 1
@@ -225,7 +225,7 @@ def _meet_ends(task: Task, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
     return C, D
 
 
-def scp_at_duration(task: Task, T: float, C0: np.ndarray, D0: np.ndarray,
+def scp_at_duration(task: ScpSegment, T: float, C0: np.ndarray, D0: np.ndarray,
                     trust: float = TRUST0) -> dict:
     """The SCP at a fixed duration T (s) from the iterate (C0, D0), trust region ``trust`` (rad).
 
@@ -284,9 +284,8 @@ def scp_at_duration(task: Task, T: float, C0: np.ndarray, D0: np.ndarray,
     ok = feasible_linear and viol <= FEAS_TOL
     if best is not None and (not ok or best[0] < obj):
         # the ℓ∞ merit may trade a violation above FEAS_TOL for objective, and rejects
-        # feasible trial points: keep the best feasible point seen (measured: the flip at
-        # Table I location 6, T = 0.6 s, had feasible trials at iterations 14–17 and ended
-        # 2e-4 outside at iteration 30)
+        # feasible trial points: keep the best feasible point seen (an SCP can pass feasible
+        # trials and end just outside)
         obj, C, D, viol = best
         ok = True
     return {"C": C, "D": D, "objective": obj if ok else math.inf,
@@ -355,7 +354,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
         if value.shape != (3,) or not np.all(np.isfinite(value)):
             raise ConfigError(f"start.{field_name} must be 3 finite numbers, got {value.tolist()}")
     tic = time.perf_counter()
-    task = Task(name, cell, tg.check_location(cell, location), start, home)
+    task = ScpSegment(name, cell, tg.check_location(cell, location), start, home)
     qp = _problem(task, SAMPLES)
     C, D = _guess_coeffs(qp.bez, np.linspace(0, 1, SAMPLES), start, task.guess_goal)
     evals: dict = {}
@@ -378,7 +377,7 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
     return _sampled(task, qp.bez, best, T, rate, elapsed, len(evals))
 
 
-def _sampled(task: Task, bez: Bezier, sol: dict, T: float, rate: float, elapsed: float,
+def _sampled(task: ScpSegment, bez: Bezier, sol: dict, T: float, rate: float, elapsed: float,
              n_durations: int) -> EETrajectory:
     t = sample_times(T, rate)
     s = t / T
@@ -394,4 +393,4 @@ def _sampled(task: Task, bez: Bezier, sol: dict, T: float, rate: float, elapsed:
                         durations_tried=n_durations)
 
 
-__all__ = ["plan_segment_scp", "scp_at_duration", "search_duration", "violation", "Task", "DEGREE", "SAMPLES"]
+__all__ = ["plan_segment_scp", "scp_at_duration", "search_duration", "violation", "ScpSegment", "DEGREE", "SAMPLES"]

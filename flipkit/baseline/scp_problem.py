@@ -75,8 +75,8 @@ class SCPProblem:
                 cp.abs(D - P("Dk", (nc, 3))) <= P("trust", nonneg=True),
                 cp.abs(C - P("Ck", (nc, 3))) <= P("trust_c", nonneg=True)]
         # Linearisation coefficients stacked in few Parameters: setting a Parameter costs
-        # cvxpy a validation of its value (measured: 0.3 of a flip's 1.6 s with one Parameter
-        # per coefficient vector, 65 per iteration)
+        # cvxpy a validation of its value, a large share of an iteration with one Parameter
+        # per coefficient vector
         edge, floor = [], P("floor", (4, n))  # each edge's floor (EDGES' order)
         He, Ce = P("He", (12, n)), P("Ce", (4, n))
         for e in range(4):  # blade edge heights p_z + R[2, :] r_e, linearised in o
@@ -129,7 +129,7 @@ class SCPProblem:
             self.par[key].value = np.asarray(value, dtype=float).reshape(self.par[key].shape)
 
     def set_task(self, task, T: float) -> None:
-        """Task and duration Parameters (``task``: :class:`flipkit.baseline.ee_scp.Task`)."""
+        """Task and duration Parameters (``task``: :class:`flipkit.baseline.ee_scp.ScpSegment`)."""
         cell, st = task.cell, task.start
         lim, ds = cell.limits, 1.0 / (self.n - 1)
         w_o = ORIENTATION_WEIGHT

@@ -1,37 +1,34 @@
 """Which pairs of the arm's shapes and the cell's boxes each subbehaviour holds to the space
-margin (issue 13's space limits; paper Sec. I: "operate within the boundaries of the walls and
+margin (the space limits; paper Sec. I: "operate within the boundaries of the walls and
 grill"), and why the tool end is exempt where it works."""
 
 from __future__ import annotations
 
 from flipkit.config.task import FLIP_END_ALLOWANCE, FLIP_TOOL_FRACTION  # noqa: F401
 
-# Space limits (issue 13; paper Sec. I: "operate within the boundaries of the walls and grill"):
+# Space limits (paper Sec. I: "operate within the boundaries of the walls and grill"):
 # every shape of the arm keeps cell.space.margin from every box of the cell, except the tool end
 # and the grill while the tool works on the grill. Going to the burger ends with the blade's tip
 # pressed into the grill, the scoop slides it pressed in and the pickup lifts it from there
 # (SCOOP_PRESS), and the handle is straight, on the flange's axis: with the blade flat on the
 # grill and the flange over it (burgers at x ≥ 0.78 m), the flange and wrist-2 housings reach
-# below the grill's surface (measured: wrist_3 −4 cm, wrist_2 −2 cm at (0.84, 0.12)). There the
+# below the grill's surface (by centimetres). There the
 # blade's own floor is grill_clearance (its edges' heights); the other links keep the margin.
 # The flip starts where the pickup ends (eq. 25: 5 cm above the grill, where the flange's
 # housing can still lie 1 cm inside the grill's box), so it holds the tool end to the margin
 # from node FLIP_TOOL_FRACTION·N on: it lifts the tool end clear in its first quarter. It ends
 # FLIP_END_ALLOWANCE farther from the cell than the margin: the turn back starts with the
-# flip's end velocity and needs room to turn the arm away (measured at (0.75, 0.00): a flip
-# ending on the margin with the flange coming down at ~0.9 m/s, and no turn back from there
-# could keep it; 1.4 cm short at its first node). The allowance is sized for ~0.9 m/s: flips
-# at the grill's far half (x ≥ 0.74 m, y ≤ 0.02 m) ended on it with the wrist housings coming
-# down at 1.2 m/s, and neither the SQP nor IPOPT found a turn back from there (measured at
-# (0.84, −0.22): node 1, 0.06 s in, 1–4 mm short with shoulder, elbow and wrist 1 braking at
-# the 20 rad/s² limit). So the flip also holds the configuration it would reach coasting for
+# flip's end velocity and needs room to turn the arm away: a flip ending on the margin with
+# the flange coming down leaves no turn back that keeps it. The allowance is sized for
+# ~0.9 m/s: flips at the grill's far half (x ≥ 0.74 m, y ≤ 0.02 m) end on it with the wrist
+# housings coming down faster, 1.2 m/s, and no turn back keeps the margin at its first node
+# even braking at the 20 rad/s² limit. So the flip also holds the configuration it would reach coasting for
 # the turn back's first node interval, q_N + (T_max/N) q̇_N, to the margin
 # (the spec's ``coast_into``, CoastingClearance): the turn back then keeps the margin at node 1
 # without braking, and brakes clear after it (needs ≥ v/(2τ) ≈ 10 m/s² at 1.2 m/s).
 # The serve's carry starts at the same pickup end as the flip and lifts the tool end clear in
-# its first quarter the same way (measured at (0.835, 0.10): the pickup ends with wrist 2
-# 8.8 mm inside the grill's box, and a carry held to the margin from node 1 stopped infeasible
-# 5 mm short, handing it to IPOPT for 5–47 s).
+# its first quarter the same way: the pickup can end with wrist 2 inside the grill's box, and
+# a carry held to the margin from node 1 is infeasible.
 # Serving: the place puts the blade's tip 5 mm above the table and tilts it tip down, and the
 # return home first withdraws the blade along its own plane: the tool end works on the table
 # there as it works on the grill above, so the same tool shapes are exempt from the table (the

@@ -30,9 +30,9 @@ def place_cone(ctx) -> list[int]:
 _to_table = partial(task_path_guess, joint_fallback=True)  # a straight carry may pass the base
 
 # The carry holds the burger in the cone planned for the least sticky burger (μ 0.16,
-# docs/robust-flips.md §2), the blade tilting into its acceleration. Within 1.2 s it solved at
-# the serves tried; a farther spot (about 1.4 m) gets the stretched bound, and within 0.9 s
-# two of three serves tried needed it (docs/benchmarks/2026-11-27-kitchen-planning.md).
+# docs/robust-flips.md §2), the blade tilting into its acceleration. 1.2 s is enough for the
+# table's spots within reach; a farther spot (about 1.4 m) gets the stretched bound, and a
+# shorter bound would send most serves to it.
 CARRY = Subbehavior(
     "carry", duration=(0.6, 1.2), carries_burger=True, end="rest", needs=("spot",),
     floor=sv.table_floor, exempt=tool_leaves_grill,
@@ -40,18 +40,17 @@ CARRY = Subbehavior(
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), cone_on_blade=True, guess=_to_table,
     record=record_placing, doc="to above the place pose, flat, cone on every node")
 # The tilt-off holds the burger in the cone planned for the least sticky burger (μ 0.16,
-# docs/robust-flips.md §2): within 0.8 s it had no solution at any serve tried, and every
-# serve spent an SQP and an IPOPT solve (~2 s) before its bound was stretched to 1.2 s.
+# docs/robust-flips.md §2); within 0.8 s it has no solution, and every serve would spend an
+# SQP and an IPOPT solve before its bound was stretched, so the bound is 1.2 s.
 PLACE = Subbehavior(
     "place", duration=(0.3, 1.2), carries_burger=True, end="rest", needs=("spot",),
     floor=sv.table_floor, exempt=tool_at_table, path=sv.place_pivot,
     end_pose=lambda ctx: sv.place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=place_cone, cone_on_blade=True, guess=_to_table, record=record_placing,
     doc="tilt-off about the tip, just above the table")
-# The return unrolls the heading back to q_home's. Within 1.2 s it solved at every serve tried,
-# but its faster withdrawal pushed the burger just placed into the one beside it on the table
-# (1.4 cm in the two-burger cook of tests/test_cook_sim.py), so its bound stays 1.5 s
-# (docs/benchmarks/2026-11-27-cook-ten.md).
+# The return unrolls the heading back to q_home's. It solves within 1.2 s too, but its faster
+# withdrawal pushes the burger just placed into the one beside it on the table, so its bound
+# is 1.5 s.
 RETURN_HOME = Subbehavior(
     "return_home", duration=(0.5, 1.5), carries_burger=False, end="home",
     floor=sv.withdrawn_floor, exempt=tool_at_table, path=sv.withdrawal,

@@ -25,6 +25,18 @@ class Pose:
     o: tuple
 
 
+BURGER_HEIGHT_TOL = 0.01  # m: |z − h_g| of a burger location accepted as on the grill
+
+
+def check_burger_height(cell: CellConfig, z: float, what: str = "burger location") -> None:
+    """Refuse a burger height ``z`` (m) more than :data:`BURGER_HEIGHT_TOL` from the grill's
+    surface h_g, with :class:`UnreachableError` naming ``what`` and the height to give."""
+    h = cell.grill.height
+    if abs(z - h) > BURGER_HEIGHT_TOL:
+        raise UnreachableError(f"{what}: z = {z:g} m is not on the grill surface: give z = "
+                               f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
+
+
 def check_location(cell: CellConfig, location) -> np.ndarray:
     """The burger location as an array, or :class:`UnreachableError` if not on the grill."""
     loc = np.asarray(location, dtype=float)
@@ -35,9 +47,7 @@ def check_location(cell: CellConfig, location) -> np.ndarray:
         raise UnreachableError(
             f"burger location ({loc[0]:.3f}, {loc[1]:.3f}) is outside the grill area "
             f"x in [{g.x_range[0]}, {g.x_range[1]}], y in [{g.y_range[0]}, {g.y_range[1]}] m")
-    if abs(loc[2] - g.height) > 0.01:
-        raise UnreachableError(
-            f"burger height {loc[2]:.3f} m is not on the grill surface (h_g = {g.height} m)")
+    check_burger_height(cell, float(loc[2]))
     return loc
 
 
@@ -55,9 +65,9 @@ def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
     """Scoop nodes with the friction cone: where the burger's centre is over the blade.
 
     The scoop ends at rest with the burger on the blade, so the blade brakes under it; braked
-    harder than friction allows, the burger slides on toward the tip (measured in MuJoCo at
-    (0.84, 0.12): 4.7 cm of a 7 cm drag happened in the last 0.15 s of the scoop, after the
-    blade was under it). The blade's tip passes under the burger's centre once the blade
+    harder than friction allows, the burger slides on toward the tip (in the simulated cell
+    most of a scoop's drag happens in its last instants, after the blade is under the
+    burger). The blade's tip passes under the burger's centre once the blade
     centre is within l/2 of p^b; on the straight scoop path of length
     d/2 + SCOOP_START_MARGIN + (l/2) cos o_y* that is the last (l/2)/length of the path,
     which the smoothstep timing of the initial guess (and of the Bezier outputs near it)

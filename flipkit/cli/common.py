@@ -14,7 +14,6 @@ from flipkit.errors import ConfigError
 from flipkit.fileio import write_text
 from flipkit.planning.plans.plan_doc import read_plan_doc
 
-SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 LOCATION_SET_CHOICES = ("table1", "more")  # flipkit.config.LOCATION_SETS
 
 
@@ -79,7 +78,7 @@ def deferred(command: str, function: str = "run"):
 
     A sub-command is two modules: ``flipkit.cli.<command>`` (its arguments and their cheap
     checks, imported for every parse) and ``flipkit.cli.commands.<command>`` (its work, with
-    the models it needs: pinocchio, CasADi, cvxpy, MuJoCo, about 1 s to import). This is the
+    the models it needs: pinocchio, CasADi, cvxpy, MuJoCo, slow to import). This is the
     one place the command line defers an import, so that ``flipkit --help`` and an input
     refused by the cheap checks never load the models.
     """

@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_GRID, MAX_WORKERS, SOLVER_CHOICES,
+from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_GRID, MAX_WORKERS,
                                 add_sweep_arguments, check_int, deferred)
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
+from flipkit.solvers.names import SOLVERS
 
 
 def register(subparsers) -> None:
@@ -35,7 +36,7 @@ def register(subparsers) -> None:
                         help="an NX x NY grid of cell centres over the grill area, each in [1, 50]")
     parser.add_argument("--burger", nargs=3, type=float, action="append", metavar=("X", "Y", "Z"),
                         help="one more burger location (m); may be repeated")
-    parser.add_argument("--solver", choices=SOLVER_CHOICES, default="sqp",
+    parser.add_argument("--solver", choices=SOLVERS, default="sqp",
                         help="collocation NLP solver (default sqp)")
     parser.add_argument("--plans", metavar="DIR", help="also write the collocation plans here")
     add_sweep_arguments(parser)

@@ -17,8 +17,8 @@ from __future__ import annotations
 import argparse
 
 from flipkit.cli.common import deferred
+from flipkit.solvers.names import SOLVERS
 
-SOLVER_CHOICES = ("sqp", "ipopt", "auto")
 DESCRIPTION = (
     "Plan with joint-space direct collocation and check the plan independently. Exit 0: "
     "solved and verified. Exit 1: a plan failed; one line per failed plan on stderr, and the "
@@ -37,7 +37,7 @@ def register(subparsers) -> None:
     sub = parser.add_subparsers(dest="plan_command", required=True, metavar="BEHAVIOR")
 
     def common(p, json_out=True):
-        p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+        p.add_argument("--solver", choices=SOLVERS, default="auto",
                        help="NLP solver: auto (default: the SQP, then IPOPT where the SQP "
                             "fails), sqp (cvxpy/OSQP) or ipopt (CasADi)")
         if json_out:

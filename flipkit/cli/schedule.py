@@ -27,12 +27,13 @@ import argparse
 import importlib.util
 import os
 
-from flipkit.cli.common import MAX_WORKERS, SOLVER_CHOICES, check_float, check_int, deferred
+from flipkit.cli.common import MAX_WORKERS, check_float, check_int, deferred
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output
 from flipkit.planning.kitchen.stream import check_stream
 from flipkit.planning.kitchen.table import DWELL_S, check_dwell
 from flipkit.planning.kitchen.windows import parse_windows
+from flipkit.solvers.names import SOLVERS
 
 FIGURE_FORMATS = (".pdf", ".png", ".svg")  # --figure, by suffix
 FILM_FORMATS = (".gif", ".mp4")  # --film, by suffix
@@ -70,7 +71,7 @@ def register(subparsers) -> None:
                         "directory")
     p.add_argument("--flip-only", action="store_true",
                    help="plan the flips alone (no serves; serve_time stays null)")
-    p.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+    p.add_argument("--solver", choices=SOLVERS, default="auto",
                    help="NLP solver (default auto: the SQP, then IPOPT where it fails)")
     p.add_argument("--workers", type=int, default=None, metavar="K",
                    help="plan the motions ahead in K worker processes, in [1, 256] "

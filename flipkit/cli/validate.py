@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS, SOLVER_CHOICES,
+from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS,
                                 add_sweep_arguments, check_float, check_int, deferred,
                                 precheck_plan)
 from flipkit.config.checks import whole
 from flipkit.config.physics import servo_lookahead
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
+from flipkit.solvers.names import SOLVERS
 
 RATE_RANGE = (10.0, 100_000.0)  # Hz, --rate of the PD controller
 
@@ -44,14 +45,14 @@ def register(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="non-negative (default 0); trial i at each location draws from "
                              "a stream of its own, numpy SeedSequence([S, i, location])")
-    parser.add_argument("--solver", choices=SOLVER_CHOICES, default="auto",
+    parser.add_argument("--solver", choices=SOLVERS, default="auto",
                         help="collocation solver for --locations (default auto: the SQP, then IPOPT where it fails)")
     parser.add_argument("--plans", metavar="DIR", help="with --locations: keep the plans here")
     parser.add_argument("--no-atlas", action="store_true",
                         help="with --locations: plan from cold starts, not from the package's "
                              "atlas; the two reach different local optima of the same NLPs, "
                              "and comparing them shows how much a result owes to the one "
-                             "found (docs/benchmarks/2026-11-28-free-motion-probe.md)")
+                             "found")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",

@@ -68,7 +68,7 @@ class PhysicsConfig:
             rigid disc). The patty bends under its own weight (:mod:`flipkit.simulation.patty`:
             Hencky's bar chain with the bending stiffness of ``burger_modulus``). A numerical
             setting, not a physical one: 5, where the Table I outcomes agree with 7 and 9
-            strips (docs/benchmarks/2026-11-27-bending-patty.md).
+            strips.
         blade_thickness: Blade thickness (m). A stiff one-piece stainless turner is 0.04 in
             = 1 mm, 18 gauge (J. Kenji Lopez-Alt, "The Food Lab", equipment chapter); a thin
             plated-steel turner 0.45 mm (softsolder.com, "Kitchen Spatula Search", 2016);
@@ -126,8 +126,8 @@ class PhysicsConfig:
             servo-rate samples and the joint PD: UR's ``servoj`` ``lookahead_time``
             ([0.03, 0.2] s, default 0.1 s, URScript manual; flipkit's URScript export sends
             the same), modelled as a first-order low-pass of that time constant (the form is
-            ours; UR publishes none; its group delay matches the measured lag,
-            docs/benchmarks/2026-11-27-servoj-lookahead.md). The cell sets it, so the
+            ours; UR publishes none; its group delay matches the lag measured through
+            ``servoj``). The cell sets it, so the
             compensated commands are made for it
             (:func:`flipkit.planning.plans.servo_command.lookahead_command`). 0: no
             smoothing, the held commands reach the PD as they are (no ``servoj`` does that).

@@ -61,7 +61,7 @@ class SpaceConfig:
 
     Attributes:
         margin: Least distance (m) between any part of the arm (links, spatula) and any box of
-            the cell, where a segment applies the pair (default 2 cm, issue 13).
+            the cell, where a segment applies the pair (default 2 cm, ours).
         walls: Boxes besides the grill and the table (default the back wall
             :data:`BACK_WALL`); a hood or a second wall is added here.
         handle_radius: Radius (m) of the spatula handle's capsule (our choice: a 2 cm thick

@@ -60,11 +60,11 @@ R_SCENARIO = 0.04  # m
 FLIGHT_MARGIN = 0.002  # m, the blade plane below the flying burger from node r + 2 on
 # The burger lands flat: its top face's normal at least TILT_MIN_DEG from +z (within 5° of
 # upside down). A burger that lands tilted slaps down rim first and slides; one that lands
-# flat stops where it touches (its sideways speed is inside the grill's friction cone). In the
-# simulated cell, within 2° of flat no patty of the sourced ranges slid over 1.3 cm, at 10° the
-# stiff and the large ones 8-11 cm; the Table I flips land 1-7° from flat and slide 0.1 cm
-# (median). A real patty bends about every axis, so the bound holds the whole tilt. Ours,
-# from those measurements (docs/benchmarks/2026-11-28-free-disc-landing.md).
+# flat stops where it touches (its sideways speed is inside the grill's friction cone): in the
+# simulated cell a patty landing within a few degrees of flat barely slides, one landing at
+# 10° can slide several centimetres. A real patty bends about every axis, so the bound holds
+# the whole tilt. Ours, from those simulations (docs/history.md, "Measurements behind the
+# code's choices").
 TILT_MIN_DEG = 175.0
 # The cones of the segments that carry the burger (pickup, flip, translate, carry, place) are
 # planned for the least sticky burger the cell may meet, since it cannot measure μ: the low

@@ -5,8 +5,8 @@ grid over the grill with the sweep executor (local processes or a Dask cluster).
 
 Each grid location (:func:`~flipkit.experiments.sweep.grill_grid`) is planned cold with the
 SQP alone (the atlas serves the SQP's warm starts; with ``auto`` a location the SQP cannot
-solve costs minutes of IPOPT: measured, a 5 × 7 build took 22 CPU-minutes in 27 min and was
-stopped unfinished); a solved chain contributes every segment's solution vector, a failed
+solve costs minutes of IPOPT, and a build with it does not finish in reasonable time); a
+solved chain contributes every segment's solution vector, a failed
 one is listed in the file's ``failed`` record and left out. Every entry's segments are rebuilt from
 their start states to record the NLP structure keys, which must agree over the grid.
 """

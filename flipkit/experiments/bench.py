@@ -72,9 +72,9 @@ from flipkit.transcription.ocp_graph import OcpGraph
 # area x 0.60–0.88, y −0.50–0.16 -> blade 7.8 cm above it. Table: 0.10 m, area x 0.20–0.55,
 # y 0.45–0.80 -> blade 9–10 cm above it. All reachable; the order (grill, then the table point
 # farthest from it, ending at the one nearest) lets IK from each point find the next. The table
-# points were 2 cm lower (blade 7–8 cm above the table) before the arm's 2 cm space margin
-# (issue 13): there the chain planned without a margin brings the arm into contact with a box
-# of the cell, and the translate from (0.32, 0.62) to (0.50, 0.52) has no solution with it.
+# points are 2 cm above where a chain planned without the arm's 2 cm space margin would put
+# them: there it brings the arm into contact with a box of the cell, and the translate from
+# (0.32, 0.62) to (0.50, 0.52) has no solution with the margin.
 TRANSLATE_KEY_POINTS = (
     (0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
     (0.45, 0.74, 0.19), (0.32, 0.62, 0.20), (0.50, 0.52, 0.20),
@@ -261,9 +261,9 @@ def _flip_row(plan) -> dict:
 def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
     """:func:`_flip_row` of ``plan_flip(location)``, with ``cpu_s`` the process CPU time (s) of
     the call. A plan runs on one thread, so CPU ≈ wall on an idle machine, and wall > CPU
-    says the machine was busy. (On the project's shared virtual machine identical solves,
-    same iterations and plans, took up to 30 % longer from one minute to the next in CPU
-    time as in wall time, measured 2026-11-23: compare runs made side by side.)"""
+    says the machine was busy. (On a shared virtual machine identical solves can take
+    longer from one minute to the next in CPU time as in wall time: compare runs made side
+    by side, ``docs/history.md``.)"""
     t0 = time.process_time()
     plan = plan_flip(location, cell=cell, **kw)
     return {**_flip_row(plan), "cpu_s": time.process_time() - t0}

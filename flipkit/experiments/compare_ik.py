@@ -34,9 +34,9 @@ from flipkit.solvers.names import SOLVERS
 
 METHODS = ("collocation", "ee_ik")
 _PRIVATE = "_segment_time_s"  # per-segment solve times, used by the summary only
-RATE = 500.0  # Hz: the judge's sample rate for both methods (issue 14)
+RATE = 500.0  # Hz: the judge's sample rate for both methods, a UR e-Series servo rate
 IK = "analytic"  # the baseline's IK: the UR10's closed form (flipkit.model.ur_ik)
-EE = "scp"  # the baseline's EE optimisation: position, orientation, duration free (issue 14)
+EE = "scp"  # the baseline's EE optimisation: position, orientation, duration free
 
 
 def _number(x) -> float | None:

@@ -93,7 +93,7 @@ def worker_died(exc: BaseException) -> bool:
 def _dask_executor(scheduler: str) -> cf.Executor:
     """The executor of a Dask client connected to ``scheduler``; it closes the client when
     shut down."""
-    import distributed.cfexecutor  # Dask takes ~0.5 s to import; only --scheduler needs it
+    import distributed.cfexecutor  # Dask is slow to import; only --scheduler needs it
 
     try:
         client = distributed.Client(scheduler, timeout="10s", set_as_default=False)

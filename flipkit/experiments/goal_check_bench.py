@@ -1,4 +1,4 @@
-"""Time of the goal pre-check (:func:`flipkit.model.goal_check.check_goal`), issue 28 item 4.
+"""Time of the goal pre-check (:func:`flipkit.model.goal_check.check_goal`).
 
     python -m flipkit.experiments.goal_check_bench [--repeat R]
 
@@ -26,7 +26,7 @@ from flipkit.model.robot import Robot
 
 FLAT = (0.0, 0.0, 0.0)
 README_START = (0.64, -0.33, 0.15)  # m: README's `flipkit plan translate --from`
-KNOWN_BAD = ((1.10, 0.0, 0.30), (0.70, -0.20, 0.10))  # m: issue 28's two slow refusals
+KNOWN_BAD = ((1.10, 0.0, 0.30), (0.70, -0.20, 0.10))  # m: goals out of reach, refused
 # m: flipkit.experiments.bench.TRANSLATE_KEY_POINTS (not imported: that module loads the solvers)
 KEY_POINTS = ((0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
               (0.45, 0.74, 0.19), (0.32, 0.62, 0.20), (0.50, 0.52, 0.20))

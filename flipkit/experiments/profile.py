@@ -1,4 +1,4 @@
-"""Where an SQP iteration's milliseconds go, on a flip segment (issue 15's baseline).
+"""Where an SQP iteration's milliseconds go, on a flip segment.
 
     python -m flipkit.experiments.profile [--location K] [--atlas] [--out FILE]
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from flipkit.behaviors import targets as tg
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
-                                      judge_flip, judge_pickup, judge_scoop)
+                                      judge_flip, judge_pickup, judge_scoop, landing_target)
 from flipkit.config import CellConfig, known_physics, with_parameter
 from flipkit.config.checks import whole
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
@@ -104,18 +104,6 @@ def _failure(scoop, pickup, flip, run) -> dict | None:
     miss = float(np.max(np.abs(flip.offset)))
     return {"stage": "flip", "reason": "missed_spot" if miss > LANDING_TOL else "other",
             "amount": miss}
-
-
-def landing_target(plan: Plan) -> np.ndarray:
-    """Where the flip should land the burger (x, y) (m): the flip segment's planned
-    ``landing["target"]`` when the plan has one (``flipkit plan flip --land X Y`` lands
-    elsewhere than the default), else :func:`flipkit.behaviors.targets.landing_spot` of the burger."""
-    flip = plan.segment("flip")
-    landing = getattr(flip, "landing", None)
-    if landing is not None:
-        return np.asarray(landing["target"], float)
-    return np.asarray(tg.landing_spot(plan.cell(), np.asarray(plan.burger["location"], float)),
-                      float)[:2]
 
 
 def run_trial(job: dict) -> dict:
@@ -394,6 +382,6 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
                     progress=progress, **kwargs)
 
 
-__all__ = ["HOLD_S", "Perturbations", "STAGES", "TRACK_RATE_HZ", "landing_target", "location_entry",
+__all__ = ["HOLD_S", "Perturbations", "STAGES", "TRACK_RATE_HZ", "location_entry",
            "merge_tracking", "plan_from_text", "plan_location", "run_trial", "track_plan",
            "trial_jobs", "trial_key", "validate", "validate_locations", "validate_plan_file"]

@@ -31,7 +31,7 @@ def kernel_name() -> str:
     ``sys.executable`` by jupyter_client); otherwise a ``flipkit-python3`` kernelspec, installed
     into ``sys.prefix/share/jupyter/kernels`` on first use.
     """
-    # Jupyter and papermill load in 0.3-1.5 s, and `flipkit --help` imports this module.
+    # Jupyter and papermill are slow to import, and `flipkit --help` imports this module.
     from jupyter_client.kernelspec import KernelSpecManager, NoSuchKernel
 
     manager = KernelSpecManager()
@@ -66,7 +66,7 @@ def execute_notebook(notebook: Path, executed: Path, parameters: dict, kernel: s
         NotebookError: One line: the notebook, the failing cell and its error, or why the
             notebook could not run at all.
     """
-    import papermill  # 1.5 s to import, and `flipkit --help` imports this module
+    import papermill  # slow to import, and `flipkit --help` imports this module
 
     try:
         papermill.execute_notebook(str(notebook), str(executed), parameters=parameters,

@@ -40,14 +40,14 @@ from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import make_executor, run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, plan_from_text, plan_text,
                                             trial_jobs)
-from flipkit.experiments.trials import landing_target, plan_location, run_trial
+from flipkit.experiments.trials import plan_location, run_trial
 from flipkit.experiments.trials import track_plan as track_execution
 from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.planners.planner import plan_flip, plan_translate, replan_flip
 from flipkit.simulation.execute import execute_plan
-from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop
+from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop, landing_target
 
 
 def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None = None,

@@ -48,9 +48,8 @@ GJK_TOLERANCE = 1e-9
 # Which query comes first depended on the process's history — a box–box pair (the blade or
 # the ee box against a cell box, or the blade against the burger in verify_flight) puts GJK's
 # default guess (1, 0, 0) in the box's frame and inflates; a link's hull against the grill
-# does not — and distances then differ by ~1e-11 m (measured: the wrist_1 hull to the grill),
-# enough for the SQP to end at another point of the solution set (a flip segment 20 instead
-# of 25 iterations, the joint path 1.1 rad apart). :func:`pin_box_support` makes the first
+# does not — and distances then differ in their last digits, enough for the SQP to end at
+# another point of the solution set. :func:`pin_box_support` makes the first
 # Box query of the process one with a generic direction (no inflation, the exact box), so
 # every flipkit process computes the same distances.
 _BOX_SUPPORT_PINNED: bool | None = None
@@ -137,8 +136,8 @@ _MESHES: dict = {}  # (URDF, joint names) -> the loaded shapes; their geometries
 def _mesh_shapes(robot: Robot) -> list[Shape]:
     """The URDF's collision geometries on moving joints; meshes as their convex hulls.
 
-    Loaded once per process and URDF (loading the meshes and building their hulls takes
-    ~40 ms, measured, and every plan's verification builds its own geometry); each call
+    Loaded once per process and URDF (loading the meshes and building their hulls is not
+    cheap, and every plan's verification builds its own geometry); each call
     returns its own :class:`Shape` records around the shared, never modified, coal geometries.
     """
     key = (str(robot.urdf), tuple(robot.model.names))
@@ -255,7 +254,7 @@ class ArmShapes:
     def nearest_nodes(self, qs, allowed, cap: float = np.inf):
         """:meth:`nearest` at n configurations at once, the broad phase of all of them in one
         array operation (per node, :meth:`nearest` spends more time in NumPy calls on a few
-        dozen pairs than in coal: measured 88 µs a node, 24 µs of them in coal's queries).
+        dozen pairs than in coal's queries).
 
         Args:
             qs: (n, nq) configurations (rad).

@@ -10,9 +10,8 @@ serve into the next motion: the re-plan is used only if it is solved and the ser
 (if at all) and re-planned, still ends before the next motion starts; otherwise the scheduled
 serve runs on and the record says why.
 
-Why a lead of 0.5 s: the blade re-plans took 0.15–0.30 s on the idle 2-core machine (the
-two-burger cook of the tests and the five-burger cooks), so 0.5 s leaves the loaded
-machine of a busy cell some room. What the camera sees then is not quite where the burger
+Why a lead of 0.5 s: the blade re-plans take well under that on an idle machine, so 0.5 s
+leaves the loaded machine of a busy cell some room. What the camera sees then is not quite where the burger
 rests when the carry stops: the record gives both (``on_blade_true`` at the sense,
 ``on_blade_at_stop`` at the carry's end) and the distance between them
 (``shift_over_lead_m``), so the shift over the lead is measured in every simulated cook.

@@ -24,11 +24,10 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from flipkit.behaviors.targets import landing_spot
 from flipkit.planning.kitchen.windows import event_deviations
 from flipkit.planning.planners.serve import table_spot
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SERVE_TOL, FlipVerdict,
-                                      ServeVerdict, judge_flip, judge_serve)
+                                      ServeVerdict, judge_flip, judge_serve, landing_target)
 from flipkit.simulation.run import BurgerRun
 
 HALF_TURN_X = np.diag([1.0, -1.0, -1.0])  # burger frame turned π about its x axis
@@ -81,14 +80,6 @@ class BurgerResult:
                 "serve_up_z": None if self.serve is None else r(self.serve.up_z),
                 "knocked_m": r(self.knocked_m), "contact_s": r(self.contact_s),
                 "failure": self.failure}
-
-
-def landing_target(plan) -> np.ndarray:
-    """Where a flip plan lands its burger (x, y) (m) (module docstring)."""
-    flip = plan.segment("flip")
-    if getattr(flip, "landing", None):
-        return np.asarray(flip.landing["target"], float)[:2]
-    return landing_spot(plan.cell(), np.asarray(plan.burger["location"], float))[:2]
 
 
 def landing_time(run: BurgerRun, flip_bounds) -> float | None:
@@ -172,5 +163,5 @@ def _failure(fv: FlipVerdict | None, sv: ServeVerdict | None) -> str | None:
     return None
 
 
-__all__ = ["BurgerResult", "judge_burger", "landing_target", "landing_time", "liftoff_time",
+__all__ = ["BurgerResult", "judge_burger", "landing_time", "liftoff_time",
            "upright_frame"]

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flipkit.behaviors.targets import landing_spot
 from flipkit.errors import ConfigError
 from flipkit.simulation.run import BLADE_GAP_TOL, GRILL_SEPARATION, BurgerRun, half_extent
 
@@ -151,7 +152,19 @@ def judge_flip(run: BurgerRun, bounds, spot) -> FlipVerdict:
                        offset=tuple(float(x) for x in offset), up_z=up_z)
 
 
-SERVE_TOL = 0.03  # m: the burger's centre rests within 3 cm of the table spot (issue 13)
+def landing_target(plan) -> np.ndarray:
+    """Where a flip plan lands its burger (x, y) (m), the spot :func:`judge_flip` judges
+    against: the flip segment's planned ``landing["target"]`` (``flipkit plan flip --land X Y``
+    lands elsewhere than the default), else :func:`~flipkit.behaviors.targets.landing_spot`
+    of the plan's burger."""
+    flip = plan.segment("flip")
+    if flip.landing:
+        return np.asarray(flip.landing["target"], float)[:2]
+    return np.asarray(landing_spot(plan.cell(), np.asarray(plan.burger["location"], float)),
+                      float)[:2]
+
+
+SERVE_TOL = 0.03  # m: the burger's centre rests within 3 cm of the table spot (ours)
 UPRIGHT_Z = 0.9  # up-axis z above this: top face up (within ~26°, as UPSIDE_DOWN_Z)
 REST_WINDOW = 0.1  # s: "resting" = moved less than REST_MOTION over the run's last 0.1 s
 REST_MOTION = 0.001  # m

@@ -10,10 +10,8 @@ import numpy as np
 # "On the spatula" / "off the grill" are judged geometrically and over a short window, not from
 # one sample's contact flag: MuJoCo's burger–blade contact flickers (present, absent, present
 # from one 1 ms step to the next) while the blade decelerates upward with the burger resting on
-# it at a gap of micrometres, so a single-instant flag reads "not on the spatula" at random.
-# Measured on the Table I IPOPT plans: flag-off runs of 1–9 ms at gaps ≤ 0.07 mm during the
-# pickup (the flag is set on a median 57 % of the last 50 ms); of 35 scooped burgers the
-# last-sample flag passed 9 pickups, these judges 34.
+# it at a gap of micrometres, so a single-instant flag reads "not on the spatula" at random
+# for milliseconds at a time: "in contact" is read over a window.
 CONTACT_WINDOW = 0.05  # s: "in contact" at an instant = some contact in the last 50 ms
 BLADE_GAP_TOL = 0.003  # m: burger bottom within 3 mm of the blade's carrying face = resting on it
 GRILL_SEPARATION = 0.001  # m: burger bottom more than 1 mm above the grill = lifted off it

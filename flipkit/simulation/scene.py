@@ -69,8 +69,7 @@ body touches it (the blade arriving), when it is simulated again. The arm never 
 (``sleep="never"``). A frozen burger keeps the contacts it fell asleep with: the records of
 a run (:class:`~flipkit.simulation.trace.BurgerTrace`,
 :class:`~flipkit.simulation.cook_record.CookRecorder`) carry them on, so the judges still see
-it lying on the grill. A step costs about half as much (27 µs against 52 µs over a Table I
-flip). :func:`place_burger` and :func:`park_burger` wake the burger they move: they write
+it lying on the grill. A step costs about half as much. :func:`place_burger` and :func:`park_burger` wake the burger they move: they write
 −0.0 into its velocities, MuJoCo's documented wake signal (a non-zero bit pattern that is
 zero), besides its new pose.
 """
@@ -98,7 +97,7 @@ LINK_RADIUS = 0.045  # m, capsule visuals
 # A ≈ 1.3-2.9 /kg at the scoops, A/R = A d/((1 − d) D) ≈ 0.1 %.
 BLADE_IMPEDANCE = 0.01
 # MuJoCo's convex collider puts one blade-grill contact at each end of the leading edge when the
-# edge lies on the grill (measured: at y = ±w/2, 2 contacts); each is one half of the blade's
+# edge lies on the grill (at y = ±w/2, 2 contacts); each is one half of the blade's
 # spring-damper, so that the pressed edge meets k and b in all.
 BLADE_EDGE_CONTACTS = 2
 # A flexing blade meets the grill and the table steel on steel: MuJoCo's stiffest recommended

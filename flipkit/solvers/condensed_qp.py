@@ -18,9 +18,8 @@ the subproblem of :mod:`flipkit.solvers.full_qp` becomes
 with g_v = Tᵀ(g + h ⊙ d_p) and the inequality rows J_I and the step box d_lo ≤ d ≤ d_hi
 shifted by d_p. OSQP sees an identity Hessian and no equality rows: the linearised equalities
 hold to the accuracy of a sparse LU solve whatever its ADMM tolerance, and its iterations are
-spent on the active inequality rows (measured on the first linearisations of a Table I chain at
-eps 1e-8: 150–620 ADMM iterations where the full-space QP needed 150–5 120; the flip's
-infeasible linearisation detected in 760 where the full-space QP ran out at 20 000).
+spent on the active inequality rows, and an infeasible linearisation is detected where the
+full-space QP runs out of iterations.
 
 Multipliers of the equality rows, which the SQP's penalty update needs, are recovered from the
 full-space stationarity condition restricted to B: E_Bᵀ y_E = −(g + h ⊙ d + J_Iᵀy_I + y_box)_B.
@@ -129,9 +128,8 @@ class CondensedQP:
         LU of Eᵀ (``"lu"``), or the pivots of a column-pivoted QR of E (``"qr"``, rank-revealing).
 
         The LU's row pivoting picks, column by column of Eᵀ, the largest remaining entry:
-        dense ``getrf`` on the 547 × 516–528 matrix, 5–13 ms against 22–35 ms for ``geqp3``
-        (measured on one thread), with a basis as well conditioned on the five segments of a
-        Table I chain (cond E_B within 1.3× of the QR's). :meth:`update` falls back to the QR
+        dense ``getrf`` on the 547 × 516–528 matrix, a few times faster than ``geqp3``, with
+        a basis about as well conditioned as the QR's. :meth:`update` falls back to the QR
         when the LU's E_B fails the pivot check.
         """
         E = self._E.matrix(jac[self._eq_entries]).toarray()

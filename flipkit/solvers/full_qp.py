@@ -12,12 +12,12 @@ with the hard linearised dynamics rows this is the Gauss–Newton model of Σu²
 slacks form the *elastic* variant, used only when the hard rows are incompatible with the
 box (or OSQP fails on them), so that every linearisation still yields a step. Its slacks are
 penalised quadratically, a least-squares compromise between the rows: with an ℓ1 term
-ρ1ᵀs the QP is LP-like and OSQP hit its iteration cap on the flip segments (measured).
+ρ1ᵀs the QP is LP-like and OSQP hits its iteration cap on the flip segments.
 
 J enters as sparse cvxpy Parameters (one per row group: equalities, finite lower and finite
 upper bounds) on the NLP's fixed pattern, so the problem is DPP and is canonicalised once per
-structure — in ~0.01 s (measured; J d written as a dense parameter vector times selection
-matrices took 1.3–1.9 s per structure); re-solves only map new parameter values and OSQP
+structure, quickly (J d written as a dense parameter vector times selection matrices
+took a hundred times as long); re-solves only map new parameter values and OSQP
 warm-starts. Written as Σ h_k d_k² the Hessian adds no auxiliary variables to the OSQP
 problem. Build (:class:`QPSubproblem`) is separate from solve, so the QP can be inspected
 alone.
@@ -87,9 +87,7 @@ class QPSubproblem:
         def slack(k: int, name: str):
             # Free, not s ≥ 0: with ½σ‖s‖² the optimum has s ≥ 0 on the inequality rows anyway
             # (a negative s only tightens its row), and one free slack per equality row
-            # replaces s⁺ − s⁻ at the same optimum. Measured on a cold flip's restorations:
-            # 0.78 → 0.52 s and 0.51 → 0.31 s for its first two (172 instead of 240 µs per ADMM
-            # iteration: a smaller KKT system, no s ≥ 0 rows).
+            # replaces s⁺ − s⁻ at the same optimum: a smaller KKT system, no s ≥ 0 rows.
             if not elastic:
                 return 0
             s = cp.Variable(k, name=name)

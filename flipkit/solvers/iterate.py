@@ -51,8 +51,8 @@ def _spd_solve(K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
     """K⁻¹b for the Gram matrix K = J_R J_Rᵀ + 1e-12 I: a dense Cholesky, else a sparse LU.
 
     K is about half full (the Bezier rows share the 42 α columns and the defect rows the
-    duration T), so the dense Cholesky is the faster: 5–7 ms against 11–27 ms for SuperLU
-    on the 520–590 rows of a Table I chain (measured, one thread). When K is not numerically
+    duration T), so the dense Cholesky is the faster, about twice SuperLU's speed on the
+    520–590 rows of a Table I chain. When K is not numerically
     positive definite (dependent rows) the sparse LU solves it as before.
     """
     try:
@@ -74,8 +74,7 @@ def newton_correction(nlp: NLP, p: Iterate, active: np.ndarray | None = None) ->
             rows are held at that bound too: the second-order correction of a step keeps the
             step's active set. Without them, the correction of the rows the step violated
             pushes the rows it left exactly at their bounds — the landing disc and the cone
-            at the flip's optimum — out by as much (measured: in 9 of 14 corrections on a
-            Table I flip the summed violation grew).
+            at the flip's optimum — out by as much, and the summed violation grows.
     """
     lo, hi = nlp.c_scale * nlp.c_lo, nlp.c_scale * nlp.c_hi
     r = p.cs - np.clip(p.cs, lo, hi)
@@ -87,9 +86,8 @@ def newton_correction(nlp: NLP, p: Iterate, active: np.ndarray | None = None) ->
         rows |= held & np.isfinite(bound)
     rows = np.flatnonzero(rows)
     # Variables fixed or at a bound do not move: a correction through them is clipped away
-    # by the projection and breaks the rows it fixed (measured on a serve's carry: wrist 1's
-    # q̈ at the start node, on its 20 rad/s² bound, was moved and clipped back, and the
-    # dynamics rows came out at 0.07; the SQP then cycled 30 iterations at 2–4e-6).
+    # by the projection and breaks the rows it fixed (a q̈ on its bound moved and clipped back
+    # leaves the dynamics rows violated, and the SQP cycles).
     span = np.maximum(nlp.x_ub - nlp.x_lb, 0.0)
     tight = 1e-9 * np.maximum(np.abs(p.x), 1.0)
     free = np.flatnonzero((span > tight) & (p.x - nlp.x_lb > tight) & (nlp.x_ub - p.x > tight))

@@ -9,14 +9,13 @@ own parameter map, applied as sparse products) instead of ``get_problem_data`` p
 
 Working set. On the SQP subproblems OSQP's ADMM is slowed by the ~1600 inequality rows
 (variable box, task-space bounds, cone) of which ~15 are active: the same QP with only its
-active rows converges in 50–100 iterations instead of 1 500–2 500 (measured). So after the
+active rows converges in a twentieth of the iterations. So after the
 first solve the inequality rows handed to OSQP are those active in the previous solve (its
 working set); the solution is then checked against *every* row, the most violated dropped
 rows are added and the solve repeated (warm-started): the :data:`ADD_PER_ROUND` most violated
 in compact mode, where a round's cost grows with its rows, and every violated one on the
-persistent solver, where a round costs the same whatever the working set (measured on the
-first three cold Table I chains: their elastic restoration QPs took 3.5 instead of 8 rounds,
-0.17 instead of 0.31–0.37 s per solve). The returned point satisfies all rows
+persistent solver, where a round costs the same whatever the working set (so fewer
+rounds). The returned point satisfies all rows
 and, the dropped rows being inactive with zero multipliers, solves the full QP. A subset of
 rows being infeasible proves the full QP infeasible. The working set carried from one solve
 to the next holds at most :data:`INITIAL_ROWS` rows per variable (see :func:`_capped`).
@@ -24,8 +23,8 @@ to the next holds at most :data:`INITIAL_ROWS` rows per variable (see :func:`_ca
 Compact mode (``compact=True``, used by the condensed subproblem of
 :mod:`flipkit.solvers.condensed_qp`): OSQP is set up afresh on the working rows alone each round,
 warm-started from the previous primal–dual pair. With 19–31 variables the setup is a
-fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~1 500
-(measured: a condensed solve 12 ms → 5 ms). A compact solve's solution reaches the cvxpy
+fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~1 500.
+A compact solve's solution reaches the cvxpy
 variables and duals through a :class:`~flipkit.solvers.solution_map.SolutionMap` (cvxpy's
 unpacking found once), not through ``unpack_results`` at each solve.
 """
@@ -48,9 +47,8 @@ MAX_ROUNDS = 12  # then every row is handed to OSQP
 # A row whose norm is below NULL_ROW times the largest row's is numerically zero: a
 # row that the equality rows fix (its gradient lies outside the condensed null space, e.g. a
 # bound on a state the endpoint rows pin), left at ~1e-15 by round-off. Handed to OSQP it
-# wrecks the ADMM (measured on a turn back's condensed QP: a row of norm 1e-15 at its bound
-# made OSQP report "primal infeasible" with iterates of 1e9 at rho 1 or eps 1e-6, where the
-# zero step was feasible; without the row it solved in 70-160 iterations). Such a row is
+# wrecks the ADMM: OSQP reports "primal infeasible" where the zero step is feasible. Such a
+# row is
 # constant, so it is left out of the working set whenever its bounds hold at zero.
 NULL_ROW = 1e-10
 ADD_PER_ROUND = 10  # compact mode: most violated dropped rows added per round
@@ -60,9 +58,8 @@ def _capped(rows: np.ndarray, first: np.ndarray, then: np.ndarray, cap: int) -> 
     """The mask ``rows`` keeping at most ``cap`` of them: smallest ``first``, ties by ``then``.
 
     A working set larger than a few rows per variable is degenerate (the condensed QP has
-    19–31 variables): measured on a cold flip with a trust box of 0.0022, every one of the
-    ~1 100 step-box rows lay within INITIAL_SLACK of its bound, and OSQP ran 10 000 ADMM
-    iterations on them (1 s) where the capped set took 150–1 200 per round."""
+    19–31 variables): in a small trust box every step-box row can lie within INITIAL_SLACK
+    of its bound, and OSQP then runs to its iteration cap on them."""
     if rows.sum() <= cap:
         return rows
     keep = np.flatnonzero(rows)

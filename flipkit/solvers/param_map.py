@@ -5,8 +5,8 @@ the parameter vector p (every parameter flattened in Fortran order, then a const
 keeps that function as sparse tensors on the compiled problem (``param_prob`` of
 ``get_problem_data``): the cone form's ``[A | b]``, ``P`` and ``q``, each flattened
 column-major. ``get_problem_data`` re-applies them on every call and then reshapes, splits and
-converts the result through its reduction chain (measured: 6.6 ms per call on a condensed flip
-subproblem of 31 variables and ~2 500 rows, where the products themselves cost 0.2 ms).
+converts the result through its reduction chain, which costs far more than the products
+themselves.
 
 :class:`ParameterMap` composes, once, those tensors with what the chain does for OSQP
 (equality rows first, inequality rows negated into ``F x ≤ g``, the upper triangle of P) into
@@ -91,8 +91,8 @@ class ParameterMap:
         self._check()
 
     def assign(self, prm: cp.Parameter, value) -> None:
-        """Give ``prm`` a value for :meth:`data` without cvxpy's validation of ``.value`` (which
-        costs ~4 ms per condensed subproblem, measured); from then on ``prm`` is read from
+        """Give ``prm`` a value for :meth:`data` without cvxpy's validation of ``.value`` (a
+        cost of the order of the subproblem's solve); from then on ``prm`` is read from
         here, not from ``prm.value``.
 
         Raises:

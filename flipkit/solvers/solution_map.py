@@ -1,9 +1,8 @@
 """OSQP's solution onto a compiled cvxpy problem's variables and constraint duals, without
 cvxpy's unpacking on every solve.
 
-``Problem.unpack_results`` inverts the whole reduction chain at each solve: 0.25–0.3 ms on a
-condensed SQP subproblem of 19–31 variables (measured, one thread), about 4 % of an SQP
-iteration on translate. For an OSQP solution that chain only selects, reshapes and negates: every
+``Problem.unpack_results`` inverts the whole reduction chain at each solve, a noticeable
+share of an SQP iteration on the small condensed subproblems. For an OSQP solution that chain only selects, reshapes and negates: every
 entry of a variable is one entry of OSQP's primal vector x, every entry of a constraint's dual
 is plus or minus one entry of its dual vector y. :class:`SolutionMap` finds that signed
 selection once, by unpacking coded vectors through cvxpy itself, then applies it; the values

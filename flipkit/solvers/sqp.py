@@ -125,10 +125,9 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         admm += sol.iterations
         if "infeasible" in sol.status and attempt == 0:
             # A warm start from the previous subproblem's duals can fake an infeasibility
-            # certificate (measured): confirm it cold. A later try starts from this
-            # subproblem's own previous try; confirming those never reversed a verdict on the
-            # 20 Table I chains (cold and from the atlas: the same plans) and cost 5–7 % of
-            # their CPU time.
+            # certificate: confirm it cold. A later try starts from this subproblem's own
+            # previous try, whose verdicts a cold confirmation did not reverse: not worth its
+            # CPU time.
             qp.cold()
             sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[attempt])
             admm += sol.iterations
@@ -139,15 +138,11 @@ def _subproblem(nlp: NLP, o: SQPOptions, p: Iterate, grad, hess, mu: float, d_lo
         return sol, qp, mu, attempt + 1, admm
     if wide is not None and not restoring:
         # Infeasible within a shrunken trust box, or no verdict from OSQP in its three tries
-        # (ADMM detects infeasibility slowly, and how slowly depends on the null-space basis:
-        # measured on the reference translate in a 1e-5 box, infeasible after 1 320 ADMM
-        # iterations with a QR basis, no verdict after 2 000 + 10 000 + 10 000 with an LU
+        # (ADMM detects infeasibility slowly, and how slowly depends on the null-space
         # basis). Then the hard QP in the largest box Δ_max ∩ the variable bounds (the line
-        # search then shortens the step). Measured on Table I flips from the atlas: each of
-        # the four such QPs was feasible there and solved in 60–110 ADMM iterations, where
-        # the elastic QP took 0.2–0.7 s. (In the variable bounds alone, without Δ_max, cold
-        # flips took steps into regions where they were declared infeasible: measured at
-        # Table I location 2.)
+        # search then shortens the step): it is usually feasible there and much cheaper than
+        # the elastic QP. Without Δ_max, in the variable bounds alone, a step can reach a
+        # region where the NLP is declared infeasible.
         qp.update(nlp, p.cs, p.jac, grad, hess + mu, *wide, **extra)
         qp.cold()
         sol = qp.solve(eps=eps, max_iter=o.qp.max_iter[-1])
@@ -212,9 +207,8 @@ def _adapt(o: SQPOptions, accepted: bool, step: float, ratio: float, d_len: floa
     elif accepted and step < 1.0:
         trust = max(step * d_len, t.radius_min)
     elif not accepted:  # never wider than before: a rejected step from the largest box
-        # (wide, longer than Δ) once reset Δ to a tenth of its own length, the same Δ at the
-        # same point each time: 85 identical iterations to max_iter (measured, a flip from
-        # the atlas at (0.87, −0.42); then the cold fallback solved it)
+        # (wide, longer than Δ) reset Δ to a tenth of its own length, the same Δ at the
+        # same point each time, and the SQP repeated one iteration to max_iter
         trust = max(0.1 * min(d_len, trust), t.radius_min) if d_len > 0 else 0.1 * trust
     return trust, mu
 
@@ -319,8 +313,6 @@ def _solve(nlp: NLP, x0, options: SQPOptions, workspace: SQPWorkspace) -> SolveR
         step, ratio, accepted = 1.0, 0.0, False
         # A negative predicted decrease at a feasible point means the QP was solved too
         # loosely (d = 0 does better): not a stationary point — solve it again, tighter.
-        # (Measured: the full-space form stopped a translate at Σu² 0.15 % above the
-        # condensed form's solution, on pred = −3e-5 at an eps of 4e-6.)
         inexact = hard and pred < 0 and p.v_max <= stop.tol and eps > o.qp.eps[0]
         tighten = 0.01 * tighten if inexact else 1.0
         stationary = hard and not inexact and pred <= stop.ftol * max(p.f, 1e-3)

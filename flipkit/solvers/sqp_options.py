@@ -123,8 +123,8 @@ class TrustRegionOptions:
         second_order_correction: Before judging a full step that raised the violation and
             fell short of its prediction, try a minimum-norm Newton correction at its end
             (holding the subproblem's active rows). Off by default: with the rows' curvature
-            in the model (:attr:`QPOptions.quasi_newton`) it cost more evaluations than it
-            saved iterations (docs/benchmarks/2026-11-28-reduced-hessian.md).
+            in the model (:attr:`QPOptions.quasi_newton`) it costs more evaluations than it
+            saves iterations.
         rho_min: Smallest ℓ1 penalty ρ of the merit J̃ + ρ‖v‖₁ (scaled cost per scaled
             violation); > 0.
     """

@@ -4,11 +4,10 @@ The solvers' linear algebra is small: a 31 × 31 Cholesky, 547 × 31 products, s
 factorisations of ~520 rows. OpenBLAS's thread pool (two threads on the 2-core machine, by
 default one per core) costs more than it saves on such sizes, and when the cores are busy —
 a second solve in a sweep worker, a notebook, another process — its threads wait for each
-other: measured on a flip segment's condensed QP update, 102 ms per call with the default
-pool on a loaded 2-core box against 8 ms with one thread (cProfile, 20 calls, same data).
+other, and a condensed QP update takes over ten times as long as with one thread.
 :func:`single_threaded_blas` limits every BLAS library loaded in the process to one thread
 for the duration of a ``with`` block and restores the previous setting after it, through
-threadpoolctl (a controller built once: entering the block costs ~20 µs).
+threadpoolctl (a controller built once, so entering the block is cheap).
 """
 
 from __future__ import annotations

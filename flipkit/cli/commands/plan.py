@@ -16,6 +16,7 @@ from pathlib import Path
 from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.serve import check_table_spot
+from flipkit.behaviors.targets import check_burger_height
 from flipkit.cli.common import MAX_WORKERS, check_int
 from flipkit.config import CellConfig
 from flipkit.config.task import R_LAND_RANGE
@@ -24,9 +25,8 @@ from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.experiments.sweep import make_executor
 from flipkit.fileio import (InputFileError, check_output, check_output_dir, data_lines, read_text,
                             write_text)
-from flipkit.model.singular import check_start
 from flipkit.planning.planners.atlas import Atlas, default_atlas
-from flipkit.planning.planners.inputs import check_joint_vector, check_spacing
+from flipkit.planning.planners.inputs import check_spacing, check_start
 from flipkit.planning.planners.planner import (MAX_BATCH, SUMMARY_HEADER, format_summary, plan_batch,
                                       plan_flip, plan_translate, summary_table)
 from flipkit.planning.planners.serve import plan_serve
@@ -49,27 +49,17 @@ def _numbers(what: str, values, count: int | None = None) -> list[float]:
     return out
 
 
-BURGER_HEIGHT_TOL = 0.01  # m: |z − h_g| accepted (flipkit.behaviors.targets.check_location)
-
-
 def _yaw(value) -> float:
     """``--yaw`` (rad) wrapped to (−π, π]: 2π plans as 0."""
     y = _numbers("--yaw", value)[0]
     return math.pi - (math.pi - y) % (2 * math.pi)
 
 
-def _on_grill(loc, cell, what: str) -> None:
-    """Refuse a burger location (m) whose height is more than BURGER_HEIGHT_TOL from h_g."""
-    h = cell.grill.height
-    if abs(loc[2] - h) > BURGER_HEIGHT_TOL:
-        raise ConfigError(f"{what}: z = {loc[2]:g} m is not on the grill surface: give z = "
-                          f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
-
-
 def _burger(values, cell) -> list[float]:
-    """``--burger X Y Z`` (m), its height on the grill surface within BURGER_HEIGHT_TOL."""
+    """``--burger X Y Z`` (m), its height on the grill surface (checked before any model
+    loads: :func:`~flipkit.behaviors.targets.check_burger_height`)."""
     loc = _numbers("--burger", values, 3)
-    _on_grill(loc, cell, "--burger")
+    check_burger_height(cell, loc[2], "--burger")
     return loc
 
 
@@ -81,9 +71,7 @@ def _start_q(values, cell):
         return None
     q = _numbers("--start-q", values, 6)
     robot = models_for(cell).for_segment("go_to_burger")
-    q = check_joint_vector("--start-q", q, robot.q_min, robot.q_max, "rad")
-    check_start(q, robot.q_home, "--start-q")
-    return q
+    return check_start(robot, q, what="--start-q", branch_side=True)[0]
 
 
 def _r_land(value) -> float:
@@ -189,23 +177,24 @@ def run_flip(args: argparse.Namespace) -> int:
     options = SegmentOptions() if args.r_land is None else SegmentOptions(
         r_land=_r_land(args.r_land))
     q_start = _start_q(args.start_q, cell)
-    atlas = _atlas(args, options)
-    plan = plan_flip(location, q_start, solver=args.solver, land=land, options=options,
-                     atlas=atlas)
+    atlas = _atlas(args, options, cell)
+    plan = plan_flip(location, q_start, cell=cell, solver=args.solver, land=land,
+                     options=options, atlas=atlas)
     plan.to_json(args.json)
     if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} locations")
     return _report(plan, args.json)
 
 
-def _atlas(args: argparse.Namespace, options):
+def _atlas(args: argparse.Namespace, options, cell):
     """The atlas ``plan flip`` warm-starts from: ``--atlas FILE`` (refused if stale), else the
-    package's when it exists and serves ``options``, else ``None`` (cold starts)."""
+    package's when it exists and serves ``options`` in ``cell``, else ``None`` (cold
+    starts)."""
     if args.no_atlas:
         return None
     if args.atlas:
-        return Atlas.load(args.atlas, CellConfig(), options)
-    return default_atlas(CellConfig(), options)  # else cold starts (e.g. another --r-land)
+        return Atlas.load(args.atlas, cell, options)
+    return default_atlas(cell, options)  # else cold starts (e.g. another --r-land)
 
 
 def run_serve(args: argparse.Namespace) -> int:
@@ -221,8 +210,8 @@ def run_serve(args: argparse.Namespace) -> int:
         raise UnreachableError(f"--table-spot: {exc}") from None
     q_start = _start_q(args.start_q, cell)
 
-    atlas = _atlas(args, SegmentOptions())
-    plan = plan_serve(location, spot, q_start, solver=args.solver, atlas=atlas)
+    atlas = _atlas(args, SegmentOptions(), cell)
+    plan = plan_serve(location, spot, q_start, cell=cell, solver=args.solver, atlas=atlas)
     plan.to_json(args.json)
     if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
@@ -237,18 +226,18 @@ def run_batch(args: argparse.Namespace) -> int:
     locations = read_locations(args.burgers)
     cell = CellConfig()
     for k, loc in enumerate(locations, 1):
-        _on_grill(loc, cell, f"{args.burgers}: burger {k}")
+        check_burger_height(cell, loc[2], f"{args.burgers}: burger {k}")
     check_spacing(locations, cell.burger.diameter, str(args.burgers))  # as schedule does
     check_output_dir(args.out, "--out", inputs=[args.burgers, args.atlas],
                      names=[*(f"burger_{k}.json" for k in range(1, len(locations) + 1)),
                             "summary.csv"])
-    atlas = _atlas(args, SegmentOptions())
+    atlas = _atlas(args, SegmentOptions(), cell)
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     pool = (make_executor(workers=workers) if workers > 1 and len(locations) > 1
             else contextlib.nullcontext())
     with pool as executor:  # its workers end with the run, however it ends
-        plans = plan_batch(locations, solver=args.solver, progress=not args.no_progress,
-                           executor=executor, atlas=atlas)
+        plans = plan_batch(locations, cell=cell, solver=args.solver,
+                           progress=not args.no_progress, executor=executor, atlas=atlas)
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)

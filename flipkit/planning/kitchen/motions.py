@@ -11,7 +11,7 @@ durations.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable, Mapping, Protocol
 
 import numpy as np
@@ -123,7 +123,7 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
     return PlannedMotion(ok=ok, duration_s=duration, event_s=float(event),
                          q_end=np.asarray(last.q[-1], float), planning_time_s=planning_time_s,
                          landing=landing, plan=plan,
-                         failure=None if ok else getattr(plan, "failure", "plan failed"))
+                         failure=None if ok else plan.failure or "plan failed")
 
 
 def refused(job: MotionJob, q_start, exc: UnreachableError, t0: float) -> PlannedMotion:
@@ -159,7 +159,7 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
     job's table spot, placing the burger as if it lay at the blade centre (``plan_serve``'s
     default: planned for the scoop model's predicted place, serves rested farther from their
-    spots in simulation, docs/benchmarks/2026-11-26-kitchen.md), coming in above the other
+    spots in simulation), coming in above the other
     burgers as the flip does; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to
     burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 from flipkit.errors import ConfigError
 
-# Dwell (s): how long a served plate stays on the table before it is taken away. Our choice
-# (not measured): 30 s, a hand at the pass clearing a plate within half a minute, and short
-# enough that the table never fills: the arm places at most one plate per serve, a serve takes
-# 5.9 s today and >= 4.0 s at the target, so at most ceil(30 / 4.0) = 8 plates arrive
+# Dwell (s): how long a served plate stays on the table before it is taken away. Our choice:
+# 30 s, a hand at the pass clearing a plate within half a minute, and short enough that the
+# table never fills: the arm places at most one plate per serve, a serve takes at least 4.0 s
+# (the throughput target), so at most ceil(30 / 4.0) = 8 plates arrive
 # within any 30 s, fewer than the nine spots. A longer dwell caps the stream: nine spots at
 # dwell D take at most 9 x 3600 / D burgers per hour (D = 120 s: 270 per hour);
 # `flipkit schedule --dwell` sets it.

@@ -22,7 +22,7 @@ from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.planning.kitchen.cook import SECOND_SIDE_S
 
 EVENTS = ("flip", "serve")
-DEFAULT_WINDOW_S = (0.0, 2.0)  # s (early, late), both events (issue 32)
+DEFAULT_WINDOW_S = (0.0, 2.0)  # s (early, late), both events: the kitchen's stated window
 MAX_WINDOW_S = 30.0  # s: a bound beyond half a minute is no cook window (ours)
 
 

@@ -169,9 +169,8 @@ class Atlas:
     def stretched(self, name: str, location, nlp) -> bool:
         """Whether the atlas's nearest entry to ``location`` solved segment ``name`` with its
         duration bound stretched (its T above ``nlp``'s upper bound): the planner then tries
-        the stretched bound first, since the warm SQP within the bound spends 0.6–1.1 s
-        proving it infeasible where the stretched solve takes 0.06–0.12 s
-        (docs/benchmarks/2026-11-29-atlas-stretch.md)."""
+        the stretched bound first, since the warm SQP within the bound spends about ten times
+        as long proving it infeasible as the stretched solve takes."""
         X = self.solutions.get(name)
         if X is None or self.structure.get(name) != nlp.structure_key:
             return False

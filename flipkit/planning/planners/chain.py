@@ -25,9 +25,8 @@ from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
 
 
-# The IPOPT fallback of ``auto``: the slowest fallback that succeeded on the planner's segments
-# took ~45 s and 429 iterations (a cold pickup; docs/benchmarks/2026-11-25-goal-check.md), so
-# the budget keeps every success seen and bounds a hopeless one. An explicit ``ipopt`` keeps
+# The IPOPT fallback of ``auto``: the budget is above the slowest fallback that has succeeded
+# on the planner's segments, and bounds a hopeless one. An explicit ``ipopt`` keeps
 # IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
 # (flipkit.model.goal_check), so the fallback no longer spends its budget on them.
 FALLBACK_IPOPT = {"max_wall_time": 60.0, "max_iter": 1000}
@@ -107,12 +106,9 @@ def solve_stretched(build, options: SegmentOptions, solver: str, guess=None, *,
     ``solver``, before the bound is stretched, and the result's wall time counts both — unless
     the warm SQP found the segment locally infeasible within its bound (status ``infeasible``):
     then the stretched bound is tried first, and the cold solve within the bound only if that
-    fails too. (Measured: a serve's scoop at (0.621, −0.325), where a burger flipped at Table I
-    location 1 lands, spent 1.9 s warm, 1.3 s cold and 1.4 s in IPOPT, each ending infeasible
-    within 0.6 s, before it was solved in 0.25 s within 0.9 s.) With
-    ``solver="ipopt"`` the guess is not used: an interior-point method started on another
-    solution's active bounds is slow (measured: a Table I chain with IPOPT from the atlas was
-    stopped after 10 CPU-minutes).
+    fails too: proving a segment infeasible warm, cold and in IPOPT costs far more than the
+    stretched solve. With ``solver="ipopt"`` the guess is not used: an interior-point method
+    started on another solution's active bounds is slow.
 
     ``stretch_first(nlp) -> bool`` (with a ``guess``): whether the guess comes from a solution
     with the bound stretched; then the stretched segment is solved warm first, and only if

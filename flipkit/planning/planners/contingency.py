@@ -41,7 +41,7 @@ from flipkit.planning.plans.plan_file import Plan
 
 # m: how far past the scenario set's extremes the contingency places lie: along the blade,
 # and to its side. The side margin is larger: the scoop's sideways drift is not in the
-# scenario set (docs/benchmarks/2026-11-27-landing-budget.md).
+# scenario set.
 MARGIN = (0.015, 0.025)
 
 

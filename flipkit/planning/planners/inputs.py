@@ -10,6 +10,8 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, UnreachableError
+from flipkit.model.singular import (ELBOW, SINGULARITY_MARGIN, WRIST, branch_band,
+                                    branch_violation)
 
 
 def check_position(what: str, value, cell: CellConfig) -> np.ndarray:
@@ -62,12 +64,38 @@ def check_spacing(locations, diameter: float, where: str) -> None:
                                   f"({diameter * 1e3:.0f} mm)")
 
 
-def check_start(robot, q_start=None, qd_start=None) -> tuple[np.ndarray, np.ndarray]:
-    """The start state (q, q̇) (rad, rad/s) within the joint limits; defaults q_home at rest."""
+def check_start(robot, q_start=None, qd_start=None, *, what: str = "start configuration",
+                branch_side: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The start state (q, q̇) (rad, rad/s) within the joint limits; defaults q_home at rest.
+
+    Args:
+        robot: The arm's model (``q_min``, ``q_max``, ``qd_max``, ``q_home``, ``nq``).
+        q_start, qd_start: The start state (rad, rad/s), or ``None``: q_home, at rest.
+        what: How an error names ``q_start`` (``--start-q`` on the command line).
+        branch_side: Also refuse a q3 or q5 within :data:`SINGULARITY_MARGIN` of its
+            singular value, or past it (:mod:`flipkit.model.singular`): the planner keeps
+            both on q_home's side by that margin, so every plan from there would fail
+            ``verify`` (group ``singularity``). The command line asks for it, to refuse such
+            a start before any planning.
+
+    Raises:
+        ConfigError: One line naming ``what`` (or the start velocity), the joint, its value
+            and the range to use.
+    """
     q = robot.q_home.copy() if q_start is None else check_joint_vector(
-        "start configuration", q_start, robot.q_min, robot.q_max, "rad")
+        what, q_start, robot.q_min, robot.q_max, "rad")
     qd = np.zeros(robot.nq) if qd_start is None else check_joint_vector(
         "start velocity", qd_start, -robot.qd_max, robot.qd_max, "rad/s")
+    if branch_side and q_start is not None:
+        violation = branch_violation(q, robot.q_home, SINGULARITY_MARGIN)[0]
+        band = branch_band(robot.q_home, SINGULARITY_MARGIN)
+        for col, (j, name) in enumerate(((ELBOW, "q3 (elbow)"), (WRIST, "q5 (wrist)"))):
+            if violation[col] > 0:
+                lo, hi = band[col]
+                raise ConfigError(
+                    f"{what}: {name} = {float(q[j]):.3f} rad is within "
+                    f"{SINGULARITY_MARGIN:g} rad of its singularity (or past it); give "
+                    f"{name.split()[0]} in [{lo:.3f}, {hi:.3f}] rad, the side of q_home")
     return q, qd
 
 

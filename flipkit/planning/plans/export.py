@@ -20,8 +20,7 @@ segment (both agree on a continuous plan). Samples are at t_j = j / rate, j = 0 
 plan does, at rest. With the nodes among the samples, the cubic spline a controller lays
 through the samples' (q, q̇) is the plan's own interpolant, which verify bounded: on the
 rate's grid alone, a spline across a node where the plan's q̈ steps (a segment join) asks
-for more acceleration than the plan does (measured: 19.1 rad/s² against the plan's peak of
-13.6 on the shoulder, at 125 Hz). :func:`evaluate` gives the same interpolant (and u,
+for more acceleration than the plan does. :func:`evaluate` gives the same interpolant (and u,
 linear between nodes) at any times; the URScript and ROS 2 writers
 (:mod:`~flipkit.planning.plans.export_urscript`, :mod:`~flipkit.planning.plans.export_ros2`)
 build on these.

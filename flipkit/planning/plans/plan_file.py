@@ -128,6 +128,11 @@ class Plan:
             (kg), ``mu``. cone: Friction-cone form. segments: The :class:`Segment` list.
         created_by: ``{"flipkit": version, "git": commit or None}``. format: the file's
             format (one of :data:`FORMATS`; written as :data:`FORMAT`).
+        report: The planner's :class:`~flipkit.planning.plans.verify_report.VerificationReport`
+            of the plan. failure: One line, why the plan failed (``None`` when solved).
+            wall_time_s: Planning time (s), from the planner's start to the verified plan.
+            These three are set by the planner and are not part of the file: ``None`` on a
+            plan read from one or made by :func:`dataclasses.replace`.
     """
 
     behavior: str
@@ -142,6 +147,9 @@ class Plan:
     created_by: dict = field(default_factory=_created_by)
     format: str = FORMAT
     cell_geometry: dict | None = None
+    report: object = field(default=None, init=False, repr=False, compare=False)
+    failure: str | None = field(default=None, init=False, compare=False)
+    wall_time_s: float | None = field(default=None, init=False, compare=False)
 
     def __post_init__(self):
         check_choice("format", self.format, FORMATS)

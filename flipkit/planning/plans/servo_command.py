@@ -56,9 +56,8 @@ def hold_torque(plan) -> np.ndarray:
     model of its last segment (with the payload that segment carries).
 
     A plan ends at rest (q̇ = 0), but its last node's torque includes M q̈ of an acceleration
-    that ends there; held after the plan, that torque moved the arm on (measured after a
-    serve's return home: 2.2 cm at the blade within 0.1 s, towards a rest Kp⁻¹ M q̈ away in
-    position mode, 0.04 rad at the elbow)."""
+    that ends there; held after the plan, that torque would move the arm on, towards a rest
+    Kp⁻¹ M q̈ away in position mode."""
     last = plan.segments[-1]
     return np.asarray(plan.robot_for(last).inverse_dynamics(
         last.q[-1], np.zeros_like(last.q[-1]), np.zeros_like(last.q[-1])), float)

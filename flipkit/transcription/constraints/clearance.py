@@ -5,7 +5,7 @@ that node (:class:`~flipkit.model.collision.ArmShapes`: the arm's shapes, the ce
 bounded below by the margin. The row's Jacobian is the nearest pair's distance gradient, on
 the node's q columns (a fixed pattern). Taking the minimum over pairs, rather than a row per
 pair, keeps the QP small (20 rows per segment instead of 27 × 20 = 540; the condensed QP's
-rows are dense, and 60 rows, one per box, measured twice the QP time of the flip); the
+rows are dense, and 60 rows, one per box, double the QP time of the flip); the
 minimum is continuous and its gradient switches between pairs where two are equally near,
 which the SQP's line search handles as it does any kink. A row reads min(d, :data:`CAP`): a node whose shapes all lie
 farther than CAP from a box costs no exact distance query (the broad phase proves it) and

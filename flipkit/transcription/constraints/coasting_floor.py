@@ -17,9 +17,8 @@ class CoastingFloor(Block):
     hands its state to the next, eq. 29). Without it a flip could end with the blade above
     the turn back's floor but falling fast, and the turn back, which must keep its corners
     above a flipped burger lying anywhere on the grill from its first node on, could not stop
-    the fall in time (measured: a flip at the grill area's corner (0.875, −0.495) ended with
-    the blade 41 mm above that floor falling at 2.0–2.3 m/s; its turn back was infeasible, its
-    corners 3.4 mm below the floor at the first node). The arm's own coasting clearance
+    the fall in time (a flip at the grill area's corner can end with the blade a few
+    centimetres above that floor, falling at over 2 m/s). The arm's own coasting clearance
     (:class:`~flipkit.transcription.constraints.clearance.CoastingClearance`) keeps the blade
     clear of the grill's box only, which is beside the blade at the grill's edges. Jacobian:
     ∂h/∂q_i = J_h(q_c), ∂h/∂q̇_i = τ J_h(q_c), q_c = q_i + τ q̇_i, with J_h a corner's height

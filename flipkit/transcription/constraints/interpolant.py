@@ -3,8 +3,7 @@ given, not only of its nodes.
 
 The controller (:mod:`flipkit.simulation.execute`) and the judge of :mod:`flipkit.baseline.
 classify` follow a plan between its nodes by the cubic Hermite interpolant of (q, q̇), knot
-at every node. Node bounds alone let that interpolant exceed the limits between nodes
-(measured 2026-11-23, Table I: q̈ up to 1.056 × q̈_max, q̇ up to 1.011 × q̇_max). On an
+at every node. Node bounds alone let that interpolant exceed the limits between nodes. On an
 interval of length h = T/N with ends (q_0, q̇_0), (q_1, q̇_1) and Δ = q_1 − q_0:
 
 * q̈ is linear in time, so its bounds hold on the whole interval when they hold at its two
@@ -13,10 +12,9 @@ interval of length h = T/N with ends (q_0, q̇_0), (q_1, q̇_1) and Δ = q_1 −
   their convex hull, so |c| ≤ q̇_max (q̇_0, q̇_1 are bounded as variables) suffices.
 
 Rows per interval: a_0 (nq), a_1 (nq), c (nq). Their coefficients are large (6/h² ≈ 7e3 per
-rad at T = 0.6 s), so the rows are scaled by :data:`ACC_SCALE` and :data:`VEL_SCALE`; measured
-(2026-11-23, cold flips at Table I locations 2, 6, 9): with the node rows' scale (0.1 and 1) the
-restoration QPs took 2–4 × the ADMM iterations of a flip without the rows, with 0.001 and
-0.01 1–2 ×. :func:`flipkit.planning.plans.verify.verify_plan` checks them in the same scaled units.
+rad at T = 0.6 s), so the rows are scaled by :data:`ACC_SCALE` and :data:`VEL_SCALE`, well
+below the node rows' scale, which would multiply the restoration QPs' ADMM iterations.
+:func:`flipkit.planning.plans.verify.verify_plan` checks them in the same scaled units.
 """
 
 from __future__ import annotations
