@@ -52,6 +52,7 @@ NOT_REPO_FILES = {
     "summary.csv": "written by `flipkit plan batch`",
     "build/notebooks/": "written by `flipkit figures`",
     "kitchen.gif": "written by `flipkit figures`",
+    "OUT.run-cache/": "written by a sweep command without --cache, beside its output OUT",
     "paper/main.pdf": "written by `make paper`",
 }
 NOT_PATHS = (re.compile(r"^[\w-]+/\d+$"),  # a format's name and version: flipkit-plan/2
