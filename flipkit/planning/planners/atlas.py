@@ -167,16 +167,21 @@ class Atlas:
 
     # ----------------------------------------------------------------- lookup
     def stretched(self, name: str, location, nlp) -> bool:
-        """Whether the atlas's nearest entry to ``location`` solved segment ``name`` with its
-        duration bound stretched (its T above ``nlp``'s upper bound): the planner then tries
-        the stretched bound first, since the warm SQP within the bound spends about ten times
-        as long proving it infeasible as the stretched solve takes."""
+        """Whether most of the atlas's ``K_NEAREST`` entries nearest to ``location`` solved
+        segment ``name`` with its duration bound stretched (their T above ``nlp``'s upper
+        bound): the planner then tries the stretched bound first. Where the neighbourhood
+        needs the stretch, the warm SQP within the bound, seeded from the few entries that
+        fit it, mostly ends infeasible, and it is slow to prove that (see
+        ``docs/benchmarks/2026-11-29-atlas-stretch.md``). A minority of stretched
+        neighbours leaves the usual order, within the bound first, so that a segment that
+        fits its bound is not made slower than it need be."""
         X = self.solutions.get(name)
         if X is None or self.structure.get(name) != nlp.structure_key:
             return False
         d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
+        near = np.argsort(d, kind="stable")[:K_NEAREST]
         i = nlp.layout.T_index
-        return bool(X[int(np.argmin(d)), i] > nlp.x_ub[i] + 1e-6)
+        return bool(2 * np.count_nonzero(X[near, i] > nlp.x_ub[i] + 1e-6) > len(near))
 
     def guess(self, name: str, location, nlp, start=None) -> np.ndarray:
         """Initial guess of segment ``name`` of the chain at ``location`` for ``nlp``.
