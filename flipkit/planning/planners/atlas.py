@@ -171,8 +171,7 @@ class Atlas:
         segment ``name`` with its duration bound stretched (their T above ``nlp``'s upper
         bound): the planner then tries the stretched bound first. Where the neighbourhood
         needs the stretch, the warm SQP within the bound, seeded from the few entries that
-        fit it, mostly ends infeasible, and it is slow to prove that (see
-        ``docs/benchmarks/2026-11-29-atlas-stretch.md``). A minority of stretched
+        fit it, mostly ends infeasible, and it is slow to prove that. A minority of stretched
         neighbours leaves the usual order, within the bound first, so that a segment that
         fits its bound is not made slower than it need be."""
         X = self.solutions.get(name)
