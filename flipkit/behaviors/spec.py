@@ -256,7 +256,16 @@ class Behavior:
                               f"{', '.join(str(s.role) for s in self.steps)}")
         return found
 
+    def before(self, role: str) -> tuple[str, ...]:
+        """Names of its steps before its step of ``role``."""
+        names = self.names
+        return names[:names.index(self.step(role).name)]
+
+    def since(self, role: str) -> tuple[str, ...]:
+        """Names of its steps from its step of ``role`` on."""
+        names = self.names
+        return names[names.index(self.step(role).name):]
+
     def kept(self) -> tuple[str, ...]:
         """Names of the steps a re-plan keeps: those before its ``replanned`` step."""
-        names = self.names
-        return names[:names.index(self.step(self.replanned).name)]
+        return self.before(self.replanned)

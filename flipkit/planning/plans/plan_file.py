@@ -307,6 +307,20 @@ class Plan:
         """The plan's first :class:`Segment` named ``name``, or ``None`` if it has none."""
         return next((s for s in self.segments if s.name == name), None)
 
+    def step(self, role: str):
+        """The plan's first segment of its behaviour's step of ``role``
+        (:meth:`~flipkit.behaviors.spec.Behavior.step`), or ``None`` if it has none.
+
+        Raises:
+            ConfigError: Its behaviour has no step of that role.
+        """
+        return self.segment(BEHAVIORS[self.behavior].step(role).name)
+
+    def step_span(self, role: str) -> tuple[float, float] | None:
+        """(start, end) (s, from the plan's start) of its segment of ``role``
+        (:meth:`step`), or ``None`` if it has none."""
+        return self.segment_span(BEHAVIORS[self.behavior].step(role).name)
+
     @property
     def duration(self) -> float:
         """Its executed duration (s): the sum of its segments'."""
