@@ -4,7 +4,9 @@ checks the task, and a new subbehaviour is one spec that the one planner chains 
 
 from __future__ import annotations
 
+import copy
 import json
+from dataclasses import replace
 from importlib import resources
 
 import numpy as np
@@ -20,8 +22,10 @@ from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.plans.verify import verify_plan
+from flipkit.transcription.constraints import KinematicBlock
 
 CELL = CellConfig()
+CELL_ROBOT = models_for(CELL).loaded
 
 
 def _spec(**kw):
@@ -33,7 +37,10 @@ def _spec(**kw):
 @pytest.mark.parametrize("kw, word", [({"duration": (0.6, 0.2)}, "duration"),
                                       ({"duration": (0.0, 0.5)}, "duration"),
                                       ({"end": "stopped"}, "rest, home, moving"),
-                                      ({"needs": ("burger",)}, "location, goal, spot")])
+                                      ({"needs": ("burger",)}, "location, goal, spot"),
+                                      ({"role": "juggle"}, "role must be one of"),
+                                      ({"records": ("notes",)}, "records must be among"),
+                                      ({"atlas_anchor": "pin"}, "shift, blend")])
 def test_a_malformed_spec_is_refused_in_one_line(kw, word):
     with pytest.raises(ConfigError, match=word) as err:
         _spec(**kw)
@@ -50,6 +57,16 @@ def test_the_library_holds_every_step_of_every_behaviour():
         library.subbehavior("scop")
     with pytest.raises(InvalidChoiceError, match="'serve'"):
         library.behavior("dance")
+
+
+def test_a_behaviour_finds_its_steps_by_role():
+    flip, serve = library.behavior("flip"), library.behavior("serve")
+    assert flip.step("release").name == "flip" and flip.step(flip.sensed).name == "scoop"
+    assert serve.step(serve.sensed).name == "carry" and serve.step("place").name == "place"
+    assert flip.kept() == ("go_to_burger", "scoop", "pickup")
+    assert serve.kept() == ("go_to_burger", "scoop", "pickup", "carry")
+    with pytest.raises(ConfigError, match="serve has no release step"):
+        serve.step("release")
 
 
 def test_the_flip_and_carry_hold_the_burger_and_the_turn_back_ends_at_home():
@@ -109,6 +126,74 @@ def test_a_new_subbehaviour_is_one_spec_that_the_planner_chains_and_verify_check
     assert verify_plan(plan, space=CELL.space).ok
     plan.segments[0].q[-1, 0] += 0.05  # the goal missed: verify says so
     assert not verify_plan(plan, space=CELL.space).ok
+
+
+# A planted subbehaviour, declared in this file alone: carry the burger up to a fixed pose,
+# the blade centre never below RISE_FLOOR; ``verify`` checks its end pose (the spec's hook)
+# and its path (the spec's own check) with no other module naming it.
+RISE_GOAL = flat_pose((0.70, 0.0, 0.35))
+RISE_FLOOR = 0.24  # m, below the start (0.25 m)
+
+
+def rise_floor(ctx):
+    L = ctx.layout
+    return [KinematicBlock("rise_floor", L, "height", range(1, L.n_nodes), RISE_FLOOR, np.inf)]
+
+
+def never_below_floor(probe):
+    for i, st in enumerate(probe.states):
+        probe.add("behavior_path", [max(RISE_FLOOR - st.p[2], 0.0)], i)
+
+
+RISE = Subbehavior("rise", duration=(0.4, 1.5), carries_burger=True, end="rest",
+                   path=rise_floor, end_pose=lambda ctx: RISE_GOAL,
+                   cone=lambda ctx: list(range(ctx.layout.n_nodes)), guess=end_pose_guess,
+                   checks=(never_below_floor,))
+
+
+@pytest.fixture(scope="module")
+def rise_plan():
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(library.SUBBEHAVIORS, "rise", RISE)
+        mp.setitem(library.BEHAVIORS, "rise", Behavior("rise", (RISE,), stretch=False))
+        planner = Planner(CELL, solver="sqp")
+        robot = planner.models.loaded
+        q0 = solve_pose(robot, (0.70, 0.0, 0.25), (0.0, 0.0, 0.0), robot.q_home)
+        plan = planner.chain("rise", Task(), q0, np.zeros(robot.nq))
+    return plan  # the catalogue as it was
+
+
+@pytest.fixture
+def planted(monkeypatch):
+    """The planted spec in the catalogue; ``planted(spec)`` swaps in a changed copy."""
+    def plant(spec=RISE):
+        monkeypatch.setitem(library.SUBBEHAVIORS, "rise", spec)
+        monkeypatch.setitem(library.BEHAVIORS, "rise", Behavior("rise", (spec,), stretch=False))
+    plant()
+    return plant
+
+
+def test_verify_checks_a_planted_subbehaviours_end_pose(rise_plan, planted):
+    assert rise_plan.status == "solved", rise_plan.failure
+    assert verify_plan(rise_plan, space=CELL.space).ok
+    off = replace(RISE_GOAL, p=(0.70, 0.0, 0.36))  # the spec's end pose 1 cm higher
+    planted(replace(RISE, end_pose=lambda ctx: off))
+    report = verify_plan(rise_plan, space=CELL.space)
+    assert not report.groups["endpoints"].ok
+    assert report.groups["dynamics"].ok and report.groups["behavior_path"].ok
+    assert report.groups["endpoints"].violation == pytest.approx(0.01, abs=1e-4)
+
+
+def test_verify_checks_a_planted_subbehaviours_path_and_fails_a_tampered_copy(rise_plan,
+                                                                              planted):
+    tampered = copy.deepcopy(rise_plan)
+    seg = tampered.segments[0]
+    seg.q[:, 1] += 0.3  # the whole path, start to end, swung down (shoulder joint)
+    assert np.min([st[2] for st in map(CELL_ROBOT.position, seg.q)]) < RISE_FLOOR
+    report = verify_plan(tampered, space=CELL.space)
+    assert not report.groups["behavior_path"].ok and not report.groups["endpoints"].ok
+    planted(replace(RISE, checks=()))  # without its check, verify has no path rows for it
+    assert verify_plan(tampered, space=CELL.space).groups["behavior_path"].ok
 
 
 def test_the_plan_format_names_every_registered_subbehaviour():

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from flipkit.behaviors import targets as tg
+from flipkit.behaviors.checks import flip_end_set
 from flipkit.behaviors.clearance import FLIP_END_ALLOWANCE, tool_leaves_grill
 from flipkit.behaviors.guesses import flip_guess, turn_back_guess
 from flipkit.behaviors.options import FLIGHT_MARGIN
@@ -110,10 +111,16 @@ def above_burger(cell: CellConfig, N: int) -> np.ndarray:
 
 TURN_BACK = Subbehavior(
     "turn_back", duration=(0.4, 0.75), carries_burger=False, free_motion=True, end="home",
-    floor=above_burger, guess=turn_back_guess, doc="eq. (27): back to q_home at rest")
+    floor=above_burger, guess=turn_back_guess, role="home", atlas_anchor="blend",
+    doc="eq. (27): back to q_home at rest")
 FLIP = Subbehavior(
     "flip", duration=(0.2, 0.9), carries_burger=True, end="moving", needs=("location",),
     exempt=tool_leaves_grill, path=flip_path, cone=flip_cone, cone_on_blade=True,
     guess=flip_guess, end_allowance=FLIP_END_ALLOWANCE, coast_into=TURN_BACK.name,
+    role="release", records=("release", "landing"), checks=(flip_end_set,),
+    atlas_anchor="shift",
     doc="eq. (26) with release, flight and landing")
-PICKUP_AND_FLIP = Behavior("flip", (GO_TO_BURGER, SCOOP, PICKUP, FLIP, TURN_BACK))
+# The burger is sensed on the blade after the scoop, at rest on the grill; a re-plan keeps the
+# go to burger, scoop and pickup (the pickup does not depend on where the burger lies).
+PICKUP_AND_FLIP = Behavior("flip", (GO_TO_BURGER, SCOOP, PICKUP, FLIP, TURN_BACK),
+                           sensed="scoop", replanned="release")

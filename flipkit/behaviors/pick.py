@@ -19,6 +19,7 @@ import numpy as np
 from flipkit.behaviors import targets as tg
 from flipkit.behaviors.clearance import tool_at_grill
 from flipkit.behaviors.approach import approach_guess, approach_path, arrival_floor
+from flipkit.behaviors.checks import approach_tip, scoop_tip
 from flipkit.behaviors.guesses import task_path_guess
 from flipkit.behaviors.options import (SCOOP_ANGLE_BAND, SCOOP_LATERAL_BAND, SCOOP_PRESS,
                                        SCOOP_TIP_BAND)
@@ -103,7 +104,7 @@ GO_TO_BURGER = Subbehavior(
     "go_to_burger", duration=(0.3, 0.5), carries_burger=False, free_motion=True, end="rest",
     needs=("location",), floor=arrival_floor, approach=True, pressed=True, exempt=tool_at_grill,
     path=approach_path, end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location),
-    guess=approach_guess,
+    guess=approach_guess, role="approach", checks=(approach_tip,),
     doc="eq. (22): to the scoop's start, tip pressed into the grill before the burger")
 SCOOP = Subbehavior(
     "scoop", duration=(0.2, 0.6), carries_burger=False, end="rest", needs=("location",),
@@ -111,10 +112,11 @@ SCOOP = Subbehavior(
     end_pose=lambda ctx: tg.scoop_end(ctx.cell, ctx.location),
     cone=lambda ctx: tg.scoop_cone_nodes(ctx.cell, ctx.layout.N),
     guess=partial(task_path_guess, tip_pressed=True), after_solve=predict_on_blade,
+    role="scoop", checks=(scoop_tip,),
     doc="eqs. (23–24): slide under the burger, tip on the grill")
 PICKUP = Subbehavior(
     "pickup", duration=(0.2, 0.25), carries_burger=True, end="moving", needs=("location",),
     floor=pressed_floor, pressed=True, exempt=tool_at_grill,
     end_pose=lambda ctx: tg.pickup_end(ctx.cell, ctx.location),
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), guess=task_path_guess,
-    doc="eq. (25): lift the burger 5 cm, tipped back")
+    role="lift", doc="eq. (25): lift the burger 5 cm, tipped back")

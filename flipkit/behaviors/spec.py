@@ -4,7 +4,10 @@ segment, a :class:`Behavior` an ordered list of them.
 A spec states what differs between segments: the duration bounds, whether the spatula
 carries the burger, the floor under the blade, which of the arm's shapes may touch the cell,
 the path constraints, the end pose and the end condition, the friction-cone nodes and the
-initial guess. Everything common to every segment (dynamics, Hermite–Simpson, Bezier
+initial guess; what ``verify`` checks of a solved segment (the same end pose and cone hooks,
+read through a :class:`~flipkit.behaviors.probe.Probe`, and its own independent ``checks``);
+the records its segments carry; and the role the planners, the simulation and the atlas ask
+for it by. Everything common to every segment (dynamics, Hermite–Simpson, Bezier
 outputs, task-space limits, the arm's clearance, the start state) is added by
 :func:`flipkit.behaviors.transcribe.transcribe`. ``docs/adding-a-behaviour.md`` walks
 through the serve as the worked example.
@@ -21,6 +24,12 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 
 END_CONDITIONS = ("rest", "home", "moving")  # at rest; at q_home at rest; moving (braking room)
+# What a segment is asked for by: where it comes down (approach), slides under the burger
+# (scoop), lifts it (lift), releases it into flight (release), carries it to the table
+# (carry), places it (place), goes home (home), reaches a goal pose (goal).
+ROLES = ("approach", "scoop", "lift", "release", "carry", "place", "home", "goal")
+RECORDS = ("goal", "release", "landing", "placing")  # optional records of a solved segment
+ATLAS_ANCHORS = ("shift", "blend")
 TASK_FIELDS = {"location": "the burger location", "goal": "a goal pose",
                "spot": "the table spot"}
 
@@ -135,6 +144,16 @@ class Subbehavior:
         after_solve: ``after_solve(segment, task, models, options) -> Task``: the task of the
             segments after it, given its solution (the scoop predicts the burger's place).
         record: ``record(segment, task, models)``: adds records to its solved segment.
+        role: One of :data:`ROLES`, or ``None``: what a planner, the simulation or the atlas
+            asks for it by (:meth:`Behavior.step`), never by its name.
+        records: The optional records (:data:`RECORDS`) its segments may carry; a plan's
+            segment with another is refused.
+        checks: ``check(probe)`` for each independent check ``verify`` runs on it beyond its
+            end pose (``end_pose``), end condition (``end``) and cone (``cone``), recomputed
+            from the plan's arrays (:mod:`flipkit.behaviors.checks`).
+        atlas_anchor: How an atlas seeds it: ``None``, the interpolated solution itself;
+            ``shift``, neighbours' joint paths moved to its actual start; ``blend``, that
+            offset faded out to its end (:func:`~flipkit.planning.planners.atlas.anchored_guess`).
     """
 
     name: str
@@ -156,6 +175,10 @@ class Subbehavior:
     coast_into: str | None = None
     after_solve: Callable | None = None
     record: Callable | None = None
+    role: str | None = None
+    records: tuple[str, ...] = ()
+    checks: tuple[Callable, ...] = ()
+    atlas_anchor: str | None = None
     doc: str = field(default="", compare=False)
 
     def __post_init__(self):
@@ -168,6 +191,14 @@ class Subbehavior:
                               f"got {self.end!r}")
         if self.free_motion and self.carries_burger:
             raise ConfigError(f"{self.name}: a free motion cannot carry the burger")
+        for attr, value, valid in (("role", self.role, ROLES),
+                                   ("atlas_anchor", self.atlas_anchor, ATLAS_ANCHORS)):
+            if value is not None and value not in valid:
+                raise ConfigError(f"{self.name}: {attr} must be one of {', '.join(valid)}, "
+                                  f"got {value!r}")
+        if set(self.records) - set(RECORDS):
+            raise ConfigError(f"{self.name}: records must be among {', '.join(RECORDS)}, "
+                              f"got {self.records!r}")
         unknown = set(self.needs) - set(TASK_FIELDS)
         if unknown:
             raise ConfigError(f"{self.name}: needs unknown task fields {sorted(unknown)}; "
@@ -194,12 +225,47 @@ class Behavior:
         steps: The specs in order.
         stretch: A segment infeasible within its duration bound is planned once more with
             the bound stretched (:data:`~flipkit.behaviors.options.T_STRETCH`).
+        open_ended: A plan of it chains any number (at least one) of its steps, not each
+            once in order.
+        sensed: Role of the step at whose end the cell senses where the burger lies on the
+            blade, or ``None``.
+        replanned: Role of the first step a re-plan for the sensed burger solves again (the
+            steps before it are kept), or ``None``.
     """
 
     name: str
     steps: tuple[Subbehavior, ...]
     stretch: bool = True
+    open_ended: bool = False
+    sensed: str | None = None
+    replanned: str | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.steps)
+
+    def step(self, role: str) -> Subbehavior:
+        """Its first step of ``role``.
+
+        Raises:
+            ConfigError: It has none.
+        """
+        found = next((s for s in self.steps if s.role == role), None)
+        if found is None:
+            raise ConfigError(f"behaviour {self.name} has no {role} step; roles: "
+                              f"{', '.join(str(s.role) for s in self.steps)}")
+        return found
+
+    def before(self, role: str) -> tuple[str, ...]:
+        """Names of its steps before its step of ``role``."""
+        names = self.names
+        return names[:names.index(self.step(role).name)]
+
+    def since(self, role: str) -> tuple[str, ...]:
+        """Names of its steps from its step of ``role`` on."""
+        names = self.names
+        return names[names.index(self.step(role).name):]
+
+    def kept(self) -> tuple[str, ...]:
+        """Names of the steps a re-plan keeps: those before its ``replanned`` step."""
+        return self.before(self.replanned)

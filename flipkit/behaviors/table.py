@@ -10,6 +10,7 @@ from __future__ import annotations
 from functools import partial
 
 from flipkit.behaviors import serve as sv
+from flipkit.behaviors.checks import place_pivot_and_rest, placing_recorded, withdrawal
 from flipkit.behaviors.clearance import tool_at_table, tool_leaves_grill
 from flipkit.behaviors.guesses import return_home_guess, task_path_guess
 from flipkit.behaviors.pick import GO_TO_BURGER, PICKUP, SCOOP
@@ -38,7 +39,8 @@ CARRY = Subbehavior(
     floor=sv.table_floor, exempt=tool_leaves_grill,
     end_pose=lambda ctx: sv.carry_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), cone_on_blade=True, guess=_to_table,
-    record=record_placing, doc="to above the place pose, flat, cone on every node")
+    record=record_placing, role="carry", records=("placing",), checks=(placing_recorded,),
+    doc="to above the place pose, flat, cone on every node")
 # The tilt-off holds the burger in the cone planned for the least sticky burger (μ 0.16,
 # docs/robust-flips.md §2); within 0.8 s it has no solution, and every serve would spend an
 # SQP and an IPOPT solve before its bound was stretched, so the bound is 1.2 s.
@@ -47,6 +49,7 @@ PLACE = Subbehavior(
     floor=sv.table_floor, exempt=tool_at_table, path=sv.place_pivot,
     end_pose=lambda ctx: sv.place_end(ctx.cell, ctx.task.spot, ctx.task.blade_point()),
     cone=place_cone, cone_on_blade=True, guess=_to_table, record=record_placing,
+    role="place", records=("placing",), checks=(place_pivot_and_rest,),
     doc="tilt-off about the tip, just above the table")
 # The return unrolls the heading back to q_home's. It solves within 1.2 s too, but its faster
 # withdrawal pushes the burger just placed into the one beside it on the table, so its bound
@@ -54,5 +57,9 @@ PLACE = Subbehavior(
 RETURN_HOME = Subbehavior(
     "return_home", duration=(0.5, 1.5), carries_burger=False, end="home",
     floor=sv.withdrawn_floor, exempt=tool_at_table, path=sv.withdrawal,
-    guess=return_home_guess, doc="withdraw the blade in its plane, then home")
-SERVE = Behavior("serve", (GO_TO_BURGER, SCOOP, PICKUP, CARRY, PLACE, RETURN_HOME))
+    guess=return_home_guess, role="home", checks=(withdrawal,),
+    doc="withdraw the blade in its plane, then home")
+# The burger is sensed on the blade at the carry's end, before the place that depends on
+# where it lies; a re-plan solves the place and return home again.
+SERVE = Behavior("serve", (GO_TO_BURGER, SCOOP, PICKUP, CARRY, PLACE, RETURN_HOME),
+                 sensed="carry", replanned="place")

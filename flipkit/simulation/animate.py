@@ -27,6 +27,7 @@ import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from flipkit.behaviors.library import PICKUP_AND_FLIP  # noqa: E402
 from flipkit.errors import FlipkitError, InvalidChoiceError  # noqa: E402
 
 FORMATS = (".gif", ".mp4")
@@ -68,7 +69,7 @@ SPOT_RADIUS = 0.05  # m: the paper's landing tolerance (5 cm), drawn about the t
 def _landing_spot(execution):
     """(x, y, z) of the executed plan's landing target on the grill surface, or None."""
     plan = getattr(execution, "plan", None)
-    flip = plan.segment("flip") if plan else None
+    flip = plan.step("release") if plan else None
     if flip is None or not flip.landing:
         return None
     x, y = flip.landing["target"]
@@ -177,7 +178,7 @@ def key_frames(execution) -> dict:
     burger-grill contact after it; ``mid_flight``: the sample halfway in time between them
     (a flipped burger often falls from the release on, so its highest point is the release).
     """
-    run, (t0, t1) = execution.run, execution.bounds["flip"]
+    run, (t0, t1) = execution.run, execution.bounds[PICKUP_AND_FLIP.step("release").name]
     in_flip = np.flatnonzero((run.t >= t0) & (run.t <= t1) & run.touch_spatula)
     out = {"release": None, "mid_flight": None, "landing": None}
     if in_flip.size == 0:

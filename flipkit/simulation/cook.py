@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from flipkit.behaviors.library import SERVE
 from flipkit.config import CellConfig, SensingUncertainty
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
@@ -251,7 +252,7 @@ def simulate_cook(timeline, *, mode: str = POSITION, command: str = DEFAULT_COMM
                 return None
             if run["done"]:
                 return None
-            carry = refs.bounds["carry"]
+            carry = refs.bounds[SERVE.step(SERVE.sensed).name]
             if refs.t[k] < sense_time(carry) - 1e-9:
                 return None
             run["done"], run["stop"] = True, max(carry[1], refs.t[k])

@@ -125,8 +125,9 @@ def judge_burger(record, flip, serve, table, knocked_m: float, contact_s: float
     fv = sv = landing = liftoff = None
     if flip is not None:
         plan, run, bounds, start = flip
-        fv = judge_flip(run, bounds["flip"], landing_target(plan))
-        t = landing_time(run, bounds["flip"])
+        flight = bounds[plan.step("release").name]
+        fv = judge_flip(run, flight, landing_target(plan))
+        t = landing_time(run, flight)
         landing = None if t is None else start + t
     if serve is not None:
         plan, run, _, start = serve

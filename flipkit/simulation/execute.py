@@ -37,6 +37,7 @@ import numpy as np
 
 from flipkit.planning.plans.servo_command import COMMANDS, DEFAULT_COMMAND
 from flipkit.simulation.run import BurgerRun
+from flipkit.behaviors.library import BEHAVIORS
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError
 from flipkit.model.robot import Robot
@@ -62,7 +63,7 @@ SETTLED_TURN = 2e-3  # (unitless)
 # scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
 # burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
 # μ × 0.81, sensed after the scoop; the place depends on where it lies then).
-SENSE_AFTER = {"flip": "scoop", "serve": "carry"}
+SENSE_AFTER = {b.name: b.step(b.sensed).name for b in BEHAVIORS.values() if b.sensed}
 # How long before that segment ends the camera sees the burger (s). A serve's re-plan starts
 # where the planned carry ends, so it runs while the carry finishes, as in a cook
 # (flipkit.simulation.cook_blade). A flip's re-plan starts where the scoop ends too, but the

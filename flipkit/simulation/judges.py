@@ -157,7 +157,7 @@ def landing_target(plan) -> np.ndarray:
     against: the flip segment's planned ``landing["target"]`` (``flipkit plan flip --land X Y``
     lands elsewhere than the default), else :func:`~flipkit.behaviors.targets.landing_spot`
     of the plan's burger."""
-    flip = plan.segment("flip")
+    flip = plan.step("release")
     if flip.landing:
         return np.asarray(flip.landing["target"], float)[:2]
     return np.asarray(landing_spot(plan.cell(), np.asarray(plan.burger["location"], float)),

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.config import CellConfig
 
 QUADRATURE = 400  # grid cells per diameter for the strips' mass properties (deterministic)
@@ -192,7 +193,7 @@ def scoop_heading(plan, robot) -> float:
     """Yaw (rad, world) of the blade's x axis at the end of the plan's first scoop: the
     simulation lays the patty's strips along it (module docstring); 0 for a plan without a
     scoop."""
-    seg = next((s for s in plan.segments if s.name == "scoop"), None)
+    seg = next((s for s in plan.segments if SUBBEHAVIORS[s.name].role == "scoop"), None)
     if seg is None:
         return 0.0
     R = robot.rotation(np.asarray(seg.q[-1], float))

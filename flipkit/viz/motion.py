@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.errors import ConfigError
 from flipkit.planning.plans.export import evaluate
 from flipkit.planning.plans.plan_file import Plan
@@ -106,7 +107,7 @@ def plan_motion(plan: Plan, fps: float = FPS) -> Motion:
                 x, y = seg.landing["target"]
                 landing = Landing(np.array([x, y, cell.grill.height]), seg.landing["r_land"],
                                   np.asarray(seg.landing["point"], float), arc)
-        if seg.placing and seg.name == "place":
+        if seg.placing and SUBBEHAVIORS[seg.name].role == "place":
             x, y = seg.placing["spot"]
             spot = np.array([x, y, cell.table.height + h / 2])
             landing = Landing(spot - [0, 0, h / 2], 0.0, spot, np.zeros((0, 3)))

@@ -28,6 +28,7 @@ from typing import Callable
 
 import numpy as np
 
+from flipkit.behaviors.library import PICKUP_AND_FLIP, SERVE
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError
 from flipkit.model.robot import Robot
@@ -35,8 +36,8 @@ from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
 from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
 
 MAX_ROUNDS = 4  # plan-schedule-check rounds before a cook with meetings left is refused
-LOW_SEGMENTS = ("go_to_burger", "scoop", "pickup")  # a serve's segments that move with its burger
-TOSS_SEGMENTS = ("flip", "turn_back")  # a flip's segments that change with its landing spot
+LOW_SEGMENTS = SERVE.before("carry")  # a serve's segments at the grill: they move with its burger
+TOSS_SEGMENTS = PICKUP_AND_FLIP.since("release")  # a flip's that change with its landing spot
 # Footprint samples tested at once against the candidate spots still in. Each test removes
 # most of them, so small chunks keep the later tests small (the five-burger cook's
 # free_landing: 2.0 s in chunks of 4, 2.9 s of 16, 2.8 s of 64, 2.3 s one sample at a time).

@@ -21,7 +21,6 @@ from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
 from flipkit.planning.planners.serve import plan_serve, replan_serve, table_spot
-from flipkit.planning.plans.plan_file import segment_span
 
 KINDS = ("flip", "serve")
 
@@ -93,11 +92,11 @@ class MotionPlanner(Protocol):
     def __call__(self, job: MotionJob, q_start: np.ndarray) -> PlannedMotion: ...
 
 
-def _segment_start(plan, name: str) -> float:
-    """Start time (s) of the first segment called ``name``, from the start of the plan."""
-    span = segment_span(plan.segments, name)
+def _segment_start(plan, role: str) -> float:
+    """Start time (s) of the plan's segment of ``role``, from the start of the plan."""
+    span = plan.step_span(role)
     if span is None:
-        raise FlipkitError(f"{plan.behavior} plan has no {name!r} segment "
+        raise FlipkitError(f"{plan.behavior} plan has no {role} segment "
                            f"(segments: {', '.join(s.name for s in plan.segments)})")
     return span[0]
 
@@ -114,12 +113,12 @@ def from_plan(plan, kind: str, planning_time_s: float) -> PlannedMotion:
     last = plan.segments[-1]
     landing, event = None, duration
     if ok and kind == "flip":
-        flip = plan.segment("flip")
-        event = (_segment_start(plan, "flip") + flip.release["time"]
+        flip = plan.step("release")
+        event = (_segment_start(plan, "release") + flip.release["time"]
                  + flip.landing["time_of_flight"])
         landing = tuple(float(v) for v in flip.landing["point"][:2])
     elif ok:
-        event = _segment_start(plan, "pickup")
+        event = _segment_start(plan, "lift")
     return PlannedMotion(ok=ok, duration_s=duration, event_s=float(event),
                          q_end=np.asarray(last.q[-1], float), planning_time_s=planning_time_s,
                          landing=landing, plan=plan,

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
+from flipkit.behaviors.library import SUBBEHAVIORS
 from flipkit.config import CellConfig, ScoopUncertainty
 from flipkit.model.robot import Robot
 from flipkit.planning.kitchen.planar import (pad_polygons, point_polygon_distance,  # noqa: F401
@@ -248,7 +249,7 @@ def footprint(plan, cell: CellConfig | None = None, robot=None, dt: float = SAMP
                     out.carried.append((t0 + t, seg.name, (prev if prev is not None
                                                             else centre)[:2], centre[:2]))
                 prev = centre
-        if seg.name == "scoop":
+        if SUBBEHAVIORS[seg.name].role == "scoop":
             end = robot.placement(qs[-1])
             centre = end.translation + end.rotation @ on_blade
             out.carried.append((t0 + ts[-1], seg.name, location, centre[:2]))

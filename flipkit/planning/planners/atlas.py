@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.library import FLIP_NAMES, PICKUP_AND_FLIP
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.config.physics import SIMULATION_ONLY
@@ -49,7 +49,7 @@ SEEDED = FLIP_NAMES  # the atlas holds every segment of the pickup-and-flip
 # anchored at the actual start is close to a solution (docs/history.md has the measurements).
 # "shift": q(t) = q_atlas(t) + (q_start − q_atlas(0)) (the flip's free end moves with its
 # start); "blend": the offset fades out by a smoothstep (the turn back ends at q_home).
-ANCHORED = {"flip": "shift", "turn_back": "blend"}
+ANCHORED = {s.name: s.atlas_anchor for s in PICKUP_AND_FLIP.steps if s.atlas_anchor}
 K_NEAREST = 4
 BRANCH_TOL = 0.5  # rad: entries whose joint path departs more from the nearest one's are left out
 DEFAULT_NAME = "atlas.npz"

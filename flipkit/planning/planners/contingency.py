@@ -54,7 +54,7 @@ def contingency_places(plan: Plan, margin=MARGIN) -> list[tuple[float, float]]:
         ConfigError: ``plan`` is not a solved flip plan.
     """
     cell, _ = check_replan(plan, "flip", (0.0, 0.0))
-    landing = plan.segment("flip").landing
+    landing = plan.step("release").landing
     x0, y0 = (float(v) for v in landing["burger_on_blade"][:2])
     pts = np.array([row["burger_on_blade"][:2] for row in landing.get("scenarios", ())]
                    or [(x0, y0)], float)

@@ -26,6 +26,7 @@ from scipy.spatial import Delaunay, QhullError
 from tqdm import tqdm
 
 from flipkit.behaviors import targets as tg
+from flipkit.behaviors.library import PICKUP_AND_FLIP
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import flat_pose
@@ -182,7 +183,7 @@ def promise(plan: Plan) -> float:
     """The radius (m) within which a solved flip plan promises to land a burger lying at any
     of its scenarios' places: the scenarios' ``r_land`` (``r_scenario``), or the nominal
     ``r_land`` of a plan without scenarios."""
-    landing = plan.segment("flip").landing
+    landing = plan.step("release").landing
     return max((row["r_land"] for row in landing.get("scenarios", ())),
                default=landing["r_land"])
 
@@ -191,7 +192,7 @@ def keeps_promise(plan: Plan, on_blade, models) -> bool:
     """Whether a solved flip plan, as it is, lands a burger measured at ``on_blade`` (x, y)
     (m) within :func:`promise`: the place lies in its scenarios' hull (:func:`covers`), or
     its own release and flight land it so (:func:`landing_miss`)."""
-    flip = plan.segment("flip")
+    flip = plan.step("release")
     return (covers(flip.landing, on_blade)
             or landing_miss(flip, on_blade, models) <= promise(plan))
 
@@ -242,12 +243,12 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     """
     t0 = time.perf_counter()
     cell, on_blade = check_replan(plan, "flip", on_blade)
-    flip = plan.segment("flip")
+    flip = plan.step("release")
     planner = Planner(cell, solver=solver,
                       options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
     if keep and keeps_promise(plan, on_blade, planner.models):
         return plan
-    done = [s for s in plan.segments if s.name in ("go_to_burger", "scoop", "pickup")]
+    done = [s for s in plan.segments if s.name in PICKUP_AND_FLIP.kept()]
     before = {s.name: s for s in plan.segments}
     robust = options.robust and bool(flip.landing.get("scenarios"))
 

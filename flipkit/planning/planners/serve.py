@@ -17,7 +17,7 @@ import numpy as np
 
 from flipkit.behaviors import serve as sv
 from flipkit.behaviors import targets as tg
-from flipkit.behaviors.library import SERVE_NAMES
+from flipkit.behaviors.library import SERVE
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.config import CellConfig
@@ -79,7 +79,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     q, qd = check_start(models.bare, q_start, qd_start)
     at = (0.0, 0.0) if on_blade is None else on_blade  # the reach check before the scoop
     for what, pose in (("carry end", sv.carry_end(cell, spot, at)),
-                       ("place", sv.place_end(cell, spot, at))):
+                       ("place pose", sv.place_end(cell, spot, at))):
         try:  # reachability first, one clear line
             solve_pose(models.loaded, pose.p, pose.o, models.bare.q_home)
         except UnreachableError as exc:
@@ -113,7 +113,7 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
     t0 = time.perf_counter()
     cell, on_blade = check_replan(plan, "serve", on_blade)
     planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone))
-    done = [s for s in plan.segments if s.name in SERVE_NAMES[:4]]
+    done = [s for s in plan.segments if s.name in SERVE.kept()]
     task = Task(location=np.asarray(plan.burger["location"], float), spot=table_spot(plan),
                 on_blade=on_blade)
     return planner.chain("serve", task, done[-1].q[-1], done[-1].qd[-1], done=done, t0=t0)

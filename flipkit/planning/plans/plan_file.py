@@ -40,7 +40,6 @@ from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, ur
 
 from flipkit.planning.plans.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
 from flipkit.model.robot import Robot
-PLAN_BEHAVIORS = tuple(BEHAVIORS)  # translate, flip, serve
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
 
@@ -153,7 +152,7 @@ class Plan:
 
     def __post_init__(self):
         check_choice("format", self.format, FORMATS)
-        check_choice("behavior", self.behavior, PLAN_BEHAVIORS)
+        check_choice("behavior", self.behavior, tuple(BEHAVIORS))
         check_choice("status", self.status, PLAN_STATUSES)
         check_choice("cone", self.cone, CONE_FORMS)
         cb = check_keys(self.created_by, "created_by", ("flipkit", "git"))
@@ -228,13 +227,14 @@ class Plan:
                 raise ConfigError(f"segments[{k}].q: {seg.q.shape[1]} joints, "
                                   f"robot.q_home has {nq}")
             names.append(seg.name)
-        allowed = BEHAVIORS[self.behavior].names
+        behavior = BEHAVIORS[self.behavior]
+        allowed = behavior.names
         order = [allowed.index(n) if n in allowed else -1 for n in names]
-        if -1 in order or (self.behavior != "translate" and order != sorted(set(order))):
+        if -1 in order or (not behavior.open_ended and order != sorted(set(order))):
             raise ConfigError(f"segments: names {names} do not fit behavior {self.behavior!r} "
                               f"(expected {', '.join(allowed)}"
                               f"{' in this order' if len(allowed) > 1 else ''})")
-        if self.behavior != "translate" and self.burger["location"] is None:
+        if any("location" in s.needs for s in behavior.steps) and self.burger["location"] is None:
             raise ConfigError(f"burger.location: a {self.behavior} plan needs the burger location")
 
     # ------------------------------------------------------------------ building
@@ -306,6 +306,20 @@ class Plan:
     def segment(self, name: str):
         """The plan's first :class:`Segment` named ``name``, or ``None`` if it has none."""
         return next((s for s in self.segments if s.name == name), None)
+
+    def step(self, role: str):
+        """The plan's first segment of its behaviour's step of ``role``
+        (:meth:`~flipkit.behaviors.spec.Behavior.step`), or ``None`` if it has none.
+
+        Raises:
+            ConfigError: Its behaviour has no step of that role.
+        """
+        return self.segment(BEHAVIORS[self.behavior].step(role).name)
+
+    def step_span(self, role: str) -> tuple[float, float] | None:
+        """(start, end) (s, from the plan's start) of its segment of ``role``
+        (:meth:`step`), or ``None`` if it has none."""
+        return self.segment_span(BEHAVIORS[self.behavior].step(role).name)
 
     @property
     def duration(self) -> float:

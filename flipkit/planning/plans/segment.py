@@ -19,6 +19,11 @@ def default_payload(name: str) -> list[str]:
     return ["spatula", "burger"] if SUBBEHAVIORS[name].carries_burger else ["spatula"]
 
 
+def _holders(record: str) -> str:
+    """The subbehaviours whose segments may carry ``record`` (their specs' ``records``)."""
+    return " and ".join(n for n, s in SUBBEHAVIORS.items() if record in s.records) or "no"
+
+
 SEGMENT_KEYS = ("name", "T", "t", "q", "qd", "qdd", "u", "alpha", "cone_nodes", "solver")
 _PLACING_KEYS = ("spot", "on_blade", "heading", "pitch")
 _LANDING_KEYS = ("target", "r_land", "point", "offset", "tilt_deg", "time_of_flight")
@@ -142,10 +147,9 @@ class Segment:
         if isinstance(self.goal, dict):
             g = check_keys(self.goal, "goal", ("p", "o"))
             self.goal = Pose(*(tuple(check_array(f"goal.{k}", g[k], (3,))) for k in ("p", "o")))
-        if self.goal is not None and self.name != "translate":
-            raise ConfigError("goal: only translate segments have a goal pose")
-        if (self.release is not None or self.landing is not None) and self.name != "flip":
-            raise ConfigError("release, landing: only flip segments have them")
+        for key in ("goal", "release", "landing", "placing"):
+            if getattr(self, key) is not None and key not in SUBBEHAVIORS[self.name].records:
+                raise ConfigError(f"{key}: only {_holders(key)} segments have it")
         if self.release is not None:
             r = check_keys(self.release, "release", ("node", "time"))
             node = r["node"]
@@ -167,8 +171,6 @@ class Segment:
                 **({"scenarios": _scenarios(self.landing["scenarios"])}
                    if self.landing.get("scenarios") else {})}
         if self.placing is not None:
-            if self.name not in ("carry", "place"):
-                raise ConfigError("placing: only carry and place segments have it")
             f = check_keys(self.placing, "placing", _PLACING_KEYS)
             self.placing = {**{k: check_array(f"placing.{k}", f[k], (2,)).tolist()
                                for k in _PLACING_KEYS[:2]},
@@ -194,7 +196,7 @@ class Segment:
         its ``end_pose``/``end_orientation`` constraint blocks."""
         L, x = nlp.layout, np.asarray(result.x, dtype=float)
         nodes, T = L.nodes(x), float(x[L.T_index])
-        if goal is None and nlp.name == "translate":
+        if goal is None and "goal" in SUBBEHAVIORS[nlp.name].records:
             blocks = {b.name: b for b in nlp.blocks}
             if "end_pose" in blocks and "end_orientation" in blocks:
                 goal = Pose(tuple(blocks["end_pose"].lo[:3]),

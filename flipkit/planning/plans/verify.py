@@ -4,9 +4,11 @@ Nothing here uses :mod:`flipkit.transcription.nlp` or
 :mod:`flipkit.transcription.constraints`; kinematics and dynamics come from pinocchio through
 :class:`~flipkit.model.robot.Robot` rebuilt from the plan file (each segment with the payload
 bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
-:mod:`flipkit.behaviors` only the specs' duration bounds, floors (``blade_floor``) and exempt
-shape pairs, SCOOP_PRESS and SCOOP_TIP_BAND, and the serve's targets from :mod:`flipkit.behaviors.serve` (place and carry
-poses, tip point, predicted rest point, withdrawal bounds). Check groups (a row's violation is ≥ 0, 0 when satisfied):
+:mod:`flipkit.behaviors` the segment's spec: its duration bounds, floor (``blade_floor``),
+exempt shape pairs and end condition, its ``end_pose`` and ``cone`` hooks asked on the plan's
+record (:class:`~flipkit.behaviors.probe.Probe`), its own independent ``checks``
+(:mod:`flipkit.behaviors.checks`) and its ``records``; no segment is named here. Check groups
+(a row's violation is ≥ 0, 0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -23,17 +25,17 @@ q/qd/qdd/u_limits  joint limits: positions and torques within the URDF's and the
 interpolant        q̇ and q̈ limits between the nodes, on the cubic Hermite        100·tol,
                    interpolant of (q, q̇) the controller follows: exact extremes  1000·tol
                    of each interval's polynomial (scipy's coefficients)
-endpoints          end pose / rest / q_home per behaviour; translate: rest at  tol
+endpoints          the spec's end pose / rest / q_home; translate: rest at     tol
                    both ends, o_x = o_y = 0 and the ``goal`` if recorded;
                    serve: carry and place end poses from the recorded spot
-behavior_path      go to burger: the tip behind the rim over the descent, then  tol
-                   low and not past the scoop's start (behaviors.approach);
+behavior_path      the spec's checks: go to burger: the tip behind the rim,     tol
+                   then low and not past the scoop's start (behaviors.approach);
                    scoop tip height h_g − SCOOP_PRESS ± SCOOP_TIP_BAND; flip
                    normal, x axis, height band; place: tip at its final
                    point ± PIVOT_BAND from node 0.7 N; return_home withdrawal
                    (in the blade's start frame, attitude band)
 continuity         (q, q̇) of segment k's last node = segment k+1's first       tol
-cone               margin ≥ 0 at cone_nodes ∪ the behaviour's cone nodes       10·tol
+cone               margin ≥ 0 at cone_nodes ∪ the spec's cone nodes            10·tol
                    (flip: nodes ≤ max(0.6 N, release node − 1); carry: all;
                    place: nodes ≤ 0.7 N)
 grill_clearance    the blade's four corners' heights ≥ the segment's floor (m):  tol
@@ -88,15 +90,14 @@ from dataclasses import replace
 import numpy as np
 
 
-from flipkit.behaviors.approach import approach_limits, descent_node, slide_node
-from flipkit.behaviors.library import FLIP_NAMES, SERVE_NAMES, SUBBEHAVIORS
-from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND, T_STRETCH
-from flipkit.config.task import APPROACH_LOW
+from flipkit.behaviors.library import BEHAVIORS, SUBBEHAVIORS
+from flipkit.behaviors.options import T_STRETCH
+from flipkit.behaviors.probe import Probe, RecordedOptions, angle, outside
+from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import blade_floor
-from flipkit.behaviors import serve as sv
-from flipkit.behaviors import targets as tg
 from flipkit.model.contact import make_cone, specific_force
-from flipkit.errors import ConfigError, FlipkitError
+from flipkit.errors import ConfigError
+from flipkit.transcription.layout import Layout
 from flipkit.model.orientation import rpy
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.config import CellConfig
@@ -114,16 +115,6 @@ from flipkit.errors import VerificationError
 
 TIME_TOL = 1e-9  # s, node times against i T / N
 INTERPOLANT_TOL = (100.0, 1000.0)  # × tol: the solver's row scales 0.01 (q̇) and 0.001 (q̈)
-def _outside(x, lo, hi) -> np.ndarray:
-    """Distance of x outside the box [lo, hi] (0 inside)."""
-    return np.maximum(np.maximum(np.asarray(lo) - x, x - np.asarray(hi)), 0.0)
-
-
-def _angle(a, b) -> np.ndarray:
-    """|a − b| wrapped to [0, π] (rad)."""
-    return np.abs((np.asarray(a) - np.asarray(b) + np.pi) % (2 * np.pi) - np.pi)
-
-
 def _point(st, r_local) -> np.ndarray:
     """World position (m) of the blade point at r_local in the spatula frame."""
     return st.p + st.R @ np.asarray(r_local, float)
@@ -165,11 +156,11 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
     report = VerificationReport(tol, [s.name for s in plan.segments])
     if plan.cone == "paper":
         report.groups["cone"].unit = "1"  # cosine margin, dimensionless
-    # A flip plan is the five subbehaviours in order (a plan cut short by a failed segment
-    # must not pass); a translate plan has at least one segment.
+    # A plan is its behaviour's steps in order (a plan cut short by a failed segment must not
+    # pass); a plan of an open-ended behaviour (translate) has at least one segment.
     names = [s.name for s in plan.segments]
-    expected = {"flip": list(FLIP_NAMES), "serve": list(SERVE_NAMES)}.get(
-        plan.behavior)
+    behavior = BEHAVIORS.get(plan.behavior)
+    expected = None if behavior is None or behavior.open_ended else list(behavior.names)
     missing = (len(expected) - sum(a == b for a, b in zip(names, expected))
                if expected is not None else int(not names))
     report.add("completeness", max(len(names) - 1, 0) if names else None, [float(missing)], 0.5)
@@ -209,7 +200,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
     add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
     T_lo, T_hi = SUBBEHAVIORS[seg.name].duration
     qdd_max = robot.qdd_bound(SUBBEHAVIORS[seg.name].free_motion)
-    add("time_grid", k, _outside(T, T_lo, T_STRETCH * T_hi), tol)
+    add("time_grid", k, outside(T, T_lo, T_STRETCH * T_hi), tol)
     dyn_tol = tol * robot.u_max / 10
     tau = np.array([robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
                     for i in range(N + 1)])
@@ -219,7 +210,7 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
             ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
             ("qdd_limits", seg.qdd, -qdd_max, qdd_max, 10.0),
             ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
-        report.add_nodes(group, k, _outside(np.asarray(x), lo, hi), tol * scale)
+        report.add_nodes(group, k, outside(np.asarray(x), lo, hi), tol * scale)
     _check_interpolant(report, k, seg, robot, qdd_max, tol)
     report.add_nodes("singularity", k, branch_violation(seg.q, plan.robot["q_home"],
                                                         SINGULARITY_MARGIN), tol)
@@ -242,22 +233,18 @@ def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
         heights = [_point_height(st, (a * l, b * w, 0)) for a, b in BLADE_CORNERS]
         add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
     cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
-    release = seg.release["node"] if seg.release else 0
-    required = {"translate": range(N + 1), "pickup": range(N + 1),
-                "scoop": tg.scoop_cone_nodes(cell, N),
-                "flip": [i for i in range(N + 1) if i <= max(tg.FLIP_CONE_FRACTION * N, release - 1)],
-                "carry": range(N + 1),
-                "place": [i for i in range(N + 1) if i <= sv.PLACE_CONE_FRACTION * N + 1e-9]}
-    for i in sorted(set(seg.cone_nodes) | set(required.get(seg.name, ()))):
+    probe = _probe(report, k, seg, robot, plan, cell, states, tol)
+    for i in sorted(set(seg.cone_nodes) | set(probe.spec.cone(probe))):  # recorded ∪ the spec's
         # the flip's cone holds where the burger lies on the blade
         st = at_burger[0].take(i) if at_burger else states[i]
         add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
-    if seg.name == "flip" and seg.release and seg.landing and plan.cone == "physical":
+    release = probe.options.release
+    if "release" in probe.spec.records and seg.release and seg.landing and plan.cone == "physical":
         # the burger leaves the blade at the release node: no normal force there
         st = at_burger[0].take(release) if at_burger else states[release]
         f = specific_force(st.R, st.a, cell.gravity)
         add("release", k, abs(f[2]), 10 * tol, release)
-    _check_behavior(report, k, seg, robot, plan, cell, states, tol)
+    _check_behavior(report, k, probe)
 
 
 def _check_interpolant(report, k, seg, robot, qdd_max, tol) -> None:
@@ -267,94 +254,43 @@ def _check_interpolant(report, k, seg, robot, qdd_max, tol) -> None:
     n = np.arange(seg.N)
     for i, qdd in enumerate((start, end)):
         # node of the interval's start (i = 0) or end (i = 1)
-        report.add_nodes("interpolant", k, _outside(qdd, -qdd_max, qdd_max),
+        report.add_nodes("interpolant", k, outside(qdd, -qdd_max, qdd_max),
                          INTERPOLANT_TOL[1] * tol, n + i)
-    report.add_nodes("interpolant", k, _outside(qd, -robot.qd_max, robot.qd_max),
+    report.add_nodes("interpolant", k, outside(qd, -robot.qd_max, robot.qd_max),
                      INTERPOLANT_TOL[0] * tol, n)
 
 
-def _check_behavior(report, k, seg, robot, plan, cell, states, tol) -> None:
-    """Endpoint and path constraints of the segment's behaviour (paper eqs. 9, 22–27)."""
-    N, add, end = seg.N, report.add, states[-1]
-    hg, pb = cell.grill.height, plan.burger["location"]
-
-    def pose(target: tg.Pose) -> None:
-        add("endpoints", k, np.abs(end.p - np.asarray(target.p)), tol, N)
-        add("endpoints", k, _angle(rpy(end.R), target.o), tol, N)
-
-    if seg.name in ("translate", "go_to_burger", "turn_back"):
-        add("endpoints", k, np.abs(seg.qd[-1]), tol, N)  # at rest at the end
-    if seg.name == "translate":
-        add("endpoints", k, np.abs(seg.qd[0]), tol, 0)
-        add("endpoints", k, _angle(rpy(end.R)[:2], 0.0), tol, N)  # flat
-        if seg.goal is not None:
-            pose(seg.goal)
-    elif seg.name == "go_to_burger":
-        pose(tg.scoop_ready(cell, pb))
-        rim, start = approach_limits(cell, pb)  # the tip behind the rim, then low (approach)
-        for i in range(descent_node(N), N + 1):
-            tip = _point(states[i], (cell.spatula.length / 2, 0.0, 0.0))
-            if i < slide_node(N):
-                add("behavior_path", k, [max(tip[0] - rim, 0.0)], tol, i)
-            else:
-                add("behavior_path", k, [max(tip[0] - start, 0.0),
-                                         max(tip[2] - hg - APPROACH_LOW, 0.0)], tol, i)
-    elif seg.name == "scoop":
-        pose(tg.scoop_end(cell, pb))
-        for i, st in enumerate(states):  # tip pressed into the grill, within the band
-            tip = _point_height(st, (cell.spatula.length / 2, 0, 0))
-            add("behavior_path", k, _outside(tip, hg - SCOOP_PRESS - SCOOP_TIP_BAND,
-                                             hg - SCOOP_PRESS + SCOOP_TIP_BAND), tol, i)
-    elif seg.name == "pickup":
-        pose(tg.pickup_end(cell, pb))
-    elif seg.name == "flip":
-        add("behavior_path", k, _outside(end.R[:, 2], *tg.FLIP_NORMAL_BOUNDS), tol, N)
-        lo, hi = tg.FLIP_HEIGHT_BAND
-        add("behavior_path", k, _outside(end.p[2], hg + lo, hg + hi), tol, N)
-        for i, st in enumerate(states):
-            add("behavior_path", k, _outside(st.R[:, 0], *tg.FLIP_XAXIS_BOUNDS), tol, i)
-        check_flight(report, k, seg, robot, cell, states)
-    elif seg.name in ("turn_back", "return_home"):
-        add("endpoints", k, np.abs(seg.q[-1] - robot.q_home), tol, N)
-    if seg.name in SERVE_NAMES[3:]:
-        _check_serve(report, k, seg, cell, states, tol, pose)
+def _check_behavior(report, k, probe: Probe) -> None:
+    """What the segment's spec declares (paper eqs. 9, 22–27 and the serve's): its end
+    condition, its end pose (the spec's ``end_pose`` hook on the plan's record), its own
+    independent ``checks``, and the flight of a segment that records a landing."""
+    spec, seg, robot, states, N = probe.spec, probe.seg, probe.robot, probe.states, probe.seg.N
+    if spec.at_rest:
+        probe.add("endpoints", np.abs(seg.qd[-1]), N)
+    if spec.end == "home":
+        probe.add("endpoints", np.abs(seg.q[-1] - robot.q_home), N)
+    target = spec.end_pose(probe) if probe.has_task() else None
+    if target is not None:
+        probe.add("endpoints", np.abs(states[-1].p - np.asarray(target.p)), N)
+        probe.add("endpoints", angle(rpy(states[-1].R), target.o), N)
+    for check in spec.checks:
+        check(probe)
+    if "landing" in spec.records:
+        check_flight(report, k, seg, robot, probe.cell, states)
 
 
-def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
-    """Serve's carry, place and return home: end poses from the recorded spot, the spot on
-    the table and the predicted rest point at it, the withdrawal (module docstring)."""
-    N, add = seg.N, report.add
-    add("endpoints", k, np.abs(seg.qd[-1]), tol, N)  # at rest at the end
-    if seg.name == "return_home":
-        R0, p0 = states[0].R, states[0].p
-        lo, hi = sv.withdraw_bounds(N)
-        o0 = rpy(R0)
-        for row, i in enumerate(range(1, sv.WITHDRAW_NODES + 1)):
-            st = states[i]
-            add("behavior_path", k, _outside(R0.T @ (st.p - p0), lo[row], hi[row]), tol, i)
-            add("behavior_path", k, np.maximum(_angle(rpy(st.R), o0) - sv.WITHDRAW_ANGLE_BAND,
-                                               0.0), tol, i)
-        return
-    if seg.placing is None:
-        add("placing", k, [np.inf], 1e-3, N)
-        return
-    spot, on_blade = np.asarray(seg.placing["spot"]), np.asarray(seg.placing["on_blade"])
-    try:
-        sv.check_table_spot(cell, spot)
-    except FlipkitError:
-        add("placing", k, [np.inf], 1e-3, N)
-        return
-    target = (sv.carry_end if seg.name == "carry" else sv.place_end)(cell, spot, on_blade)
-    pose(target)
-    if seg.name == "place":  # the tilt pivots about the tip's final point
-        tip = sv.tip_point(cell, target)
-        half = np.array([cell.spatula.length / 2, 0.0, 0.0])
-        for i in sv.pivot_nodes(N):
-            miss = np.abs(states[i].p + states[i].R @ half - tip) - sv.PIVOT_BAND
-            add("behavior_path", k, np.maximum(miss, 0.0), tol, i)
-        end = states[-1]
-        rest = sv.predicted_rest(cell, end.p, rpy(end.R)[2], on_blade)
-        add("placing", k, [np.linalg.norm(rest - spot)], 1e-3, N)
+def _probe(report, k, seg, robot, plan, cell, states, tol) -> Probe:
+    """The spec's view of segment k (:class:`~flipkit.behaviors.probe.Probe`): the task and
+    options rebuilt from the plan's record."""
+    placing, landing = seg.placing or {}, seg.landing or {}
+    pb = plan.burger["location"]
+    on_blade = placing.get("on_blade", landing.get("burger_on_blade"))
+    task = Task(location=pb, goal=seg.goal, spot=placing.get("spot"), on_blade=on_blade)
+    options = RecordedOptions(landing=seg.release is not None,
+                              release=seg.release["node"] if seg.release else 0)
+    return Probe(SUBBEHAVIORS[seg.name], seg, Layout(robot.nq, seg.N), cell, task,
+                 None if pb is None else np.asarray(pb, float), options, robot, states, tol,
+                 lambda group, v, t, node: report.add(group, k, v, t, node))
 
 
 def require_verified(plan: Plan, where, behaviors=None, *, force: bool = False,
