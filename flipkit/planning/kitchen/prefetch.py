@@ -14,15 +14,21 @@ The plans are those of the serial run: the same planner with the same inputs, ea
 own process (the solvers are deterministic and start from nothing a previous solve left;
 tested). Each prefetched motion records ``ready_s``, when its plan was in, from the start of
 planning, so the schedule's planning clock and slack follow the real (parallel) planning.
+
+A worker that dies (the OOM killer, a crash in native code, a signal) breaks its pool: the
+motion it was planning, and every motion after it, is planned on demand in this process,
+with one line on stderr, and the cook goes on.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import sys
 import time
 from collections.abc import Mapping
 
 import numpy as np
+from tqdm import tqdm
 
 from flipkit.config import CellConfig
 from flipkit.planning.kitchen.motions import MotionJob, PlannedMotion, default_planners
@@ -60,8 +66,14 @@ class PrefetchPlanners(Mapping):
         self.on_demand = 0  # motions planned in this process (no prefetched match)
 
     def _submit(self, job: MotionJob) -> None:
-        fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
-                                   self.solver, self.atlas)
+        if self.executor is None:  # the workers died: motions are planned on demand, here
+            return
+        try:
+            fut = self.executor.submit(plan_motion, job.kind, job, self.q_rest, self.cell,
+                                       self.solver, self.atlas)
+        except cf.BrokenExecutor:
+            self._workers_died(job)
+            return
         key = job.key
         fut.add_done_callback(lambda _f, key=key: self._ready.setdefault(
             key, time.perf_counter() - self._t0))
@@ -84,12 +96,26 @@ class PrefetchPlanners(Mapping):
             pm.ready_s = time.perf_counter() - self._t0
             pm.planning_time_s = time.perf_counter() - t
             return pm
-        pm = fut.result()
+        try:
+            pm = fut.result()
+        except cf.BrokenExecutor:  # its worker died: planned here, like a motion not ahead
+            self._workers_died(job)
+            del self._futures[job.key]
+            return self._result(job, q_start)
         pm.ready_s = self._ready.get(job.key, time.perf_counter() - self._t0)
         if job.kind == "flip" and "serve" in self.kinds and pm.ok and job.burger in self._spots:
             self.prefetch(MotionJob("serve", job.burger, (*pm.landing, self.cell.grill.height),
                                     self._spots[job.burger]))
         return pm
+
+    def _workers_died(self, job: MotionJob) -> None:
+        """The pool broke (a worker was killed, or crashed in native code): say so once,
+        and plan every motion from now on in this process."""
+        if self.executor is not None:
+            tqdm.write(f"flipkit: a planning worker died (at {job.kind}:{job.burger}); "
+                       "the cook's motions are planned in this process from now on",
+                       file=sys.stderr)
+        self.executor = None
 
     def __getitem__(self, kind: str):
         if kind not in self.kinds:

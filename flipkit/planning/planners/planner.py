@@ -17,7 +17,9 @@ before anything is solved.
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import math
+import sys
 import time
 from dataclasses import replace
 
@@ -310,7 +312,8 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
         try:
             start_ok = ahead is not None and (k == 1 or any(p.status == "solved" for p in plans)
                                               or q_start is None)
-            plan = ahead[k - 1].result() if start_ok else plan_flip(pb, q, qd, **kw)
+            plan = _ahead_or_here(ahead[k - 1], k, pb, q, qd, kw) if start_ok else \
+                plan_flip(pb, q, qd, **kw)
         except FlipkitError as exc:
             raise type(exc)(f"burger {k}: {exc}") from None
         plans.append(plan)
@@ -320,6 +323,18 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
             if max(np.abs(q - home).max(), np.abs(qd).max()) <= REST_TOL:
                 q, qd = home, None  # at rest at q_home, to the solver's tolerance
     return plans
+
+
+def _ahead_or_here(future, k: int, pb, q, qd, kw: dict) -> Plan:
+    """Burger ``k``'s plan made ahead by a worker, or, if that worker died (its pool broke:
+    the OOM killer, a crash in native code, a signal), made here from the same start, with
+    one line on stderr."""
+    try:
+        return future.result()
+    except cf.BrokenExecutor as exc:
+        tqdm.write(f"flipkit: the worker planning burger {k} died ({type(exc).__name__}); "
+                   "planning it in this process", file=sys.stderr)
+        return plan_flip(pb, q, qd, **kw)
 
 
 SUMMARY_HEADER = ("burger", "location_m", "status", "solve_time_s", "iterations",
