@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from flipkit import cli
+from flipkit.behaviors import library
 from flipkit.config import CellConfig
 from flipkit.errors import InvalidChoiceError
 from flipkit.planning.kitchen import cook, motions
@@ -200,13 +201,18 @@ def test_a_kind_without_a_planner_is_refused():
 def test_serve_planner_calls_plan_serve_from_the_start_configuration(monkeypatch):
     seen = {}
 
+    serve_behavior = library.behavior("serve")  # its steps by role
+
     def fake_plan_serve(burger, table_spot, q_start=None, **kw):
         seen.update(burger=burger, spot=table_spot, q=q_start, **kw)
         seg = [SimpleNamespace(name=n, T=t, q=np.full((21, 6), k))
                for k, (n, t) in enumerate([("go_to_burger", 0.7), ("scoop", 0.6),
                                            ("pickup", 0.3), ("carry", 1.0)])]
+        starts = dict(zip([g.name for g in seg], np.cumsum([0.0] + [g.T for g in seg])))
         return SimpleNamespace(status="solved", segments=seg, behavior="serve",
-                               duration=sum(g.T for g in seg))
+                               duration=sum(g.T for g in seg),
+                               step_span=lambda role: (starts[serve_behavior.step(role).name],
+                                                       None))
 
     monkeypatch.setattr(motions, "plan_serve", fake_plan_serve)
     serve = motions.default_planners(("flip", "serve"), CELL, "sqp")["serve"]
