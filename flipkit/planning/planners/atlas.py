@@ -33,9 +33,9 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.config.physics import SIMULATION_ONLY
 from flipkit.errors import AtlasError
-from flipkit.fileio import InputFileError, check_input
 from flipkit.fileio import replace_with
 from flipkit.jsonread import strict_loads
+from flipkit.planning.planners.inputs import check_atlas_file
 from flipkit.transcription.guess import fit_guess
 
 FORMAT = "flipkit-atlas/1"
@@ -131,16 +131,7 @@ class Atlas:
         Raises:
             AtlasError: Unreadable, not an atlas, or stale (other options or cell).
         """
-        try:
-            check_input(path, "atlas")
-            with open(path, "rb") as fh:
-                magic = fh.read(4)
-        except (InputFileError, OSError) as exc:
-            raise AtlasError(f"cannot read atlas {path}: "
-                             f"{str(exc).split(': ', 1)[-1]}") from None
-        if magic != b"PK\x03\x04":  # every .npz is a zip archive
-            raise AtlasError(f"cannot read atlas {path}: not an .npz archive; give a file "
-                             "written by `flipkit atlas build`, or --no-atlas")
+        check_atlas_file(path)
         try:
             with np.load(Path(path), allow_pickle=False) as data:
                 header = strict_loads(str(data["header"]))

@@ -9,9 +9,12 @@ import math
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, UnreachableError
+from flipkit.errors import AtlasError, ConfigError, UnreachableError
+from flipkit.fileio import InputFileError, check_input
 from flipkit.model.singular import (ELBOW, SINGULARITY_MARGIN, WRIST, branch_band,
                                     branch_violation)
+
+MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 
 
 def check_position(what: str, value, cell: CellConfig) -> np.ndarray:
@@ -46,6 +49,25 @@ def check_joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
         raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
                           f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
     return v
+
+
+def check_atlas_file(path) -> None:
+    """Refuse an atlas file that cannot be read or is not an ``.npz`` archive (a zip), before
+    its arrays are loaded (:meth:`flipkit.planning.planners.atlas.Atlas.load`).
+
+    Raises:
+        AtlasError: One line naming the file and what to give instead.
+    """
+    try:
+        check_input(path, "atlas")
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+    except (InputFileError, OSError) as exc:
+        raise AtlasError(f"cannot read atlas {path}: "
+                         f"{str(exc).split(': ', 1)[-1]}") from None
+    if magic != b"PK\x03\x04":  # every .npz is a zip archive
+        raise AtlasError(f"cannot read atlas {path}: not an .npz archive; give a file "
+                         "written by `flipkit atlas build`, or --no-atlas")
 
 
 def check_spacing(locations, diameter: float, where: str) -> None:

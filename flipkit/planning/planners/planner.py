@@ -35,13 +35,12 @@ from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import (check_approach_height, check_joint_vector,
-                                              check_on_blade, check_position,
-                                              check_replan, check_start)
+from flipkit.planning.planners.inputs import (MAX_BATCH, check_approach_height,
+                                              check_joint_vector, check_on_blade,
+                                              check_position, check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_flight import LANDING_TOL, TILT_MIN_DEG, recompute_landing
 
-MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
 
 

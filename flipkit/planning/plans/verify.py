@@ -340,7 +340,7 @@ def _check_serve(report, k, seg, cell, states, tol, pose) -> None:
         return
     spot, on_blade = np.asarray(seg.placing["spot"]), np.asarray(seg.placing["on_blade"])
     try:
-        sv.check_table_spot(cell, spot)
+        tg.check_table_spot(cell, spot)
     except FlipkitError:
         add("placing", k, [np.inf], 1e-3, N)
         return
