@@ -29,6 +29,16 @@ HARNESS = (
     "sys.exit(rc)\n")
 
 GOOD_ORDER = "burger,t_drop,x,y\nb1,0,0.70,-0.20\n"
+TOP_KEYS = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
+            "cone", "created_by")
+
+
+def plan_doc(t) -> str:
+    """A plan file's top level, all but its one segment's node times ``t`` left empty."""
+    return json.dumps({"format": "flipkit-plan/2", **dict.fromkeys(TOP_KEYS),
+                       "segments": [{"t": t}]})
+
+
 FILES = {
     "bad.json": "{oops",
     "list.json": "[1, 2]",
@@ -41,6 +51,8 @@ FILES = {
     "batch_six.csv": "x,y,z\n" + "0.75,0.0,0.072\n" * 6,
     "batch_close.csv": "x,y,z\n0.70,-0.20,0.072\n0.72,-0.20,0.072\n",
     "cell.json": '{"cell_geometry": {}, "cell_geometry": {}}',
+    "swapped.json": plan_doc([0.0, 0.2, 0.1]),
+    "nodes.json": plan_doc([i * 1e-3 for i in range(1003)]),
     "atlas.npz": "not a zip",
 }
 FLIP = ["plan", "flip", "--burger", "0.69", "-0.16", "0.072", "--json", "{d}/o.json"]
@@ -91,6 +103,11 @@ CASES = {
                     "--rate"),
     "verify malformed": (["verify", "{d}/bad.json"], "not a JSON file"),
     "verify not an object": (["verify", "{d}/list.json"], "expected a JSON object"),
+    "verify swapped times": (["verify", "{d}/swapped.json"],
+                             "segments[0].t: node times must increase strictly"),
+    "verify node count": (["verify", "{d}/nodes.json"], "segments[0].t: expected N+1"),
+    "export swapped times": (["export", "{d}/swapped.json", "--out", "{d}/o.csv"],
+                             "segments[0].t"),
     "verify tol": (["verify", "{d}/bad.json", "--tol", "1"], "--tol"),
     "verify cell": (["verify", "{d}/list.json", "--cell", "{d}/cell.json"], "duplicate key"),
     "animate": (["animate", "{d}/bad.json", "--out", "{d}/a.gif"], "not a JSON file"),
@@ -135,13 +152,12 @@ def test_a_refusal_imports_no_heavy_module(inputs, name):
     assert sorted(p.name for p in inputs.iterdir()) == before  # nothing written
 
 
-def test_the_harness_sees_a_heavy_import(inputs):
+def test_the_harness_sees_a_heavy_import(tmp_path):
     """The same harness on a command that gets past its cheap checks: it reports the heavy
     modules, so an empty list above means they were not imported."""
-    plan = inputs / "no_segments.json"
-    plan.write_text(json.dumps({"format": "flipkit-plan/2", **{k: None for k in (
-        "behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger", "cone",
-        "segments", "created_by")}}))
-    code, err, heavy = refuse(["verify", str(plan)], inputs)
+    plan = tmp_path / "no_segments.json"
+    plan.write_text(json.dumps({"format": "flipkit-plan/2", **dict.fromkeys(TOP_KEYS),
+                                "segments": None}))
+    code, err, heavy = refuse(["verify", str(plan)], tmp_path)
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert "scipy" in heavy

@@ -105,8 +105,9 @@ def register(subparsers) -> None:
                                    "previous solved plan ended; write DIR/burger_<k>.json "
                                    "and DIR/summary.csv.")
     b.add_argument("--burgers", required=True, metavar="FILE.csv",
-                   help="CSV with header x,y,z (or px,py,pz), 1 to 5 rows, burgers one "
-                        "diameter apart; lines starting with # skipped")
+                   help="CSV with header x,y,z (or px,py,pz; in any order, no other "
+                        "column), 1 to 5 rows, burgers one diameter apart; lines starting "
+                        "with # skipped")
     b.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (burger_<k>.json, summary.csv; not holding an "
                         "input of those names)")

@@ -63,9 +63,9 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("schedule", help="schedule and plan the flips and serves of a "
                                                 "cook (one arm)", description=DESCRIPTION)
     p.add_argument("burgers", metavar="BURGERS.csv", nargs="?",
-                   help="cook order: header burger,t_drop,x,y (id, drop time s in [0, "
-                        "86400], grill position m); lines starting with # skipped; "
-                        "omitted with --stream")
+                   help="cook order: header burger,t_drop,x,y (in any order, no other "
+                        "column: id, drop time s in [0, 86400], grill position m); lines "
+                        "starting with # skipped; omitted with --stream")
     p.add_argument("--json", required=True, metavar="TIMELINE.json",
                    help="timeline output (.json; not the cook order)")
     p.add_argument("--figure", metavar="PATH", help="Gantt chart (.pdf, .png or .svg)")

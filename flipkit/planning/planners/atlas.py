@@ -210,7 +210,10 @@ class Atlas:
 
 def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
     """Raise :class:`~flipkit.errors.AtlasError` if ``atlas`` (or ``None``) was built for
-    other planning options or another cell."""
+    other planning options or another cell, or is not an :class:`Atlas`."""
+    if atlas is not None and not isinstance(atlas, Atlas):
+        raise AtlasError(f"atlas: expected an Atlas (Atlas.load(path)) or None, got "
+                         f"{type(atlas).__name__}")
     if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
         raise AtlasError("stale atlas: built for other planning options or another cell; "
                          "rebuild it with `flipkit atlas build`")

@@ -30,6 +30,7 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import flat_pose
 from flipkit.config import CellConfig, SensingUncertainty
+from flipkit.config.checks import real_number
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
@@ -71,8 +72,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
     planner = Planner(cell, solver=solver, options=options)
     cell, robot = planner.cell, planner.models.loaded
     p_goal = check_position("translate goal", goal, cell)
-    if not np.isfinite(yaw):
-        raise ConfigError(f"yaw must be finite (rad), got {yaw!r}")
+    yaw = real_number("yaw", yaw, "rad")
     if q_start is None:
         if start is None:
             raise ConfigError("translate needs a start position or a start configuration")
