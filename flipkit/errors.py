@@ -2,6 +2,8 @@
 
 Messages are one line and, where the error is a bad choice, list the valid choices, so the
 command line can print them as they are (``flipkit: error: <message>``) and exit non-zero.
+A message that quotes a value whose ``repr`` spans lines (a numpy array) is folded to one
+line by :class:`FlipkitError` itself; :func:`brief` shortens such a value for a message.
 """
 
 from __future__ import annotations
@@ -9,14 +11,28 @@ from __future__ import annotations
 from typing import Any, Iterable
 
 
+BRIEF_CHARS = 80  # characters of a value quoted in a message
+
+
+def brief(value) -> str:
+    """``repr(value)`` on one line, cut to :data:`BRIEF_CHARS` characters (``...`` marks a
+    cut): how a message quotes a value it refuses."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= BRIEF_CHARS else text[:BRIEF_CHARS - 3] + "..."
+
+
 class FlipkitError(Exception):
-    """Root of every flipkit error.
+    """Root of every flipkit error. Its message is one line: every run of whitespace,
+    line breaks included, reads as one space.
 
     Attributes:
         exit_status: The command line's exit status for it: 2, bad input refused.
     """
 
     exit_status = 2
+
+    def __str__(self) -> str:
+        return " ".join(super().__str__().split())
 
 
 class ConfigError(FlipkitError, ValueError):

@@ -10,7 +10,7 @@ import pytest
 
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.cli import main
-from flipkit.cli.commands.plan import read_locations
+from flipkit.cli.plan_inputs import read_locations
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
 from flipkit.planning.plans.plan_file import Plan
@@ -81,9 +81,9 @@ def test_malformed_csv_exits_2(tmp_path, capsys, name):
     assert not (tmp_path / "out").exists()
 
 
-def test_csv_accepts_table1_columns_and_comments(tmp_path):
+def test_csv_accepts_table1_columns_in_any_order_and_comments(tmp_path):
     src = tmp_path / "b.csv"
-    src.write_text("# Table I\npx,py,pz,scoop\n0.64,-0.33,0.073,7\n\n# row 2\n0.75,0.00,0.073,10\n")
+    src.write_text("# Table I\npy,px,pz\n-0.33,0.64,0.073\n\n# row 2\n0.00,0.75,0.073\n")
     assert read_locations(src) == [(0.64, -0.33, 0.073), (0.75, 0.0, 0.073)]
     with pytest.raises(ConfigError, match="cannot read"):
         read_locations(tmp_path / "missing.csv")

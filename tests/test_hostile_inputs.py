@@ -229,7 +229,7 @@ def test_t_drop_is_bounded(tmp_path, capsys):
 
 
 def test_yaw_is_wrapped():
-    from flipkit.cli.commands.plan import _yaw
+    from flipkit.cli.plan_inputs import yaw as _yaw
 
     assert _yaw("6.283185307") == pytest.approx(0.0, abs=1e-9)
     assert _yaw(str(math.pi)) == pytest.approx(math.pi)

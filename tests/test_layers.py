@@ -23,7 +23,7 @@ from flipkit.import_graph import module_name, package_files
 
 # Lowest first. A module may import its own layer and the layers below it.
 LAYERS = (
-    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "import_graph"),
+    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "csv_header", "import_graph"),
     ("config", ""),  # "" is the package root (flipkit/__init__.py: version, CellConfig)
     ("model",),
     ("transcription",),

@@ -13,6 +13,7 @@ from conftest import central_fd
 
 from flipkit.behaviors.library import SERVE_NAMES
 from flipkit.behaviors import serve as sv
+from flipkit.behaviors.targets import check_table_spot
 from flipkit.cli import main
 from flipkit.config import TableConfig
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
@@ -49,7 +50,7 @@ def plan_file(tmp_path_factory):
                                   "here"])
 def test_table_spot_off_the_table_or_malformed_is_refused(cell, spot):
     with pytest.raises(UnreachableError) as exc:
-        sv.check_table_spot(cell, spot)
+        check_table_spot(cell, spot)
     assert "\n" not in str(exc.value)
 
 

@@ -88,12 +88,16 @@ def test_a_signal_ends_every_process_of_the_run(request, tmp_path, command, sign
     assert sorted(os.listdir(tmp_path)) == files  # nothing written
 
 
-def test_validate_with_two_workers_ends_on_sigterm(flip_plan_file, tmp_path):
+@pytest.mark.parametrize("signum, status, word", [
+    (signal.SIGTERM, 143, "terminated"), (signal.SIGHUP, 129, "hung up"),
+    (signal.SIGINT, 130, "interrupted")])
+def test_validate_with_two_workers_ends_on_a_signal(flip_plan_file, tmp_path, signum, status,
+                                                    word):
     argv = ["validate", "--plan", flip_plan_file, "--trials", "20", "--workers", "2",
             "--no-progress", "--json", tmp_path / "v.json"]
-    code, err, took, survivors = _run_and_signal(argv, signal.SIGTERM, 4, tmp_path)
+    code, err, took, survivors = _run_and_signal(argv, signum, 4, tmp_path)
     lines = err.strip().splitlines()  # the run cache's line, then the farewell
-    assert code == 143 and lines[-1] == "flipkit: terminated" and len(lines) == 2, err
+    assert code == status and lines[-1] == f"flipkit: {word}" and len(lines) == 2, err
     assert "run the same command again to resume" in lines[0], err
     assert not survivors and took < 10
     assert os.listdir(tmp_path) == ["v.run-cache"]  # kept for the resume; no result file

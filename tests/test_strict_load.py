@@ -10,7 +10,7 @@ import pytest
 from flipkit.cli import main
 from flipkit.errors import PlanFileError
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.plans.segment import MAX_NODES
+from flipkit.planning.plans.json_fields import MAX_NODES
 
 
 def _swap_t(doc):

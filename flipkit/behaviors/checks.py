@@ -67,7 +67,7 @@ def table_spot(p: Probe):
     spot = None if p.seg.placing is None else np.asarray(p.seg.placing["spot"])
     try:
         if spot is not None:
-            return sv.check_table_spot(p.cell, spot)
+            return tg.check_table_spot(p.cell, spot)
     except FlipkitError:
         pass
     p.add("placing", [np.inf], p.seg.N, 1e-3)

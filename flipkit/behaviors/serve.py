@@ -68,27 +68,6 @@ from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy_matrix
 
 
-def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
-    """The table spot (x, y) (m) as an array, or :class:`UnreachableError` (one line).
-
-    The whole burger must lie on the table: the spot is at least a burger radius inside the
-    table's edges (:class:`~flipkit.config.TableConfig`)."""
-    try:
-        xy = np.asarray(spot, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}") from None
-    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
-        raise UnreachableError(f"table spot must be two finite numbers (m), got {spot!r}")
-    tb, r = cell.table, cell.burger.diameter / 2
-    lo = np.array([tb.x_range[0], tb.y_range[0]]) + r
-    hi = np.array([tb.x_range[1], tb.y_range[1]]) - r
-    if np.any(xy < lo - 1e-9) or np.any(xy > hi + 1e-9):
-        raise UnreachableError(
-            f"table spot ({xy[0]:.3f}, {xy[1]:.3f}) m is off the table: a burger there must lie "
-            f"on it, x in [{lo[0]:.3f}, {hi[0]:.3f}], y in [{lo[1]:.3f}, {hi[1]:.3f}] m")
-    return xy
-
-
 def heading(spot) -> float:
     """Heading ψ (rad) of the blade at the table: radially outward from the base, toward the spot."""
     return float(math.atan2(spot[1], spot[0]))

@@ -14,6 +14,7 @@ from flipkit.config import CellConfig
 from flipkit.config.task import (FLIP_CONE_FRACTION, FLIP_HEIGHT_BAND,  # noqa: F401
                                  FLIP_NORMAL_BOUNDS, FLIP_XAXIS_BOUNDS, PICKUP_OFFSET,
                                  PICKUP_PITCH, SCOOP_PITCH, SCOOP_PRESS, SCOOP_START_MARGIN)
+from flipkit.config.checks import real_vector
 from flipkit.errors import UnreachableError
 
 
@@ -37,11 +38,25 @@ def check_burger_height(cell: CellConfig, z: float, what: str = "burger location
                                f"{h:g} m (h_g; within +-{BURGER_HEIGHT_TOL:g} m accepted)")
 
 
+def check_table_spot(cell: CellConfig, spot) -> np.ndarray:
+    """The table spot (x, y) (m) as an array, or :class:`UnreachableError` (one line).
+
+    The whole burger must lie on the table: the spot is at least a burger radius inside the
+    table's edges (:class:`~flipkit.config.TableConfig`)."""
+    xy = real_vector("table spot", spot, 2, "m", UnreachableError)
+    tb, r = cell.table, cell.burger.diameter / 2
+    lo = np.array([tb.x_range[0], tb.y_range[0]]) + r
+    hi = np.array([tb.x_range[1], tb.y_range[1]]) - r
+    if np.any(xy < lo - 1e-9) or np.any(xy > hi + 1e-9):
+        raise UnreachableError(
+            f"table spot ({xy[0]:.3f}, {xy[1]:.3f}) m is off the table: a burger there must lie "
+            f"on it, x in [{lo[0]:.3f}, {hi[0]:.3f}], y in [{lo[1]:.3f}, {hi[1]:.3f}] m")
+    return xy
+
+
 def check_location(cell: CellConfig, location) -> np.ndarray:
     """The burger location as an array, or :class:`UnreachableError` if not on the grill."""
-    loc = np.asarray(location, dtype=float)
-    if loc.shape != (3,) or not np.all(np.isfinite(loc)):
-        raise UnreachableError(f"burger location must be three finite numbers (m), got {location!r}")
+    loc = real_vector("burger location", location, 3, "m", UnreachableError)
     g = cell.grill
     if not g.contains(loc[:2]):
         raise UnreachableError(
@@ -107,9 +122,7 @@ def pickup_end(cell: CellConfig, pb) -> Pose:
 
 def check_spot(cell: CellConfig, spot) -> np.ndarray:
     """A landing spot (x, y) (m) on the grill as an array, or :class:`UnreachableError`."""
-    xy = np.asarray(spot, dtype=float).ravel()
-    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
-        raise UnreachableError(f"landing spot must be two finite numbers (m), got {spot!r}")
+    xy = real_vector("landing spot", spot, 2, "m", UnreachableError)
     g = cell.grill
     if not g.contains(xy):
         raise UnreachableError(

@@ -12,7 +12,11 @@ Exit 0 written; 2 bad input or no location solved.
 
 from __future__ import annotations
 
-from flipkit.cli.common import deferred
+import argparse
+
+from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int, deferred
+from flipkit.fileio import check_output
+from flipkit.planning.planners.inputs import check_atlas_file
 
 
 def register(subparsers) -> None:
@@ -30,7 +34,26 @@ def register(subparsers) -> None:
     b.add_argument("--out", metavar="FILE.npz",
                    help="output, .npz (default: the package's atlas)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
-    b.set_defaults(run=deferred("atlas", "run_build"))
+    b.set_defaults(run=run_build)
     i = sub.add_parser("info", help="describe an atlas")
     i.add_argument("file", nargs="?", metavar="FILE", help="atlas (default: the package's)")
-    i.set_defaults(run=deferred("atlas", "run_info"))
+    i.set_defaults(run=run_info)
+
+
+def run_build(args: argparse.Namespace) -> int:
+    """Check the grid, the workers and a given output, then build
+    (:mod:`flipkit.cli.commands.atlas`)."""
+    for n in args.grid or ():
+        check_int("--grid", n, 1, MAX_GRID)
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    if args.out is not None:  # the package's own atlas is checked where it is known
+        check_output(args.out, "--out", (".npz",))
+    return deferred("atlas", "run_build")(args)
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """Check a given file is a readable ``.npz`` archive, then describe it."""
+    if args.file is not None:
+        check_atlas_file(args.file)
+    return deferred("atlas", "run_info")(args)

@@ -30,7 +30,6 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-MAX_TRIALS = 10_000  # trials per location of validate
 MAX_WORKERS = 256  # local worker processes
 MAX_GRID = 50  # points per axis of a grid over the grill (atlas build, compare-ik)
 

@@ -10,13 +10,23 @@ a start configuration of the wrong size or outside the joint limits, a table spo
 table, a malformed CSV) —
 one line on stderr, nothing written. A plan file is never written as ``"solved"`` unless it
 passed the check.
+
+The numbers, the burgers and the outputs are checked here (:mod:`flipkit.cli.plan_inputs`)
+before the planners are imported; the start configuration, against the arm's model, in
+:mod:`flipkit.cli.commands.plan`.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import deferred
+from flipkit.behaviors.targets import check_table_spot
+from flipkit.cli.common import MAX_WORKERS, check_int, deferred
+from flipkit.cli.plan_inputs import batch_locations, burger, numbers, r_land, yaw
+from flipkit.config import CellConfig
+from flipkit.errors import UnreachableError
+from flipkit.fileio import check_output, check_output_dir
+from flipkit.planning.planners.inputs import check_atlas_file
 from flipkit.solvers.names import SOLVERS
 
 DESCRIPTION = (
@@ -53,7 +63,7 @@ def register(subparsers) -> None:
                    help="goal position X Y Z (m)")
     t.add_argument("--yaw", default="0", metavar="RAD", help="spatula heading o_z (rad), any finite number: wrapped to (-pi, pi]")
     common(t)
-    t.set_defaults(run=deferred("plan", "run_translate"))
+    t.set_defaults(run=run_translate)
 
     f = sub.add_parser("flip", help="pick up and flip one burger (five chained segments)",
                        description="Go to burger, scoop, pickup, flip and turn back "
@@ -72,7 +82,7 @@ def register(subparsers) -> None:
                         "(default: the planner's R_LAND, which the package's atlas serves)")
     atlas_arguments(f)
     common(f)
-    f.set_defaults(run=deferred("plan", "run_flip"))
+    f.set_defaults(run=run_flip)
 
     s = sub.add_parser("serve", help="pick up one burger and put it on the side table",
                        description="Go to burger, scoop, pickup (eqs. 22-25), carry with the "
@@ -88,15 +98,16 @@ def register(subparsers) -> None:
                         "singularities and 0.2 rad from them")
     atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
-    s.set_defaults(run=deferred("plan", "run_serve"))
+    s.set_defaults(run=run_serve)
 
     b = sub.add_parser("batch", help="pick up and flip up to five burgers in a row",
                        description="Plan up to five burgers, each starting where the "
                                    "previous solved plan ended; write DIR/burger_<k>.json "
                                    "and DIR/summary.csv.")
     b.add_argument("--burgers", required=True, metavar="FILE.csv",
-                   help="CSV with header x,y,z (or px,py,pz), 1 to 5 rows, burgers one "
-                        "diameter apart; lines starting with # skipped")
+                   help="CSV with header x,y,z (or px,py,pz; in any order, no other "
+                        "column), 1 to 5 rows, burgers one diameter apart; lines starting "
+                        "with # skipped")
     b.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (burger_<k>.json, summary.csv; not holding an "
                         "input of those names)")
@@ -106,7 +117,7 @@ def register(subparsers) -> None:
     b.add_argument("--no-progress", action="store_true", help="no progress bar")
     atlas_arguments(b)
     common(b, json_out=False)
-    b.set_defaults(run=deferred("plan", "run_batch"))
+    b.set_defaults(run=run_batch)
 
 
 def atlas_arguments(parser: argparse.ArgumentParser, which: str = "") -> None:
@@ -115,3 +126,68 @@ def atlas_arguments(parser: argparse.ArgumentParser, which: str = "") -> None:
                         help=f"warm-start atlas (`flipkit atlas build`){which}; default: the "
                              "package's atlas when it serves these options, else cold starts")
     parser.add_argument("--no-atlas", action="store_true", help="cold starts (no atlas)")
+
+
+# The cheap checks of each behaviour, then its planning (flipkit.cli.commands.plan): a
+# refusal here never imports the planners.
+def _json_out(args: argparse.Namespace) -> None:
+    """``--json``: a writable ``.json`` file, not an input (the atlas)."""
+    check_output(args.json, "--json", (".json",), inputs=[getattr(args, "atlas", None)])
+
+
+def _atlas_file(args: argparse.Namespace) -> None:
+    """``--atlas FILE``, unless ``--no-atlas``: readable and an ``.npz`` archive (whether it
+    serves the plan's options is known once it is loaded)."""
+    if args.atlas and not args.no_atlas:
+        check_atlas_file(args.atlas)
+
+
+def _start_q(values):
+    """``--start-q``: six finite numbers, or ``None``; their limits and singularity sides
+    are checked with the arm's model."""
+    return None if values is None else numbers("--start-q", values, 6)
+
+
+def run_translate(args: argparse.Namespace) -> int:
+    """Check the output and the numbers, then plan."""
+    _json_out(args)
+    args.start, args.goal = numbers("--from", args.start, 3), numbers("--to", args.goal, 3)
+    args.yaw = yaw(args.yaw)
+    return deferred("plan", "run_translate")(args)
+
+
+def run_flip(args: argparse.Namespace) -> int:
+    """Check the output, the burger, the landing and the start's numbers, then plan."""
+    _json_out(args)
+    args.burger = burger(args.burger, CellConfig())
+    args.land = None if args.land is None else numbers("--land", args.land, 2)
+    args.r_land = None if args.r_land is None else r_land(args.r_land)
+    args.start_q = _start_q(args.start_q)
+    _atlas_file(args)
+    return deferred("plan", "run_flip")(args)
+
+
+def run_serve(args: argparse.Namespace) -> int:
+    """Check the output, the burger, the table spot and the start's numbers, then plan."""
+    _json_out(args)
+    cell = CellConfig()
+    args.burger = burger(args.burger, cell)
+    args.table_spot = numbers("--table-spot", args.table_spot, 2)
+    try:
+        check_table_spot(cell, args.table_spot)
+    except UnreachableError as exc:
+        raise UnreachableError(f"--table-spot: {exc}") from None
+    args.start_q = _start_q(args.start_q)
+    _atlas_file(args)
+    return deferred("plan", "run_serve")(args)
+
+
+def run_batch(args: argparse.Namespace) -> int:
+    """Check the workers, the CSV's burgers and the output directory, then plan."""
+    if args.workers is not None:
+        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    args.locations = batch_locations(args.burgers, CellConfig())
+    names = [*(f"burger_{k}.json" for k in range(1, len(args.locations) + 1)), "summary.csv"]
+    check_output_dir(args.out, "--out", inputs=[args.burgers, args.atlas], names=names)
+    _atlas_file(args)
+    return deferred("plan", "run_batch")(args)

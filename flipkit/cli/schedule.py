@@ -27,9 +27,13 @@ import argparse
 import importlib.util
 import os
 
+from pathlib import Path
+
 from flipkit.cli.common import MAX_WORKERS, check_float, check_int, deferred
+from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.fileio import check_output
+from flipkit.fileio import check_output, check_output_dir
+from flipkit.planning.kitchen.cook import read_cook_csv
 from flipkit.planning.kitchen.stream import check_stream
 from flipkit.planning.kitchen.table import DWELL_S, check_dwell
 from flipkit.planning.kitchen.windows import parse_windows
@@ -59,9 +63,9 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("schedule", help="schedule and plan the flips and serves of a "
                                                 "cook (one arm)", description=DESCRIPTION)
     p.add_argument("burgers", metavar="BURGERS.csv", nargs="?",
-                   help="cook order: header burger,t_drop,x,y (id, drop time s in [0, "
-                        "86400], grill position m); lines starting with # skipped; "
-                        "omitted with --stream")
+                   help="cook order: header burger,t_drop,x,y (in any order, no other "
+                        "column: id, drop time s in [0, 86400], grill position m); lines "
+                        "starting with # skipped; omitted with --stream")
     p.add_argument("--json", required=True, metavar="TIMELINE.json",
                    help="timeline output (.json; not the cook order)")
     p.add_argument("--figure", metavar="PATH", help="Gantt chart (.pdf, .png or .svg)")
@@ -127,8 +131,9 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the outputs and the options, then read, plan, write and report
-    (:mod:`flipkit.cli.commands.schedule`)."""
+    """Check the options and the outputs, read the cook order (``args.order``), then plan,
+    write and report (:mod:`flipkit.cli.commands.schedule`). Everything here runs before the
+    planners, MuJoCo and matplotlib are imported, so a refusal takes a fraction of a second."""
     if (args.burgers is None) == (args.stream is None):
         raise ConfigError("give a cook order BURGERS.csv or --stream RATE"
                           + (", not both" if args.burgers else ""))
@@ -171,4 +176,10 @@ def run(args: argparse.Namespace) -> int:
                           f"got {args.time_limit!r}")
     check_float("--time-limit", args.time_limit, 0.0, MAX_TIME_LIMIT_S, "s")
     check_int("--seed", args.seed, 0, 2**31 - 1)
+    args.order = read_cook_csv(args.burgers, CellConfig()) if args.burgers else None
+    if args.plans is None:  # TIMELINE_plans/ beside the timeline
+        args.plans = str(Path(args.json).with_name(Path(args.json).stem + "_plans"))
+    if args.burgers or args.plan:
+        check_output_dir(args.plans, "--plans", inputs=inputs + [args.json, args.figure,
+                                                                  args.film])
     return deferred("schedule")(args)

@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import argparse
 
-from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_TRIALS, MAX_WORKERS,
-                                add_sweep_arguments, check_float, check_int, deferred,
-                                precheck_plan)
+from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_WORKERS, add_sweep_arguments,
+                                check_float, check_int, deferred, precheck_plan)
 from flipkit.config.checks import whole
 from flipkit.config.physics import servo_lookahead
 from flipkit.errors import ConfigError
+from flipkit.experiments.perturbations import MAX_TRIALS
 from flipkit.fileio import check_output, check_output_dir
 from flipkit.solvers.names import SOLVERS
 

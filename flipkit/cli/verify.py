@@ -10,7 +10,9 @@ from __future__ import annotations
 import argparse
 
 from flipkit.cli.common import check_float, deferred, precheck_plan
-from flipkit.fileio import check_input, check_output
+from flipkit.config import CellConfig
+from flipkit.fileio import check_output
+from flipkit.planning.plans.cell_in_use import read_cell_file
 from flipkit.planning.plans.verify_report import TOL, TOL_RANGE
 
 
@@ -38,13 +40,12 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the options and the file cheaply, then verify (:mod:`flipkit.cli.commands.verify`);
-    0 pass, 1 fail."""
+    """Check the options, read the cell file (``args.cell_in_use``) and check the plan file
+    cheaply, then verify (:mod:`flipkit.cli.commands.verify`); 0 pass, 1 fail."""
     if args.json:
         check_output(args.json, "--json", (".json",), inputs=[args.plan])
     if args.tol is not None:
         check_float("--tol", args.tol, *TOL_RANGE, "(scaled units)")
-    if args.cell is not None:
-        check_input(args.cell, "--cell")
+    args.cell_in_use = read_cell_file(args.cell) if args.cell is not None else CellConfig()
     precheck_plan(args.plan)
     return deferred("verify")(args)

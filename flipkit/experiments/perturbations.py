@@ -58,9 +58,18 @@ class Perturbations:
         return {**out, "sense_dx_m": float(sx), "sense_dy_m": float(sy)}
 
 
+MAX_TRIALS = 10_000  # trials per location of a validation
+
+
 def check_seed(seed) -> int:
     """``seed`` as an int, or :class:`ConfigError` (one line): a non-negative integer."""
     return whole("seed", seed)
+
+
+def check_trials(trials) -> int:
+    """``trials`` (per location) as an int, or :class:`ConfigError` (one line): an integer in
+    [1, :data:`MAX_TRIALS`]."""
+    return whole("trials", trials, 1, MAX_TRIALS)
 
 
 def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
@@ -85,4 +94,4 @@ def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([check_seed(seed), trial, *where]))
 
 
-__all__ = ["Perturbations", "check_seed", "trial_rng"]
+__all__ = ["MAX_TRIALS", "Perturbations", "check_seed", "check_trials", "trial_rng"]

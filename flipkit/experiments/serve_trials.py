@@ -20,11 +20,10 @@ from pathlib import Path
 
 
 from flipkit.config import PhysicsConfig, known_physics
-from flipkit.config.checks import whole
 from flipkit.errors import ConfigError
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.ratios import success_intervals
-from flipkit.experiments.perturbations import Perturbations, trial_rng
+from flipkit.experiments.perturbations import Perturbations, check_trials, trial_rng
 from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
@@ -118,7 +117,7 @@ def validate_serve(path, trials: int, seed: int = 0, perturbations=Perturbations
     if plan.behavior != "serve" or plan.status != "solved":
         raise ConfigError(f"{path}: a {plan.status} {plan.behavior} plan; needs a solved serve plan")
     require_verified(plan, path, ("serve",))  # nothing unverified is simulated
-    whole("trials", trials, 1)
+    check_trials(trials)
     jobs = trial_jobs(Path(path).read_text(), int(trials), seed, perturbations, rate_hz, mode,
                       replan, servo_physics(servo_lookahead_s), command=command,
                       servo_form=servo_form)

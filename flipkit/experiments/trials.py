@@ -25,13 +25,13 @@ from flipkit.behaviors import targets as tg
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
                                       judge_flip, judge_pickup, judge_scoop, landing_target)
 from flipkit.config import CellConfig, known_physics, with_parameter
-from flipkit.config.checks import whole
-from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import location_label, plan_filename
 from flipkit.experiments.pauses import pause_summary
 from flipkit.experiments.ratios import success_intervals
-from flipkit.experiments.perturbations import Perturbations, check_seed, trial_rng
+from flipkit.experiments.perturbations import (Perturbations, check_seed, check_trials,
+                                              trial_rng)
 from flipkit.experiments.serve_trials import validate_serve
 from flipkit.experiments.slides import slide_summary
 from flipkit.experiments.sweep import run_sweep
@@ -285,7 +285,7 @@ def validate(targets, trials: int, seed: int = 0, perturbations: Perturbations =
     """
     if mode not in MODES:
         raise InvalidChoiceError("execution mode", mode, MODES)
-    whole("trials", trials, 1)
+    check_trials(trials)
     physics = servo_physics(servo_lookahead_s)
     jobs, owner = [], []
     for k, (_, _, text) in enumerate(targets):
@@ -327,6 +327,8 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
     """:func:`validate` of one plan file (a serve plan: :func:`~flipkit.experiments.serve_trials.validate_serve`);
     raises FlipkitError (one line) if it is missing, malformed, not a flip or serve plan, not
     solved or fails :func:`~flipkit.planning.plans.verify.verify_plan`. ``kwargs`` as :func:`validate`."""
+    check_trials(trials)
+    check_seed(seed)
     plan = Plan.load(path)
     if plan.behavior == "serve":  # the serve judge (flipkit.experiments.serve_trials)
         return validate_serve(path, trials, seed, **kwargs)
@@ -353,10 +355,13 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
     """
-    if solver not in SOLVERS:
+    if not isinstance(solver, str) or solver not in SOLVERS:
         raise InvalidChoiceError("solver", solver, SOLVERS)
-    whole("trials", trials, 1)
+    check_trials(trials)
     check_seed(seed)  # before any planning
+    if isinstance(locations, (str, bytes, dict)) or not hasattr(locations, "__iter__"):
+        raise ConfigError(f"locations: expected a sequence of burger locations (x, y, z) (m), "
+                          f"got {type(locations).__name__}")
     cell, locs = CellConfig(), []
     for k, loc in enumerate(locations, 1):
         try:

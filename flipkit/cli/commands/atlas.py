@@ -7,7 +7,6 @@ import argparse
 import sys
 
 from flipkit.behaviors.options import SegmentOptions
-from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int
 from flipkit.config import CellConfig
 from flipkit.experiments.atlas import DEFAULT_GRID, build_atlas
 from flipkit.fileio import check_output
@@ -16,11 +15,7 @@ from flipkit.planning.planners.atlas import Atlas, default_path, options_hash
 
 def run_build(args: argparse.Namespace) -> int:
     """Build, write, summarise."""
-    grid = tuple(args.grid) if args.grid else DEFAULT_GRID
-    for n in grid:
-        check_int("--grid", n, 1, MAX_GRID)
-    if args.workers is not None:
-        check_int("--workers", args.workers, 1, MAX_WORKERS)
+    grid = tuple(args.grid) if args.grid else DEFAULT_GRID  # a given one: flipkit.cli.atlas
     out = check_output(args.out or default_path(), "--out", (".npz",))
     atlas = build_atlas(grid=grid, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)

@@ -21,10 +21,10 @@ from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError
 from flipkit.experiments.sweep import make_executor
 from flipkit.figures.draw import plot_schedule
-from flipkit.fileio import check_output_dir, replace_with
+from flipkit.fileio import replace_with
 from flipkit.planning.kitchen import motions
 from flipkit.planning.kitchen.clearance import CookConflictError, clear_cook, cook_meetings
-from flipkit.planning.kitchen.cook import check_cook, read_cook_csv, table_spots
+from flipkit.planning.kitchen.cook import check_cook, table_spots
 from flipkit.planning.kitchen.durations import plan_model, representative_order
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
@@ -57,14 +57,9 @@ def run(args: argparse.Namespace) -> int:
     kinds = ("flip",) if args.flip_only else ("flip", "serve")
     stream = args.stream is not None
     burgers = (stream_order(args.stream, args.minutes, args.seed, cell, args.windows)
-               if stream else read_cook_csv(args.burgers, cell))
+               if stream else args.order)  # the cook order read by flipkit.cli.schedule
     atlas = None if args.no_atlas else default_atlas(cell)
-    timeline_path = Path(args.json)
-    plans = Path(args.plans) if args.plans else timeline_path.with_name(
-        timeline_path.stem + "_plans")
-    if not stream or args.plan:
-        check_output_dir(plans, "--plans", inputs=[p for p in (args.burgers,) if p]
-                         + [args.json, args.figure, getattr(args, "film", None)])
+    timeline_path, plans = Path(args.json), Path(args.plans)  # --plans checked there too
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     pool = make_executor(workers=workers) if workers > 1 else contextlib.nullcontext()
     with pool as executor:  # its workers end with the run, however it ends

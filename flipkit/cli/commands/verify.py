@@ -6,8 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from flipkit.config import CellConfig
-from flipkit.planning.plans.cell_in_use import CellMismatchError, read_cell_file
+from flipkit.planning.plans.cell_in_use import CellMismatchError
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify import TOL, verify_plan
 
@@ -15,11 +14,10 @@ from flipkit.planning.plans.verify import TOL, verify_plan
 def run(args: argparse.Namespace) -> int:
     """Verify in the cell in use (the defaults, or ``--cell``), print the table and the
     verdict; 0 pass, 1 fail (a plan for another cell included)."""
-    cell = read_cell_file(args.cell) if args.cell else CellConfig()
     plan = Plan.load(args.plan)
     try:
-        report = verify_plan(plan, tol=TOL if args.tol is None else args.tol, cell=cell,
-                             where=args.plan)
+        report = verify_plan(plan, tol=TOL if args.tol is None else args.tol,
+                             cell=args.cell_in_use, where=args.plan)
     except CellMismatchError as exc:
         print(f"flipkit: error: {exc}", file=sys.stderr)
         return 1

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from flipkit.config import CellConfig
+from flipkit.csv_header import header_columns
 from flipkit.decimal_text import decimal
 from flipkit.errors import ConfigError
 from flipkit.fileio import InputFileError, data_lines, read_text
@@ -125,16 +126,18 @@ def check_cook(burgers, cell: CellConfig | None = None, where: str = "cook order
 
 def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
     """Read a cook order CSV (UTF-8, with or without a byte-order mark): header
-    ``burger,t_drop,x,y`` (in that order), one row per burger; blank lines and lines starting
-    with ``#`` are skipped.
+    ``burger,t_drop,x,y`` (in any order; no other column,
+    :func:`~flipkit.csv_header.header_columns`), one row per burger; blank lines and lines
+    starting with ``#`` are skipped.
 
     Returns:
         The burgers sorted by drop time (:func:`check_cook`).
 
     Raises:
-        CookOrderError: Unreadable file, wrong header, a row with the wrong number of
-            values, a non-numeric or non-finite number, and everything :func:`check_cook`
-            refuses — one line naming the file (and the line).
+        CookOrderError: Unreadable file, a header with an unknown, missing or repeated
+            column, a row with the wrong number of values, a non-numeric or non-finite
+            number, and everything :func:`check_cook` refuses — one line naming the file
+            (and the line).
     """
     try:
         text = read_text(path, "cook order", 2**20)
@@ -145,12 +148,7 @@ def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
     if not lines:
         raise CookOrderError(f"{path}: empty; expected the header {','.join(CSV_HEADER)}")
     n0, first = lines[0]
-    header = tuple(h.strip().lower() for h in next(csv.reader([first])))
-    if header != CSV_HEADER:
-        missing = [c for c in CSV_HEADER if c not in header]
-        why = f"missing column {missing[0]!r}" if missing else f"got {','.join(header)}"
-        raise CookOrderError(f"{path}: line {n0}: header must be {','.join(CSV_HEADER)}; "
-                             f"{why}")
+    col = header_columns(first, (CSV_HEADER,), f"{path}: line {n0}", CookOrderError)
     burgers = []
     for n, line in lines[1:]:
         cells = [c.strip() for c in next(csv.reader([line]))]
@@ -158,11 +156,11 @@ def read_cook_csv(path, cell: CellConfig | None = None) -> list[CookBurger]:
             raise CookOrderError(f"{path}: line {n}: expected {len(CSV_HEADER)} values "
                                  f"(burger,t_drop,x,y), got {len(cells)}")
         try:
-            t_drop, x, y = (decimal(c) for c in cells[1:])
+            t_drop, x, y = (decimal(cells[col[c]]) for c in CSV_HEADER[1:])
         except ValueError:
             raise CookOrderError(f"{path}: line {n}: t_drop, x and y must be decimal numbers, got "
-                                 f"{','.join(cells[1:])}") from None
-        burgers.append(CookBurger(cells[0], t_drop, x, y))
+                                 f"{','.join(cells[col[c]] for c in CSV_HEADER[1:])}") from None
+        burgers.append(CookBurger(cells[col["burger"]], t_drop, x, y))
     return check_cook(burgers, cell, where=str(path))
 
 

@@ -33,9 +33,9 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.config.physics import SIMULATION_ONLY
 from flipkit.errors import AtlasError
-from flipkit.fileio import InputFileError, check_input
 from flipkit.fileio import replace_with
 from flipkit.jsonread import strict_loads
+from flipkit.planning.planners.inputs import check_atlas_file
 from flipkit.transcription.guess import fit_guess
 
 FORMAT = "flipkit-atlas/1"
@@ -131,16 +131,7 @@ class Atlas:
         Raises:
             AtlasError: Unreadable, not an atlas, or stale (other options or cell).
         """
-        try:
-            check_input(path, "atlas")
-            with open(path, "rb") as fh:
-                magic = fh.read(4)
-        except (InputFileError, OSError) as exc:
-            raise AtlasError(f"cannot read atlas {path}: "
-                             f"{str(exc).split(': ', 1)[-1]}") from None
-        if magic != b"PK\x03\x04":  # every .npz is a zip archive
-            raise AtlasError(f"cannot read atlas {path}: not an .npz archive; give a file "
-                             "written by `flipkit atlas build`, or --no-atlas")
+        check_atlas_file(path)
         try:
             with np.load(Path(path), allow_pickle=False) as data:
                 header = strict_loads(str(data["header"]))
@@ -223,7 +214,10 @@ class Atlas:
 
 def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
     """Raise :class:`~flipkit.errors.AtlasError` if ``atlas`` (or ``None``) was built for
-    other planning options or another cell."""
+    other planning options or another cell, or is not an :class:`Atlas`."""
+    if atlas is not None and not isinstance(atlas, Atlas):
+        raise AtlasError(f"atlas: expected an Atlas (Atlas.load(path)) or None, got "
+                         f"{type(atlas).__name__}")
     if atlas is not None and atlas.meta.get("options_hash") != options_hash(cell, options):
         raise AtlasError("stale atlas: built for other planning options or another cell; "
                          "rebuild it with `flipkit atlas build`")

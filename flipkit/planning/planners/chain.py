@@ -17,7 +17,8 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Behavior, Task
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
-from flipkit.errors import AtlasError, FlipkitError, InvalidChoiceError, SolverError
+from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoiceError,
+                            SolverError)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.segment import Segment
 from flipkit.planning.plans.verify import verify_plan
@@ -188,8 +189,12 @@ class Planner:
 
     def __init__(self, cell: CellConfig | None = None, *, solver: str = "auto",
                  options: SegmentOptions = SegmentOptions(), workspace=None):
-        if solver not in SOLVERS:
+        if not isinstance(solver, str) or solver not in SOLVERS:
             raise InvalidChoiceError("solver", solver, SOLVERS)
+        if cell is not None and not isinstance(cell, CellConfig):
+            raise ConfigError(f"cell: expected a CellConfig, got {type(cell).__name__}")
+        if not isinstance(options, SegmentOptions):
+            raise ConfigError(f"options: expected SegmentOptions, got {type(options).__name__}")
         self.cell = cell or CellConfig()
         self.solver, self.options = solver, options
         self.models = models_for(self.cell)

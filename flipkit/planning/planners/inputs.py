@@ -9,19 +9,18 @@ import math
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.errors import ConfigError, UnreachableError
+from flipkit.config.checks import real_number, real_vector
+from flipkit.errors import AtlasError, ConfigError, UnreachableError, brief
+from flipkit.fileio import InputFileError, check_input
 from flipkit.model.singular import (ELBOW, SINGULARITY_MARGIN, WRIST, branch_band,
                                     branch_violation)
+
+MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 
 
 def check_position(what: str, value, cell: CellConfig) -> np.ndarray:
     """``value`` as a finite 3-vector (m) inside the task-space box of ``cell``."""
-    try:
-        p = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{what} must be three numbers (m), got {value!r}") from None
-    if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ConfigError(f"{what} must be three finite numbers (m), got {np.ravel(p).tolist()}")
+    p = real_vector(what, value, 3, "m")
     lo, hi = np.asarray(cell.limits.p_min), np.asarray(cell.limits.p_max)
     if np.any(p < lo) or np.any(p > hi):
         box = ", ".join(f"{a} in [{lo[k]:g}, {hi[k]:g}]" for k, a in enumerate("xyz"))
@@ -33,9 +32,12 @@ def check_position(what: str, value, cell: CellConfig) -> np.ndarray:
 def check_joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
     """``value`` as a finite joint vector of len(lo) within [lo, hi]."""
     try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{what} must be {len(lo)} numbers ({unit}), got {value!r}") from None
+        v = np.asarray(value)
+    except (TypeError, ValueError):  # a ragged sequence
+        v = np.asarray(None)
+    if v.dtype.kind not in "iuf":  # text, booleans, complex numbers, objects
+        raise ConfigError(f"{what} must be {len(lo)} numbers ({unit}), got {brief(value)}")
+    v = v.astype(float)
     if v.shape != np.shape(lo):
         raise ConfigError(f"{what} must have {len(lo)} values ({unit}), got {v.size}")
     if not np.all(np.isfinite(v)):
@@ -46,6 +48,25 @@ def check_joint_vector(what: str, value, lo, hi, unit: str) -> np.ndarray:
         raise ConfigError(f"{what}: joint {j + 1} = {v[j]:.4g} {unit} is outside its limits "
                           f"[{lo[j]:.4g}, {hi[j]:.4g}] {unit}")
     return v
+
+
+def check_atlas_file(path) -> None:
+    """Refuse an atlas file that cannot be read or is not an ``.npz`` archive (a zip), before
+    its arrays are loaded (:meth:`flipkit.planning.planners.atlas.Atlas.load`).
+
+    Raises:
+        AtlasError: One line naming the file and what to give instead.
+    """
+    try:
+        check_input(path, "atlas")
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+    except (InputFileError, OSError) as exc:
+        raise AtlasError(f"cannot read atlas {path}: "
+                         f"{str(exc).split(': ', 1)[-1]}") from None
+    if magic != b"PK\x03\x04":  # every .npz is a zip archive
+        raise AtlasError(f"cannot read atlas {path}: not an .npz archive; give a file "
+                         "written by `flipkit atlas build`, or --no-atlas")
 
 
 def check_spacing(locations, diameter: float, where: str) -> None:
@@ -101,12 +122,11 @@ def check_start(robot, q_start=None, qd_start=None, *, what: str = "start config
 
 def check_on_blade(on_blade, cell: CellConfig) -> np.ndarray:
     """(x, y) (m) of the burger's centre in the blade frame, on the blade, or ConfigError."""
-    xy = np.asarray(on_blade, dtype=float).ravel()
+    xy = real_vector("burger position on the blade", on_blade, 2, "m")
     sp = cell.spatula
-    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or abs(xy[0]) > sp.length / 2 or abs(
-            xy[1]) > sp.width / 2:
+    if abs(xy[0]) > sp.length / 2 or abs(xy[1]) > sp.width / 2:
         raise ConfigError(f"burger position on the blade must be (x, y) within ±{sp.length / 2}"
-                          f", ±{sp.width / 2} m, got {on_blade!r}")
+                          f", ±{sp.width / 2} m, got {xy.tolist()}")
     return xy
 
 
@@ -115,11 +135,8 @@ def check_approach_height(height) -> float | None:
     (:attr:`~flipkit.behaviors.spec.Task.approach_height`); ConfigError otherwise."""
     if height is None:
         return None
-    try:
-        h = float(height)
-    except (TypeError, ValueError):
-        h = math.nan
-    if not (math.isfinite(h) and h >= 0):
+    h = real_number("approach_height", height, "m")
+    if h < 0:
         raise ConfigError(f"approach_height must be a finite height >= 0 m, got {height!r}")
     return h
 

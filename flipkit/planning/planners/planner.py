@@ -33,18 +33,18 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Task
 from flipkit.behaviors.transcribe import flat_pose
 from flipkit.config import CellConfig, SensingUncertainty
+from flipkit.config.checks import real_number
 from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import (check_approach_height, check_joint_vector,
-                                              check_on_blade, check_position,
-                                              check_replan, check_start)
+from flipkit.planning.planners.inputs import (MAX_BATCH, check_approach_height,
+                                              check_joint_vector, check_on_blade,
+                                              check_position, check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.verify_flight import LANDING_TOL, TILT_MIN_DEG, recompute_landing
 
-MAX_BATCH = 5  # burgers per batch (paper Sec. I: 4–5 burgers within 90 s)
 REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration ends at it
 
 
@@ -75,8 +75,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
     planner = Planner(cell, solver=solver, options=options)
     cell, robot = planner.cell, planner.models.loaded
     p_goal = check_position("translate goal", goal, cell)
-    if not np.isfinite(yaw):
-        raise ConfigError(f"yaw must be finite (rad), got {yaw!r}")
+    yaw = real_number("yaw", yaw, "rad")
     if q_start is None:
         if start is None:
             raise ConfigError("translate needs a start position or a start configuration")

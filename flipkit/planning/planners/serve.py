@@ -40,7 +40,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     Args:
         burger: Burger location p^b (m) on the grill (:func:`~flipkit.behaviors.targets.check_location`).
         table_spot: Where the burger's centre should come to rest on the table (x, y) (m);
-            the whole burger must lie on the table (:func:`~flipkit.behaviors.serve.check_table_spot`).
+            the whole burger must lie on the table (:func:`~flipkit.behaviors.targets.check_table_spot`).
         q_start: Start configuration (rad), default q_home — e.g. where the previous motion
             of a schedule ended. qd_start: Start joint velocities (rad/s), default rest.
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
@@ -74,7 +74,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     cell, models = planner.cell, planner.models
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, burger)
-    spot = sv.check_table_spot(cell, table_spot)
+    spot = tg.check_table_spot(cell, table_spot)
     on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
     q, qd = check_start(models.bare, q_start, qd_start)
     at = (0.0, 0.0) if on_blade is None else on_blade  # the reach check before the scoop

@@ -26,6 +26,32 @@ def check_array(name: str, value, shape: tuple) -> np.ndarray:
     return arr
 
 
+# Nodes per segment read: the planners use 21 (N = 20), the scaling study up to 81; verify
+# takes about 0.25 ms a node, so a file cannot make it run for minutes.
+MAX_NODES = 1001
+
+
+def check_times(name: str, value) -> np.ndarray:
+    """A segment's node times ``t`` (s): N+1 of them, N even in [2, MAX_NODES − 1], finite
+    and strictly increasing.
+
+    Raises:
+        ConfigError: One line naming ``name`` and, for a grid that does not increase, the
+            first pair of node times out of order.
+    """
+    t = check_array(name, value, (None,))
+    n = t.size
+    if n < 3 or n % 2 == 0 or n > MAX_NODES:
+        raise ConfigError(f"{name}: expected N+1 node times with N even in [2, "
+                          f"{MAX_NODES - 1}], got {n}")
+    steps = np.diff(t)
+    if not np.all(steps > 0):
+        i = int(np.argmax(steps <= 0))
+        raise ConfigError(f"{name}: node times must increase strictly, got t[{i}] = "
+                          f"{t[i]:.9g} s, t[{i + 1}] = {t[i + 1]:.9g} s")
+    return t
+
+
 def check_number(name: str, value, positive: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
         raise ConfigError(f"{name}: expected a number, got {value!r}")

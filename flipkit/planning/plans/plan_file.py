@@ -38,7 +38,7 @@ from flipkit.planning.plans.cell_record import cell_geometry, geometry_configs
 from flipkit.provenance import git_commit
 from flipkit.config.urdf import check_urdf_text, portable_urdf, resolve_urdf, urdf_sha256
 
-from flipkit.planning.plans.plan_doc import FORMAT, FORMATS, read_plan_doc  # noqa: E402
+from flipkit.planning.plans.plan_doc import FORMAT, FORMATS, plan_path, read_plan_doc  # noqa: E402
 from flipkit.model.robot import Robot
 PLAN_STATUSES = ("solved", "failed")
 PAYLOAD_RTOL = 1e-9  # relative agreement of the recorded payload with the rebuilt model
@@ -418,10 +418,11 @@ class Plan:
         too: each segment then carries the bodies its behaviour carries (the spec's ``carries_burger``).
 
         Raises:
-            PlanFileError: Missing or unreadable file, not JSON, or not ``flipkit-plan/1``
-                (the one-line message names the file and the offending key).
+            PlanFileError: Not a path, missing or unreadable file, not JSON, or not
+                ``flipkit-plan/1`` or ``/2`` (the one-line message names the file and the
+                offending key).
         """
-        path = Path(path)
+        path = plan_path(path)
         doc = read_plan_doc(path)  # file, JSON, format, top-level keys: before any schema
         try:
             keys = ("behavior", "status", "robot", "gravity", "grill_height", "spatula", "burger",
