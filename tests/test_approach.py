@@ -5,7 +5,7 @@ and checked by verify."""
 import numpy as np
 import pytest
 
-import flipkit.planning.plans.verify as verify_module
+import flipkit.behaviors.checks as checks_module
 from flipkit.behaviors import approach as ap
 from flipkit.behaviors import targets as tg
 from flipkit.config import PHYSICAL_RANGES
@@ -73,7 +73,7 @@ def test_verify_checks_the_approach(flip_plan, cell, monkeypatch):
         rim, start = real(c, pb)
         return rim - 0.02, start
 
-    monkeypatch.setattr(verify_module, "approach_limits", farther)
+    monkeypatch.setattr(checks_module, "approach_limits", farther)  # the spec's check
     report = verify_plan(flip_plan)
     group = report.groups["behavior_path"]
     assert not group.ok and flip_plan.segments[group.segment].name == "go_to_burger"
