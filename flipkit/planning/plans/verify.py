@@ -99,6 +99,7 @@ from flipkit.model.contact import make_cone, specific_force
 from flipkit.errors import ConfigError
 from flipkit.transcription.layout import Layout
 from flipkit.model.orientation import rpy
+from flipkit.model.robot import BLADE_CORNERS
 from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.config import CellConfig
 from flipkit.planning.plans.cell_in_use import check_record, checked_cell
@@ -108,7 +109,6 @@ from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
 from flipkit.planning.plans.verify_flight import check_flight
 from flipkit.planning.plans.verify_safety import check_safety
 # the report's types, importable from here as before
-from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
 from flipkit.planning.plans.verify_report import (GROUPS, TOL, TOL_RANGE,  # noqa: F401
                                                   GroupResult, VerificationReport)
 from flipkit.errors import VerificationError
