@@ -147,7 +147,8 @@ def test_kinematic_block_over_nodes_jacobian(flip_nlp, cell, quantity):
     """Every quantity evaluated over a batch of nodes (not contiguous) against central
     differences, through the NLP's Evaluation that computes the blade points with the
     centre."""
-    from flipkit.transcription.constraints.kinematic import Cone, KinematicBlock
+    from flipkit.transcription.constraints.kinematic import KinematicBlock
+    from flipkit.transcription.constraints.quantities import Cone
 
     if quantity.startswith(("cone", "paper")):
         form = "paper" if quantity.startswith("paper") else "physical"
@@ -162,7 +163,8 @@ def test_kinematic_block_over_nodes_jacobian(flip_nlp, cell, quantity):
 def test_node_by_node_quantity_matches_its_batch(flip_nlp, cell):
     """A quantity without broadcasting is applied node by node: the same rows as the built-in
     one it wraps."""
-    from flipkit.transcription.constraints.kinematic import BladeCornerHeights, KinematicBlock
+    from flipkit.transcription.constraints.kinematic import KinematicBlock
+    from flipkit.transcription.constraints.quantities import BladeCornerHeights
     from flipkit.transcription.layout import Evaluation
 
     class PerNode(BladeCornerHeights):
@@ -181,7 +183,7 @@ def test_the_corner_heights_are_the_lowest_points_of_the_rolled_blade(flip_nlp, 
     """The grill_clearance rows hold the whole blade: at random joint states their smallest
     value is the lowest point of a dense grid over the blade rectangle, which an edge's
     midpoint misses once the blade rolls."""
-    from flipkit.transcription.constraints.kinematic import BladeCornerHeights
+    from flipkit.transcription.constraints.quantities import BladeCornerHeights
     from flipkit.transcription.layout import Evaluation
 
     ctx = {"length": cell.spatula.length, "width": cell.spatula.width}

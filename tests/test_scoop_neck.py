@@ -13,7 +13,7 @@ from flipkit.behaviors.transcribe import blade_floor
 from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.verify import verify_plan
-from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+from flipkit.model.robot import BLADE_CORNERS
 
 PRESSED = ("go_to_burger", "scoop", "pickup")
 

@@ -107,7 +107,7 @@ def test_coasting_floor_rows_are_the_corner_heights_ahead_with_their_jacobian(mo
     """Four rows, the blade's corner heights at q_N + τ q̇_N (computed here from the spatula's
     placement), with a Jacobian on q_N and q̇_N that matches central differences."""
     from flipkit.transcription.constraints.coasting_floor import CoastingFloor
-    from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+    from flipkit.model.robot import BLADE_CORNERS
 
     L, robot, cell = Layout(6, 20), models.bare, models.cell
     rng = np.random.default_rng(5)
@@ -159,7 +159,7 @@ def test_a_cook_flip_at_the_grill_corner_turns_back():
     from flipkit.config import CellConfig
     from flipkit.planning.kitchen.sweep import approach_height
     from flipkit.planning.planners.planner import plan_flip
-    from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+    from flipkit.model.robot import BLADE_CORNERS
 
     cell = CellConfig()
     plan = plan_flip(GRILL_CORNER, solver="sqp", approach_height=approach_height(cell))

@@ -23,7 +23,7 @@ from flipkit.behaviors.spec import Behavior, Subbehavior
 from flipkit.config import CellConfig
 from flipkit.model.contact import make_cone
 from flipkit.transcription.constraints import KinematicBlock
-from flipkit.transcription.constraints.kinematic import Cone
+from flipkit.transcription.constraints.quantities import Cone
 from flipkit.transcription.constraints.flight import FlightClearance, Landing, ScenarioLanding
 
 

@@ -31,7 +31,7 @@ from flipkit.transcription.constraints import KinematicBlock
 
 def pressed_floor(cell: CellConfig, N: int) -> np.ndarray:
     """The floor of the blade's corners (m), (N + 1) × 4 in the order of
-    :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS` (tip left, tip right,
+    :data:`~flipkit.model.robot.BLADE_CORNERS` (tip left, tip right,
     back left, back right): the tip's corners may be pressed SCOOP_PRESS into the grill (less
     the tip's band), where the blade flexes; the back corners, at the blade's neck, never go
     below the grill's surface (a blade flexes from its neck, not at it)."""

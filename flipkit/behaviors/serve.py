@@ -63,7 +63,8 @@ from flipkit.config.task import (BURGER_CLEARANCE, CARRY_CLEARANCE, PIVOT_BAND, 
 from flipkit.errors import UnreachableError
 from flipkit.model.orientation import rpy
 from flipkit.model.robot import skew
-from flipkit.transcription.constraints.kinematic import KinematicBlock, Quantity
+from flipkit.transcription.constraints.kinematic import KinematicBlock
+from flipkit.transcription.constraints.quantities import Quantity
 from flipkit.model.ik import solve_pose
 from flipkit.model.orientation import rpy_matrix
 
@@ -128,6 +129,8 @@ def withdrawn_floor(cell: CellConfig, N: int) -> np.ndarray:
 class TipPoint(Quantity):
     """World position (m) of the blade tip p + R (l/2, 0, 0) and its ∂/∂q = ∂p/∂q − [R r]× J_ω."""
 
+    no_symbolic_form = "no SX form is stated: the place, which applies it, is solved by the SQP"
+
     def __call__(self, st, ctx):
         r = st.R @ np.array([ctx["length"] / 2, 0.0, 0.0])
         return st.p + r, st.dp_dq - skew(r) @ st.Jw
@@ -147,6 +150,9 @@ def pivot_nodes(N: int) -> list[int]:
 
 class InStartFrame(Quantity):
     """Blade-centre position in a fixed frame (R0, p0): R0ᵀ (p − p0) (m), ∂/∂q = R0ᵀ ∂p/∂q."""
+
+    no_symbolic_form = ("no SX form is stated: return home, which applies it, is solved by "
+                        "the SQP")
 
     def __init__(self, R0, p0):
         self.R0, self.p0 = np.asarray(R0, float), np.asarray(p0, float)

@@ -108,7 +108,7 @@ def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
 
 def tip_pressed(cell: CellConfig, tip_floor: float) -> np.ndarray:
     """The floors (m) of the blade's four corners (tip left, tip right, back left, back
-    right: :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS`) when the tip
+    right: :data:`~flipkit.model.robot.BLADE_CORNERS`) when the tip
     may go down to ``tip_floor``: the back corners, at the neck the blade flexes from, stay
     on the grill's surface."""
     hg = cell.grill.height

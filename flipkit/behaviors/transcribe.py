@@ -29,7 +29,7 @@ from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.clearance import ArmClearance, CoastingClearance
 from flipkit.transcription.constraints.coasting_floor import CoastingFloor
 from flipkit.transcription.constraints.interpolant import InterpolantLimits
-from flipkit.transcription.constraints.kinematic import Cone
+from flipkit.transcription.constraints.quantities import Cone
 from flipkit.transcription.layout import Layout
 from flipkit.transcription.nlp import NLP
 
@@ -93,7 +93,7 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
 
 def blade_floor(spec: Subbehavior | str, cell, N: int, task=None) -> np.ndarray:
     """Lowest height (m) of the blade's four corners at nodes 0..N, (N + 1) × 4 in the order
-    of :data:`~flipkit.transcription.constraints.kinematic.BLADE_CORNERS`: the spec's floor
+    of :data:`~flipkit.model.robot.BLADE_CORNERS`: the spec's floor
     (per node, or per node and corner), the grill's surface by default; on an approach
     (``spec.approach``) at least ``task.approach_height`` above the grill until its descent
     (:func:`~flipkit.behaviors.approach.descent_node`) when the task sets one."""

@@ -18,6 +18,8 @@ from flipkit.config.urdf import default_urdf
 from flipkit.errors import ConfigError
 
 SPATULA_FRAME = "spatula"
+# the blade's corners (±l/2, ±w/2) as signs (a, b): tip left, tip right, heel left, heel right
+BLADE_CORNERS = ((1, 1), (1, -1), (-1, 1), (-1, -1))
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 

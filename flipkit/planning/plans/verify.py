@@ -7,8 +7,12 @@ bodies it lists), targets from :mod:`flipkit.behaviors.targets`, and from
 :mod:`flipkit.behaviors` the segment's spec: its duration bounds, floor (``blade_floor``),
 exempt shape pairs and end condition, its ``end_pose`` and ``cone`` hooks asked on the plan's
 record (:class:`~flipkit.behaviors.probe.Probe`), its own independent ``checks``
-(:mod:`flipkit.behaviors.checks`) and its ``records``; no segment is named here. Check groups
-(a row's violation is ≥ 0, 0 when satisfied):
+(:mod:`flipkit.behaviors.checks`) and its ``records``; no segment is named here. Each
+segment goes through every independent check of
+:data:`~flipkit.planning.plans.verify_checks.CHECKS`, the table that also answers, for each
+constraint block, the groups its ``check`` names
+(:mod:`flipkit.transcription.constraints.registry`). Check groups (a row's violation is ≥ 0,
+0 when satisfied):
 
 =================  ==========================================================  ==============
 group              what                                                        tolerance
@@ -89,40 +93,18 @@ from dataclasses import replace
 
 import numpy as np
 
-
 from flipkit.behaviors.library import BEHAVIORS, SUBBEHAVIORS
-from flipkit.behaviors.options import T_STRETCH
-from flipkit.behaviors.probe import Probe, RecordedOptions, angle, outside
+from flipkit.behaviors.probe import Probe, RecordedOptions
 from flipkit.behaviors.spec import Task
-from flipkit.behaviors.transcribe import blade_floor
-from flipkit.model.contact import make_cone, specific_force
-from flipkit.errors import ConfigError
-from flipkit.transcription.layout import Layout
-from flipkit.model.orientation import rpy
-from flipkit.model.singular import SINGULARITY_MARGIN, branch_violation
 from flipkit.config import CellConfig
+from flipkit.errors import ConfigError, VerificationError
 from flipkit.planning.plans.cell_in_use import check_record, checked_cell
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.planning.plans.hermite import hermite_extremes
-from flipkit.planning.plans.verify_clearance import CellGeometry, check_space
-from flipkit.planning.plans.verify_flight import check_flight
-from flipkit.planning.plans.verify_safety import check_safety
-# the report's types, importable from here as before
-from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
-from flipkit.planning.plans.verify_report import (GROUPS, TOL, TOL_RANGE,  # noqa: F401
-                                                  GroupResult, VerificationReport)
-from flipkit.errors import VerificationError
-
-TIME_TOL = 1e-9  # s, node times against i T / N
-INTERPOLANT_TOL = (100.0, 1000.0)  # × tol: the solver's row scales 0.01 (q̇) and 0.001 (q̈)
-def _point(st, r_local) -> np.ndarray:
-    """World position (m) of the blade point at r_local in the spatula frame."""
-    return st.p + st.R @ np.asarray(r_local, float)
-
-
-def _point_height(st, r_local) -> float:
-    """World height (m) of the blade point at r_local in the spatula frame."""
-    return float(_point(st, r_local)[2])
+from flipkit.planning.plans.verify_checks import CHECKS, INTERPOLANT_TOL, SegmentView
+from flipkit.planning.plans.verify_clearance import CellGeometry
+from flipkit.planning.plans.verify_report import (GROUPS, TOL, TOL_RANGE, GroupResult,
+                                                  VerificationReport)
+from flipkit.transcription.layout import Layout
 
 
 def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
@@ -170,14 +152,9 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
         if bodies not in robots:
             robots[bodies] = plan.robot_for(seg, cell)
         geometry = geometry or CellGeometry(robots[bodies], cell)
-        _check_segment(report, k, seg, robots[bodies], plan, cell, tol)
-        geometry.robot = robots[bodies]
-        check_space(report, k, seg, robots[bodies], cell, geometry, tol)
-        check_safety(report, k, seg, robots[bodies], tol)
-        if k:
-            prev = plan.segments[k - 1]
-            jump = np.abs(np.concatenate([prev.q[-1] - seg.q[0], prev.qd[-1] - seg.qd[0]]))
-            report.add("continuity", k, jump, tol, 0)
+        view = _view(report, k, seg, robots[bodies], plan, cell, tol, geometry)
+        for check in CHECKS:  # every independent check, in order (verify_checks)
+            check.run(view)
     return report
 
 
@@ -194,89 +171,16 @@ def check_arguments(plan, tol, cell) -> None:
         raise ConfigError(f"cell: expected a CellConfig, got {type(cell).__name__}")
 
 
-def _check_segment(report, k, seg, robot, plan, cell, tol) -> None:
-    """Time grid, dynamics, limits, defects, clearance, cone and behaviour of segment k."""
-    N, T, add = seg.N, seg.T, report.add
-    add("time_grid", k, np.abs(seg.t - np.linspace(0.0, T, N + 1)), TIME_TOL)
-    T_lo, T_hi = SUBBEHAVIORS[seg.name].duration
-    qdd_max = robot.qdd_bound(SUBBEHAVIORS[seg.name].free_motion)
-    add("time_grid", k, outside(T, T_lo, T_STRETCH * T_hi), tol)
-    dyn_tol = tol * robot.u_max / 10
-    tau = np.array([robot.inverse_dynamics(seg.q[i], seg.qd[i], seg.qdd[i])
-                    for i in range(N + 1)])
-    report.add_nodes("dynamics", k, np.abs(tau - seg.u), dyn_tol)
-    for group, x, lo, hi, scale in (
-            ("q_limits", seg.q, robot.q_min, robot.q_max, 1.0),
-            ("qd_limits", seg.qd, -robot.qd_max, robot.qd_max, 1.0),
-            ("qdd_limits", seg.qdd, -qdd_max, qdd_max, 10.0),
-            ("u_limits", seg.u, -robot.u_max, robot.u_max, robot.u_max / 10)):
-        report.add_nodes(group, k, outside(np.asarray(x), lo, hi), tol * scale)
-    _check_interpolant(report, k, seg, robot, qdd_max, tol)
-    report.add_nodes("singularity", k, branch_violation(seg.q, plan.robot["q_home"],
-                                                        SINGULARITY_MARGIN), tol)
-    mid = np.arange(1, N, 2)  # Hermite–Simpson midpoints; a = i − 1, b = i + 1
-    dt = (seg.t[mid + 1] - seg.t[mid - 1])[:, None]
-    rows = []
-    for x, xd in ((np.asarray(seg.q), np.asarray(seg.qd)), (np.asarray(seg.qd), np.asarray(seg.qdd))):
-        xa, xi, xb, da, di, db = x[mid - 1], x[mid], x[mid + 1], xd[mid - 1], xd[mid], xd[mid + 1]
-        rows += [xi - (xa + xb) / 2 - dt * (da - db) / 8, xb - xa - dt * (da + 4 * di + db) / 6]
-    report.add_nodes("defects", k, np.abs(np.concatenate(rows, axis=1)), tol, mid)
-
+def _view(report, k, seg, robot, plan, cell, tol, geometry) -> SegmentView:
+    """Segment k as the checks see it: the blade's states at the nodes (at its centre and at
+    the burger's recorded place) and the spec's :class:`~flipkit.behaviors.probe.Probe`."""
     on_blade = (seg.landing or seg.placing or {}).get(
         "burger_on_blade" if seg.landing else "on_blade", (0.0, 0.0))
     under_burger = [(*on_blade, 0.0)] if np.any(on_blade) else []
     centre, at_burger = robot.states(seg.q, seg.qd, seg.qdd, under_burger)
-    states = [centre.take(i) for i in range(N + 1)]
-    l, w = cell.spatula.length / 2, cell.spatula.width / 2
-    floor = blade_floor(seg.name, cell, N)
-    for i, st in enumerate(states[1:], 1):  # node 0 is the previous segment's last node
-        heights = [_point_height(st, (a * l, b * w, 0)) for a, b in BLADE_CORNERS]
-        add("grill_clearance", k, np.maximum(floor[i] - np.array(heights), 0.0), tol, i)
-    cone = make_cone(plan.cone, cell.burger.mu, cell.gravity)
+    states = [centre.take(i) for i in range(seg.N + 1)]
     probe = _probe(report, k, seg, robot, plan, cell, states, tol)
-    for i in sorted(set(seg.cone_nodes) | set(probe.spec.cone(probe))):  # recorded ∪ the spec's
-        # the flip's cone holds where the burger lies on the blade
-        st = at_burger[0].take(i) if at_burger else states[i]
-        add("cone", k, max(-cone.margin(st), 0.0), 10 * tol, i)
-    release = probe.options.release
-    if "release" in probe.spec.records and seg.release and seg.landing and plan.cone == "physical":
-        # the burger leaves the blade at the release node: no normal force there
-        st = at_burger[0].take(release) if at_burger else states[release]
-        f = specific_force(st.R, st.a, cell.gravity)
-        add("release", k, abs(f[2]), 10 * tol, release)
-    _check_behavior(report, k, probe)
-
-
-def _check_interpolant(report, k, seg, robot, qdd_max, tol) -> None:
-    """q̇ and q̈ limits on the cubic Hermite interpolant between every two nodes, exactly, at
-    its extremes (:func:`~flipkit.planning.plans.hermite.hermite_extremes`)."""
-    start, end, qd = hermite_extremes(seg.t, seg.q, seg.qd)
-    n = np.arange(seg.N)
-    for i, qdd in enumerate((start, end)):
-        # node of the interval's start (i = 0) or end (i = 1)
-        report.add_nodes("interpolant", k, outside(qdd, -qdd_max, qdd_max),
-                         INTERPOLANT_TOL[1] * tol, n + i)
-    report.add_nodes("interpolant", k, outside(qd, -robot.qd_max, robot.qd_max),
-                     INTERPOLANT_TOL[0] * tol, n)
-
-
-def _check_behavior(report, k, probe: Probe) -> None:
-    """What the segment's spec declares (paper eqs. 9, 22–27 and the serve's): its end
-    condition, its end pose (the spec's ``end_pose`` hook on the plan's record), its own
-    independent ``checks``, and the flight of a segment that records a landing."""
-    spec, seg, robot, states, N = probe.spec, probe.seg, probe.robot, probe.states, probe.seg.N
-    if spec.at_rest:
-        probe.add("endpoints", np.abs(seg.qd[-1]), N)
-    if spec.end == "home":
-        probe.add("endpoints", np.abs(seg.q[-1] - robot.q_home), N)
-    target = spec.end_pose(probe) if probe.has_task() else None
-    if target is not None:
-        probe.add("endpoints", np.abs(states[-1].p - np.asarray(target.p)), N)
-        probe.add("endpoints", angle(rpy(states[-1].R), target.o), N)
-    for check in spec.checks:
-        check(probe)
-    if "landing" in spec.records:
-        check_flight(report, k, seg, robot, probe.cell, states)
+    return SegmentView(report, k, seg, robot, plan, cell, tol, geometry, states, at_burger, probe)
 
 
 def _probe(report, k, seg, robot, plan, cell, states, tol) -> Probe:
@@ -335,3 +239,8 @@ def load_verified(path, behaviors=None, *, force: bool = False, tol: float = TOL
     plan = Plan.load(path)
     require_verified(plan, path, behaviors, force=force, tol=tol)
     return plan
+
+
+# the report's types and the interpolant's tolerances, importable from here
+__all__ = ["GROUPS", "INTERPOLANT_TOL", "TOL", "TOL_RANGE", "GroupResult", "VerificationReport",
+           "check_arguments", "load_verified", "require_verified", "verify_plan"]

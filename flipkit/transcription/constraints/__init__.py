@@ -8,7 +8,8 @@ values and the Jacobian entries in pattern order.
 from flipkit.transcription.constraints.base import Block, FixedValues
 from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.dynamics import BezierOutput, Dynamics, HermiteSimpson
-from flipkit.transcription.constraints.kinematic import QUANTITIES, KinematicBlock
+from flipkit.transcription.constraints.kinematic import KinematicBlock
+from flipkit.transcription.constraints.quantities import QUANTITIES
 
 __all__ = ["Block", "FixedValues", "BrakingMargin", "Dynamics", "HermiteSimpson", "BezierOutput",
            "KinematicBlock", "QUANTITIES"]

@@ -1,11 +1,18 @@
-"""Base class of constraint blocks and the simplest block, fixed variable values."""
+"""Base class of constraint blocks and the simplest block, fixed variable values.
+
+A block's module holds its three parts (:mod:`flipkit.transcription.constraints.registry`):
+``evaluate`` (numeric rows and Jacobian), ``symbolic`` (the same rows as CasADi SX, for the
+stage-wise graph of :mod:`flipkit.transcription.ocp_graph`) and ``check`` (the groups of
+``verify`` that recompute what it requires independently, or why there are none).
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
+from flipkit.errors import ConfigError, NoSymbolicFormError
+from flipkit.transcription.constraints.registry import BLOCK_TERMS, Check
 from flipkit.transcription.layout import Evaluation, Layout
-from flipkit.errors import ConfigError
 
 _PATTERNS: dict = {}  # Block._pattern's cache: (block type, key) -> (rows, cols), read-only
 
@@ -14,13 +21,26 @@ class Block:
     """A group of constraints lo ≤ c(Z) ≤ hi with a fixed Jacobian sparsity pattern.
 
     Subclasses fill the pattern with :meth:`_add` in the same order as :meth:`evaluate`
-    produces the Jacobian entries.
+    produces the Jacobian entries, state the rows as SX in :meth:`symbolic` (or say why not
+    in ``no_symbolic_form``) and name their independent check in ``check``. Defining a
+    subclass registers it in :data:`~flipkit.transcription.constraints.registry.BLOCK_TERMS`
+    (or in the ``registry`` given as a class keyword).
 
     Attributes:
         name: Constraint group, used in reports ("dynamics", "cone", ...).
         m: Number of rows. rows, cols: Pattern (rows local to the block).
         lo, hi: Bounds (±inf where open). scale: Row scale applied by the solvers.
+        check: Where ``verify`` checks the block (class attribute).
+        no_symbolic_form: Why the block has no :meth:`symbolic` (class attribute; empty
+            when it has one).
     """
+
+    check: Check | None = None
+    no_symbolic_form = ""
+
+    def __init_subclass__(cls, registry=None, **kwargs):
+        super().__init_subclass__(**kwargs)
+        (BLOCK_TERMS if registry is None else registry).register(cls)
 
     def __init__(self, name: str, layout: Layout):
         self.name, self.layout = name, layout
@@ -67,6 +87,20 @@ class Block:
         """Values c (m,) and Jacobian entries (nnz,) at the point of ``ev``."""
         raise NotImplementedError
 
+    def symbolic(self, acc) -> list:
+        """The rows as SX, grouped by stage: (stage, SX values, block-local row indices) per
+        group, in the block's units before the row scale; ``acc`` gives the variables
+        (:mod:`flipkit.transcription.symbolic_blocks`).
+
+        Raises:
+            NoSymbolicFormError: The block has no symbolic form (``no_symbolic_form``).
+        """
+        why = f" ({self.no_symbolic_form})" if self.no_symbolic_form else ""
+        raise NoSymbolicFormError(
+            f"constraint block {self.name!r} ({type(self).__name__}) has no symbolic form{why}; "
+            "build the segment without it (SegmentOptions(arm_clearance=False) for "
+            "arm_clearance)")
+
 
 class FixedValues(Block):
     """Linear equalities Z[idx] = target (start state, rest, home configuration).
@@ -96,5 +130,14 @@ class FixedValues(Block):
         x[self.indices] = self.target
         return x
 
+    check = Check(("continuity", "endpoints"))  # start state; end state, rest, q_home
+
     def evaluate(self, ev):
         return ev.x[self.indices].copy(), np.ones(self.m)
+
+    def symbolic(self, acc):
+        L, out = self.layout, []
+        for r, idx in enumerate(self.indices):
+            s = acc.stage_of(int(idx) // L.node_size) if idx < L.alpha_start else 0
+            out.append((s, acc.var(int(idx), s), np.array([r])))
+        return out

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
 
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.constraints.registry import Check
 
 
 class BrakingMargin(Block):
@@ -34,3 +36,11 @@ class BrakingMargin(Block):
         vals = q + qd * np.abs(qd) / a
         jac = np.column_stack([np.ones_like(q), 2.0 * np.abs(qd) / a]).ravel()
         return vals, jac
+
+    check = Check(none="a margin the planner keeps for the next segment: what it protects, "
+                       "that segment's q_limits from its continuous start, is checked there")
+
+    def symbolic(self, acc):
+        s = acc.stage_of(self.node)
+        q, qd = acc.node(self.node, s)[:2]
+        return [(s, q + qd * ca.fabs(qd) / ca.DM(2.0 * self.qdd_max), np.arange(self.m))]

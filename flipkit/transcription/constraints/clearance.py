@@ -19,6 +19,9 @@ import numpy as np
 from flipkit.errors import ConfigError
 from flipkit.model.collision import ArmShapes
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.constraints.registry import Check
+
+NO_SX = "coal computes its distances; they have no CasADi form"
 
 CAP = 0.25  # m: distances beyond it read as CAP (our choice; > 10 × the default margin)
 
@@ -65,6 +68,9 @@ class ArmClearance(Block):
         self.nearest = np.full((self.m, 2), -1)  # (shape, box) setting each row, last evaluate
         self._finish(margin, np.inf, 1.0)
 
+    check = Check(("arm_clearance",))
+    no_symbolic_form = NO_SX
+
     def evaluate(self, ev):
         if not self.m:
             return np.zeros(0), np.zeros(0)
@@ -109,6 +115,10 @@ class CoastingClearance(Block):
         self.m = 1
         self.nearest = np.full((1, 2), -1)
         self._finish(margin, np.inf, 1.0)
+
+    check = Check(none="a margin the planner keeps for the next segment: what it protects, "
+                       "that segment's arm_clearance from its continuous start, is checked there")
+    no_symbolic_form = NO_SX
 
     def evaluate(self, ev):
         q, qd = ev.node(self.node)[:2]

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from flipkit.errors import ConfigError
+from flipkit.model.robot import BLADE_CORNERS
 from flipkit.transcription.constraints.base import Block
-from flipkit.transcription.constraints.kinematic import BLADE_CORNERS
+from flipkit.transcription.constraints.registry import Check
 
 
 class CoastingFloor(Block):
@@ -43,6 +44,11 @@ class CoastingFloor(Block):
         self.m = len(BLADE_CORNERS)
         self._add(0, self.m, np.concatenate([layout.iq(self.node), layout.iqd(self.node)]))
         self._finish(float(floor), np.inf, 1.0)
+
+    check = Check(none="a margin the planner keeps for the next segment: what it protects, "
+                       "that segment's grill_clearance from its continuous start, is checked "
+                       "there")
+    no_symbolic_form = "not stated as SX: the flip, which applies it, is solved by the SQP"
 
     def evaluate(self, ev):
         q, qd = ev.node(self.node)[:2]

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
 
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.constraints.registry import Check
 
 
 class Dynamics(Block):
@@ -49,6 +51,16 @@ class Dynamics(Block):
             for f, block in enumerate(parts):
                 jac[i, :, f * nq:(f + 1) * nq] = block
         return vals.ravel(), jac.ravel()
+
+    check = Check(("dynamics",))
+
+    def symbolic(self, acc):
+        nq = self.layout.nq
+        out = []
+        for i in range(self.layout.n_nodes):
+            s = acc.stage_of(i)
+            out.append((s, acc.rnea(i, s) - acc.node(i, s)[3], np.arange(i * nq, (i + 1) * nq)))
+        return out
 
 
 class HermiteSimpson(Block):
@@ -102,6 +114,24 @@ class HermiteSimpson(Block):
             np.stack([one, -one, -one * dt / 6, -one * 4 * dt / 6, -one * dt / 6, -ddt * s / 6], 2),
         ], axis=2)  # (N/2, 2, 2, 6, nq)
         return vals.ravel(), jac.ravel()
+
+    check = Check(("defects",))
+
+    def symbolic(self, acc):
+        L, nq, out, row = self.layout, self.layout.nq, [], 0
+        for i in range(1, L.N, 2):
+            s = acc.stage_of(i - 1)
+            na, ni, nb = (acc.node(n, s) for n in (i - 1, i, i + 1))
+            dt = 2 * acc.var(L.T_index, s) / L.N
+            for k in (0, 1):
+                xa, xi, xb = na[k], ni[k], nb[k]
+                da, di, db = na[k + 1], ni[k + 1], nb[k + 1]
+                delta = xi - (xa + xb) / 2 - dt * (da - db) / 8
+                sigma = xb - xa - dt * (da + 4 * di + db) / 6
+                out.append((s, delta, np.arange(row, row + nq)))
+                out.append((s, sigma, np.arange(row + nq, row + 2 * nq)))
+                row += 2 * nq
+        return out
 
 
 class BezierOutput(Block):
@@ -159,3 +189,31 @@ class BezierOutput(Block):
                                  M * (a1 - a0) / T**2])
         return (np.concatenate([vals.ravel(), q[0] - a0, qd[0] - M * (a1 - a0) / T]),
                 np.concatenate([jac_nodes.ravel(), np.tile([1.0, -1.0], nq), start.ravel()]))
+
+    check = Check(none="the outputs y = q − P(t) shape the motion the solver looks for; a "
+                       "plan records no α, and what the arm must meet (dynamics, limits, "
+                       "poses) is checked by the other groups")
+
+    def _alpha(self, acc, s) -> ca.SX:
+        """α as an (nq, M+1) SX matrix, held by stage s."""
+        L = self.layout
+        flat = ca.vertcat(*[acc.var(int(j), s) for j in np.arange(L.alpha_start, L.T_index)])
+        return ca.reshape(flat, L.bezier.n_coeffs, L.nq).T  # row-major (nq, M+1)
+
+    def symbolic(self, acc):
+        L, nq, e, out = self.layout, self.layout.nq, self.eps, []
+        B0, B1, B2 = self.B
+        for i in range(L.n_nodes):
+            s = acc.stage_of(i)
+            q, qd, qdd, _ = acc.node(i, s)
+            T, alpha = acc.var(L.T_index, s), self._alpha(acc, s)
+            c = ca.DM(B2[i]) / T**2 + 2 * e * ca.DM(B1[i]) / T + e**2 * ca.DM(B0[i])
+            out.append((s, qdd + 2 * e * qd + e**2 * q - alpha @ c,
+                        np.arange(i * nq, (i + 1) * nq)))
+        s0, M, row = acc.stage_of(0), L.bezier.degree, L.n_nodes * nq
+        q0, qd0 = acc.node(0, s0)[:2]
+        T, alpha = acc.var(L.T_index, s0), self._alpha(acc, s0)
+        out.append((s0, q0 - alpha[:, 0], np.arange(row, row + nq)))
+        out.append((s0, qd0 - M * (alpha[:, 1] - alpha[:, 0]) / T,
+                    np.arange(row + nq, row + 2 * nq)))
+        return out

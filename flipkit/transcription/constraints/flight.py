@@ -22,7 +22,11 @@ from flipkit.errors import ConfigError
 from flipkit.model.flight import (TILT_MIN_DEG, clearance_function, gravity_magnitude,
                                   landing_function, landing_parameters, predict_landing)
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.constraints.registry import Check
 from flipkit.transcription.layout import Evaluation
+
+NO_SX = ("the burger's flight is a CasADi function called numerically "
+         "(flipkit.model.flight); its rows are not part of the stage-wise graph")
 
 
 def _release_inputs(ev, r: int):
@@ -105,6 +109,9 @@ class Landing(Block):
                 {"target": [float(v) for v in self.par[3:5]], "r_land": float(self.hi[0]),
                  **pred, "burger_on_blade": list(self.on_blade)})
 
+    check = Check(("landing",))
+    no_symbolic_form = NO_SX
+
     def evaluate(self, ev):
         return _landing_rows(ev, self.release, [self.par])
 
@@ -155,6 +162,9 @@ class ScenarioLanding(Block):
                 for ob, pred in zip(self.scenarios, _predictions(ev, robot, self.release,
                                                                  self.pars))]
 
+    check = Check(("landing_scenarios",))
+    no_symbolic_form = NO_SX
+
     def evaluate(self, ev):
         return _landing_rows(ev, self.release, self.pars)
 
@@ -184,6 +194,9 @@ class FlightClearance(Block):
                                              [layout.T_index]]))
         self.m = len(self.nodes)
         self._finish(margin, np.inf, 1.0)
+
+    check = Check(("flight_clearance",))
+    no_symbolic_form = NO_SX
 
     def evaluate(self, ev):
         L, r, n = self.layout, self.release, len(self.nodes)

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from flipkit.transcription.constraints.base import Block
+from flipkit.transcription.constraints.registry import Check
 
 ACC_SCALE = 1e-3  # row scale of a_0, a_1 (s²/rad): the solver's tolerance 1e-6 is 1e-3 rad/s²
 VEL_SCALE = 1e-2  # row scale of c (s/rad): 1e-4 rad/s
@@ -80,6 +81,19 @@ class InterpolantLimits(Block):
         vals = np.stack([a0, a1, c], axis=1)  # (N, 3, nq)
         jac = np.stack([jac_a0, jac_a1, jac_c], axis=1)  # (N, 3, nq, 5)
         return vals.ravel(), jac.ravel()
+
+    check = Check(("interpolant",))
+
+    def symbolic(self, acc):
+        L, nq, out = self.layout, self.layout.nq, []
+        for i in range(L.N):
+            s = acc.stage_of(i)  # holds node i and node i + 1 (itself or the copy of the next)
+            (q0, qd0), (q1, qd1) = acc.node(i, s)[:2], acc.node(i + 1, s)[:2]
+            terms = interval_terms(q0, qd0, q1, qd1, acc.var(L.T_index, s) / L.N)
+            for r, value in enumerate(terms):
+                row = (3 * i + r) * nq
+                out.append((s, value, np.arange(row, row + nq)))
+        return out
 
 
 __all__ = ["ACC_SCALE", "InterpolantLimits", "VEL_SCALE", "interval_terms"]
