@@ -48,6 +48,7 @@ def summarise(translate: dict, flip: dict, replan: dict) -> dict:
            "translate_segments": n, "flip_locations": len(flip["rows"])}
     out["flip"] = {m: {"solve_s": flip["median"][m]["solve_s"],
                        "wall_s": flip["median"][m]["wall_s"],
+                       "cpu_s": flip["median"][m]["cpu_s"],
                        "iterations": flip["median"][m]["iterations"],
                        "ms_per_iteration": _ms_per_iteration(flip["rows"], m),
                        "solved": flip["median"][m]["solved"]}
@@ -73,18 +74,19 @@ def summarise(translate: dict, flip: dict, replan: dict) -> dict:
 def print_summary(s: dict) -> None:
     """Print :func:`summarise`'s summary as one table and the lines under it."""
     print(f"\n=== one run, side by side ({machine()})")
-    print(f"{'problem':<34}{'solver':<22}{'median s':>9}{'it':>6}{'ms/it':>7}{'solved':>8}")
+    print(f"{'problem':<34}{'solver':<22}{'median s':>9}{'it':>6}{'ms/it':>7}{'solved':>8}"
+          f"{'cpu s':>8}")
     n = s["translate_segments"]
     for name, m in s["translate"].items():
         print(f"{f'translate (median of {n})':<34}{TRANSLATE_SOLVERS[name]:<22}"
               f"{m['time_s']:9.3f}{m['iterations']:6.0f}{m['ms_per_iteration']:7.1f}"
-              f"{m['solved']:>6}/{n}")
+              f"{m['solved']:>6}/{n}{m['cpu_s']:8.3f}")
     for method, label in _FLIP_METHODS.items():
         if method in s["flip"]:
             m = s["flip"][method]
             print(f"{'pickup-and-flip (solve; median)':<34}{label:<22}{m['solve_s']:9.3f}"
                   f"{m['iterations']:6.0f}{m['ms_per_iteration']:7.1f}"
-                  f"{m['solved']:>6}/{s['flip_locations']}")
+                  f"{m['solved']:>6}/{s['flip_locations']}{m['cpu_s']:8.3f}")
     for key, b in s["batch"].items():
         start = "from the atlas" if key == "batch_atlas" else "cold"
         print(f"{'batch of five, ' + start:<34}{'SQP':<22}{b['parallel_s']:9.3f}"
@@ -96,7 +98,8 @@ def print_summary(s: dict) -> None:
     ratio = s["sqp_ratio_translate"]
     if ratio:
         print(f"translate: the best peer ({TRANSLATE_SOLVERS[ratio['best']]}) takes "
-              f"{ratio['ratio']:.2f} × the SQP's median time (> 1: the SQP is faster)")
+              f"{ratio['ratio']:.2f} × the SQP's median time (> 1: the SQP is faster); in "
+              f"CPU time {TRANSLATE_SOLVERS[ratio['best_cpu']]} {ratio['ratio_cpu']:.2f} ×")
     if s["sqp_ratio_flip_cold"]:
         print(f"pickup-and-flip, cold: IPOPT L-BFGS takes {s['sqp_ratio_flip_cold']:.2f} × the "
               f"SQP's median solve time")
