@@ -1,11 +1,11 @@
 """Solve-time benchmarks against the paper's budgets: SQP (cvxpy/OSQP) beside IPOPT.
 
     python -m flipkit.experiments.bench translate [--full] [--jit] [--json OUT]
-    python -m flipkit.experiments.bench all [--jit] [--locations N] [--json OUT]
     python -m flipkit.experiments.bench flip [--locations N] [--batch K] [--atlas FILE]
                                              [--no-atlas] [--no-ipopt] [--baseline] [--cook]
                                              [--json OUT]
 
+``python -m flipkit.experiments.bench_all`` runs the three side by side.
 ``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
 NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP,
 exact-Hessian IPOPT and ``sqpmethod`` (:mod:`flipkit.solvers.exact`, on the NLP as a CasADi
@@ -464,12 +464,12 @@ def _warm_worker(_) -> None:
     plan_flip(TABLE1_LOCATIONS[1], solver="sqp")
 
 
-def _plain(obj):
+def plain_json(obj):
     """``obj`` with NaN as None and numpy numbers as floats (strict JSON)."""
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
+        return {k: plain_json(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
+        return [plain_json(v) for v in obj]
     if isinstance(obj, (float, np.floating)):
         return float(obj) if np.isfinite(obj) else None
     return obj.item() if isinstance(obj, np.generic) else obj
@@ -479,7 +479,7 @@ def main(argv=None) -> int:
     """Command-line entry point (see the module docstring)."""
     parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench",
                                      description=__doc__.splitlines()[0])
-    parser.add_argument("which", choices=("translate", "flip", "replan", "all"))
+    parser.add_argument("which", choices=("translate", "flip", "replan"))
     parser.add_argument("--validate", metavar="FILE",
                         help="replan: the sensed places of this `flipkit validate --replan "
                              "--json` result (default: run Table I, 3 trials, position mode)")
@@ -487,7 +487,7 @@ def main(argv=None) -> int:
                         help="replan: also prepare each plan's contingency flips and time the "
                              "re-plan that uses them")
     parser.add_argument("--locations", type=int, default=len(TABLE1_LOCATIONS), metavar="N",
-                        help="flip, all: the first N Table I locations (default all ten)")
+                        help="flip: the first N Table I locations (default all ten)")
     parser.add_argument("--batch", type=int, default=5, metavar="K",
                         help="flip: batch of the first K locations with the SQP (0: none)")
     parser.add_argument("--full", action="store_true",
@@ -495,7 +495,7 @@ def main(argv=None) -> int:
                              "L-BFGS IPOPT only (default: the comparison NLP without them, four "
                              "solvers)")
     parser.add_argument("--jit", action="store_true",
-                        help="translate, all: JIT-compile the exact-derivative peers' functions")
+                        help="translate: JIT-compile the exact-derivative peers' functions")
     parser.add_argument("--atlas", metavar="FILE",
                         help="flip: warm-start atlas for the SQP-with-atlas column (default: "
                              "the package's, when it serves the default options)")
@@ -514,9 +514,6 @@ def main(argv=None) -> int:
     cell = CellConfig()
     if args.which == "translate":
         result = bench_translate(cell, args.full, args.jit)
-    elif args.which == "all":
-        from flipkit.experiments.bench_all import bench_all  # it builds on this module
-        result = bench_all(cell, args.jit, args.locations)
     elif args.which == "replan":
         print(machine())
         result = bench_replan(load_result(args.validate) if args.validate else run_validation(),
@@ -530,7 +527,7 @@ def main(argv=None) -> int:
                             args.baseline, args.cook)
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(_plain(result), fh, indent=1)
+            json.dump(plain_json(result), fh, indent=1)
     return 0
 
 

@@ -1,7 +1,7 @@
 """Every speed claim in one run: the translates with every peer, the flips, the batch and the
 replan, side by side, printed and returned for JSON.
 
-    python -m flipkit.experiments.bench all [--jit] [--locations N] [--json OUT]
+    python -m flipkit.experiments.bench_all [--jit] [--locations N] [--json OUT]
 
 Runs, one after the other in this process, :func:`~flipkit.experiments.bench.bench_translate`
 (the six translates, the SQP beside FATROP, exact IPOPT, ``sqpmethod`` and L-BFGS IPOPT),
@@ -16,10 +16,15 @@ measurement.
 
 from __future__ import annotations
 
+import argparse
+import json
 import statistics
+import sys
+import warnings
 
-from flipkit.config import CellConfig
-from flipkit.experiments.bench import TRANSLATE_SOLVERS, bench_flip, bench_translate, machine
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.experiments.bench import (TRANSLATE_SOLVERS, bench_flip, bench_translate, machine,
+                                       plain_json)
 from flipkit.experiments.bench_replan import bench_replan, run_validation
 from flipkit.planning.planners.atlas import default_atlas
 
@@ -120,4 +125,27 @@ def bench_all(cell: CellConfig, jit: bool, n_locations: int) -> dict:
             "replan": replan}
 
 
-__all__ = ["TARGETS_S", "bench_all", "print_summary", "summarise"]
+def main(argv=None) -> int:
+    """Command-line entry point (see the module docstring)."""
+    parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench_all",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("--jit", action="store_true",
+                        help="JIT-compile the exact-derivative peers' functions")
+    parser.add_argument("--locations", type=int, default=len(TABLE1_LOCATIONS), metavar="N",
+                        help="the first N Table I pickup-and-flips (default all ten)")
+    parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
+    args = parser.parse_args(argv)
+    if not 1 <= args.locations <= len(TABLE1_LOCATIONS):
+        parser.error(f"--locations must be 1..{len(TABLE1_LOCATIONS)}")
+    warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+    result = bench_all(CellConfig(), args.jit, args.locations)
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(plain_json(result), fh, indent=1)
+    return 0
+
+
+__all__ = ["TARGETS_S", "bench_all", "main", "print_summary", "summarise"]
+
+if __name__ == "__main__":
+    sys.exit(main())
