@@ -58,7 +58,7 @@ SQPMETHOD_PROXIMAL = 1e-4
 
 @dataclass(frozen=True)
 class ExactOptions:
-    """Settings of both exact-derivative solvers (tolerances in the scaled units).
+    """Settings of the exact-derivative solvers (tolerances in the scaled units).
 
     Attributes:
         tol: IPOPT's overall convergence tolerance (its scaled KKT residual).
@@ -68,7 +68,7 @@ class ExactOptions:
             stops with Σu² within 5e-5 of IPOPT's optimum, the accuracy the SQP stops at.
         constr_viol_tol: Largest scaled violation accepted; also the independent check.
         max_iter: Iteration cap (FATROP, IPOPT).
-        sqpmethod_max_iter: ``sqpmethod``'s (each of its iterations costs 60–80 ms).
+        sqpmethod_max_iter: ``sqpmethod``'s (its iterations took 66–250 ms on the translates).
         jit: Compile the graph's functions to C before solving (CasADi JIT, ``-O0``: the
             graph's C is ~40 MB; gcc -O1 on it ran for over 3 min and 3 GB, not finished).
         print_level: Solver verbosity (0 silent).
