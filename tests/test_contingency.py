@@ -104,6 +104,21 @@ def test_bench_replan_times_the_replan_with_and_without_contingencies(capsys):
     assert "handed a contingency" in capsys.readouterr().out
 
 
+def test_bench_replan_records_a_place_off_the_blade_as_refused(capsys):
+    """A sensed place past the blade's edge is refused by the planner: the bench records and
+    counts it apart instead of stopping, and times the others."""
+    from flipkit.experiments.bench_replan import bench_replan
+
+    result = {"locations": [{"location": [0.69, -0.16, 0.072], "landings": [
+        {"replan": {"sensed_on_blade": [0.083, 0.0]}},
+        {"replan": {"sensed_on_blade": [0.036, 0.0]}}]}]}
+    out = bench_replan(result)
+    off, on = out["rows"]
+    assert "within ±0.08" in off["refused"] and on["kept"]
+    assert out["summary"]["refused"] == 1 and out["summary"]["replans"] == 1
+    assert "1 sensed place(s) off the blade refused" in capsys.readouterr().out
+
+
 def test_prepared_on_an_executor_the_contingencies_are_the_same(flip_plan, side):
     from concurrent.futures import ThreadPoolExecutor
 

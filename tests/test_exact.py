@@ -1,7 +1,9 @@
-"""FATROP and exact-Hessian IPOPT (flipkit.solvers.exact) against the SQP, on the same NLP."""
+"""FATROP, exact-Hessian IPOPT and sqpmethod (flipkit.solvers.exact) against the SQP, on the
+same NLP."""
 
 import os
 
+import casadi as ca
 import pytest
 
 from flipkit.behaviors.models import Models
@@ -34,18 +36,26 @@ def sqp(translate):
 
 
 @pytest.fixture(scope="module")
-def graph(translate):
-    return OcpGraph(translate)
+def graphs(translate):
+    """The translate's graph as each solver needs it."""
+    return {s: OcpGraph(translate, **ExactOptions().graph_options(s))
+            for s in ("fatrop", "ipopt", "sqpmethod")}
 
 
-@pytest.mark.parametrize("solver", ["fatrop", "ipopt"])
-def test_agrees_with_sqp(translate, sqp, graph, solver):
-    """Both solve the segment, feasible by the NLP's own check, with Σu² within 1 % of the
+@pytest.fixture(scope="module")
+def graph(graphs):
+    return graphs["ipopt"]
+
+
+@pytest.mark.parametrize("solver", ["fatrop", "ipopt", "sqpmethod"])
+def test_agrees_with_sqp(translate, sqp, graphs, solver):
+    """Each solves the segment, feasible by the NLP's own check, with Σu² within 1 % of the
     SQP's (a wrong row, scale or objective in the graph moves the optimum)."""
-    result = ExactSolver(translate, solver, graph=graph).solve()
+    result = ExactSolver(translate, solver, graph=graphs[solver]).solve()
     assert sqp.success, sqp.status
     assert result.success, (result.status, result.max_violation)
-    assert result.solver == ("fatrop" if solver == "fatrop" else "ipopt_exact")
+    assert result.solver == {"fatrop": "fatrop", "ipopt": "ipopt_exact",
+                             "sqpmethod": "sqpmethod"}[solver]
     assert result.iterations > 0 and result.max_violation <= 1e-6
     assert abs(result.objective - sqp.objective) <= 0.01 * abs(sqp.objective)
     T = translate.layout.T_index
@@ -67,12 +77,40 @@ def test_other_graph_refused(cell, translate, graph):
         ExactSolver(translate, "ipopt", graph=graph).solve(graph=pickup)
 
 
+@pytest.mark.skipif(not ca.has_nlpsol("fatrop"), reason="casadi built without FATROP")
+def test_fatrop_knot_layout_small_translate(cell):
+    """FATROP on the knot layout (states: knot q, q̇, q̈ with T and α; 36 controls; manual
+    structure; scaled cost) solves a 10-interval translate to the SQP's optimum: Σu² within
+    0.5 % and T within 0.02 s, in fewer than 100 iterations."""
+    models = Models(cell)
+    q0 = solve_pose(models.loaded, (0.65, -0.30, 0.15), (0, 0, 0))
+    nlp = transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)),
+                     options=SegmentOptions(arm_clearance=False, mu_plan=0.4, N=10))
+    exact = ExactSolver(nlp, "fatrop")
+    s = exact.graph.structure
+    assert s["N"] == 5 and s["nx"][0] == 3 * 6 + 1 + 42 and s["nu"][0] == 36
+    result, sqp = exact.solve(), solve_sqp(nlp, raise_on_failure=False)
+    assert sqp.success and result.success, (sqp.status, result.status)
+    assert result.max_violation <= 1e-6 and 0 < result.iterations < 100
+    assert abs(result.objective - sqp.objective) <= 5e-3 * sqp.objective
+    T = nlp.layout.T_index
+    assert result.x[T] == pytest.approx(sqp.x[T], abs=0.02)
+
+
+def test_graph_for_another_solver_refused(translate, graphs):
+    """FATROP's graph (its own objective scale) is not IPOPT's, nor HPIPM's layout FATROP's."""
+    with pytest.raises(ConfigError, match="not set up"):
+        ExactSolver(translate, "ipopt", graph=graphs["fatrop"])
+    with pytest.raises(ConfigError, match="not set up"):
+        ExactSolver(translate, "fatrop", graph=graphs["sqpmethod"])
+
+
 @pytest.mark.parametrize("solver", ["fatrop", "ipopt"])
-def test_step_profile_counts_the_solves_iterations(translate, graph, solver):
+def test_step_profile_counts_the_solves_iterations(translate, graphs, solver):
     """With ``step_profile`` each solve records how many of its iterations regularised the
     Hessian and cut the primal step: FATROP from its captured table (nothing of it shown),
     IPOPT from its statistics; over as many iterations as the solver reports."""
-    exact = ExactSolver(translate, solver, ExactOptions(step_profile=True), graph=graph)
+    exact = ExactSolver(translate, solver, ExactOptions(step_profile=True), graph=graphs[solver])
     result = exact.solve()
     p = exact.last_profile
     assert result.success and p is not None

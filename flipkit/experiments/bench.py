@@ -5,9 +5,11 @@
                                              [--no-atlas] [--no-ipopt] [--baseline] [--cook]
                                              [--json OUT]
 
+``python -m flipkit.experiments.bench_all`` runs the three side by side.
 ``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
-NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP and
-exact-Hessian IPOPT (:mod:`flipkit.solvers.exact`, on the NLP's stage-wise CasADi graph) and
+NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP,
+exact-Hessian IPOPT and ``sqpmethod`` (:mod:`flipkit.solvers.exact`, on the NLP as a CasADi
+OCP) and
 IPOPT with L-BFGS through callbacks, all on the same scaled NLP — without the arm's clearance
 rows, which have no symbolic form (``--full``: the planner's NLP with them, the SQP and
 L-BFGS IPOPT only). ``flip``: the full
@@ -65,6 +67,7 @@ from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES, NLP_SOLVERS
 from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
+from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.transcription.ocp_graph import OcpGraph
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
@@ -105,10 +108,13 @@ def cpu_model() -> str:
 
 
 def machine() -> str:
-    """One line: CPU count, platform, CPU model, Python, BLAS/OpenMP thread setting."""
+    """One line: CPU count, platform, CPU model, Python, BLAS/OpenMP thread setting, and the
+    load average over the last minute (runnable processes: above the CPU count, the machine
+    is shared and wall times stretch)."""
+    load = f", load {os.getloadavg()[0]:.1f}" if hasattr(os, "getloadavg") else ""
     return (f"machine: {os.cpu_count()} CPUs, {platform.platform()}, {cpu_model()}"
             f", Python {platform.python_version()}, OMP_NUM_THREADS="
-            f"{os.environ.get('OMP_NUM_THREADS', 'unset')}")
+            f"{os.environ.get('OMP_NUM_THREADS', 'unset')}{load}")
 
 
 def warm_up(nlps) -> float:
@@ -132,25 +138,38 @@ def _med(values) -> float:
     return statistics.median(values) if values else float("nan")
 
 
-# The translate comparison's solvers: the SQP and IPOPT (L-BFGS, callbacks) on the NLP, FATROP
-# and exact-Hessian IPOPT on its SX graph (flipkit.solvers.exact); labels for the table.
+# The translate comparison's solvers: the SQP and IPOPT (L-BFGS, callbacks) on the NLP, FATROP,
+# exact-Hessian IPOPT and CasADi's sqpmethod on its stage-wise graph (flipkit.solvers.exact);
+# labels for the table.
 TRANSLATE_SOLVERS = {"sqp": "SQP", "fatrop": "FATROP", "ipopt_exact": "IPOPT exact",
-                     "ipopt": "IPOPT L-BFGS"}
+                     "sqpmethod": "sqpmethod", "ipopt": "IPOPT L-BFGS"}
 
 
-def _exact_solvers(graphs, jit: bool, cache: dict) -> tuple[dict, dict]:
-    """FATROP and exact-Hessian IPOPT for each graph, built once per distinct graph
-    (:attr:`OcpGraph.key`: the translates differ only in their bounds); build times (s)."""
-    solvers, build = {}, {}
-    for plugin, name in EXACT_RESULT_NAMES.items():  # fatrop, then ipopt_exact
-        for g in graphs:
-            key = (plugin, g.key, jit)
-            if key not in cache:
-                cache[key] = ExactSolver(g.nlp, plugin, ExactOptions(jit=jit, step_profile=True),
-                                         graph=g)
-                build[name] = build.get(name, 0.0) + cache[key].build_time_s
-            solvers[(name, id(g))] = cache[key]
-    return solvers, build
+def _exact_solvers(nlps, jit: bool) -> tuple[dict, dict, dict]:
+    """Each exact-derivative peer with the graphs of ``nlps`` it needs
+    (:meth:`ExactOptions.graph_options`), one solver built per distinct graph
+    (:attr:`OcpGraph.key`: the translates differ only in their bounds).
+
+    Returns:
+        ``{(result name, k): (solver, graph of nlps[k])}``, build times (s) by what was
+        built, and each peer's graph of ``nlps[0]``.
+    """
+    options, arm = ExactOptions(jit=jit, step_profile=True), CasadiArm(nlps[0].robot)
+    solvers, build, first, graphs, built = {}, {}, {}, {}, {}
+    for plugin, name in EXACT_RESULT_NAMES.items():
+        spec = tuple(sorted(options.graph_options(plugin).items()))
+        if spec not in graphs:
+            t0 = time.perf_counter()
+            graphs[spec] = [OcpGraph(nlp, arm, **dict(spec)) for nlp in nlps]
+            build["graphs"] = build.get("graphs", 0.0) + time.perf_counter() - t0
+        for k, g in enumerate(graphs[spec]):
+            if g.key not in built:
+                built[g.key] = ExactSolver(g.nlp, plugin, options, graph=g)
+                build[name] = build.get(name, 0.0) + built[g.key].build_time_s
+            solvers[(name, k)] = (built[g.key], g)
+        first[name] = graphs[spec][0]
+        built.clear()
+    return solvers, build, first
 
 
 def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
@@ -187,28 +206,26 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
           f"{warm_up(nlps[:1]):.1f} s, not counted below")
     build = {}
     if not full:
-        t0 = time.perf_counter()
-        graphs = [OcpGraph(nlp) for nlp in nlps]
-        build["graphs"] = time.perf_counter() - t0
-        exact, more = _exact_solvers(graphs, jit, {})
-        build.update(more)
-        print("build, not counted below: SX graphs of the six NLPs " + ", ".join(
-            f"{k} {v:.1f} s" for k, v in build.items()) + f" ({len(set(g.key for g in graphs))}"
-            f" distinct graph(s){', JIT-compiled' if jit else ''}); "
-            f"FATROP structure N={graphs[0].K}, nx={graphs[0].nx[0]}, nu={graphs[0].nu[0]}")
+        exact, build, first = _exact_solvers(nlps, jit)
+        g = first["fatrop"]
+        print("build, not counted below: SX graphs of the six NLPs and the solvers " + ", ".join(
+            f"{k} {v:.1f} s" for k, v in build.items()) + f"{' (JIT-compiled)' if jit else ''}; "
+            f"FATROP structure N={g.K}, nx={g.nx[0]}, nu={g.nu[0]}, ng={g.ng[1]}, objective "
+            f"{g.obj_scale:g}·Σu²")
     print(f"{'seg':<6}{'solver':<14}{'time s':>8}{'it':>5}{'objective':>12}{'dJ vs SQP':>11}"
           f"{'status':>14}{'T s':>6}", flush=True)
     rows = []
     for k, nlp in enumerate(nlps):
         r = {"segment": f"{k + 1}->{(k + 1) % len(nlps) + 1}"}
         for name in names:
-            profile = None
+            profile, cpu = None, time.process_time()
             if name in EXACT_RESULT_NAMES.values():
-                solver = exact[(name, id(graphs[k]))]
-                res, profile = solver.solve(graph=graphs[k]), solver.last_profile
+                solver, graph = exact[(name, k)]
+                res, profile = solver.solve(graph=graph), solver.last_profile
             else:
                 res = solve_segment(nlp, name)
-            r[name] = {"time_s": res.wall_time_s, "iterations": res.iterations,
+            r[name] = {"time_s": res.wall_time_s, "cpu_s": time.process_time() - cpu,
+                       "iterations": res.iterations,
                        "objective": res.objective, "status": str(res.status),
                        "T_s": float(res.x[nlp.layout.T_index]),
                        "profile": None if profile is None else asdict(profile)}
@@ -224,7 +241,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
                   f"{d['status'][:13]:>14}{d['T_s']:6.2f}", flush=True)
         rows.append(r)
     med = {name: {key: _med([r[name][key] for r in rows])
-                  for key in ("time_s", "iterations", "T_s")} for name in names}
+                  for key in ("time_s", "cpu_s", "iterations", "T_s")} for name in names}
     for name in names:
         med[name]["max_abs_rel_objective_diff_vs_sqp"] = max(
             (abs(r[name]["rel_objective_diff_vs_sqp"]) for r in rows
@@ -232,13 +249,19 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         med[name]["solved"] = sum(r[name]["status"] == "solved" for r in rows)
         med[name]["ms_per_iteration"] = 1e3 * _med(
             [r[name]["time_s"] / r[name]["iterations"] for r in rows if r[name]["iterations"]])
-    print(f"{'median':<7}{'solver':<13}{'time s':>8}{'it':>5}{'ms/it':>7}{'max |dJ|':>10}"
-          f"{'solved':>9}")
+    print(f"{'median':<7}{'solver':<13}{'time s':>8}{'cpu s':>7}{'it':>5}{'ms/it':>7}"
+          f"{'max |dJ|':>10}{'solved':>9}")
     for name in names:
         m = med[name]
-        print(f"{'':<6}{TRANSLATE_SOLVERS[name]:<14}{m['time_s']:8.3f}{m['iterations']:5.0f}"
-              f"{m['ms_per_iteration']:7.0f}{m['max_abs_rel_objective_diff_vs_sqp']:10.1e}"
-              f"{m['solved']:>7d}/{len(rows)}")
+        print(f"{'':<6}{TRANSLATE_SOLVERS[name]:<14}{m['time_s']:8.3f}{m['cpu_s']:7.3f}"
+              f"{m['iterations']:5.0f}{m['ms_per_iteration']:7.1f}"
+              f"{m['max_abs_rel_objective_diff_vs_sqp']:10.1e}{m['solved']:>7d}/{len(rows)}")
+    ratio = sqp_ratio(med, len(rows))
+    if ratio:
+        print(f"SQP vs the best peer that solved all {len(rows)}: {ratio['best']} "
+              f"{ratio['best_s']:.3f} s / SQP {ratio['sqp_s']:.3f} s = {ratio['ratio']:.2f}"
+              f" (> 1: the SQP is faster); in CPU time {ratio['best_cpu']} "
+              f"{ratio['ratio_cpu']:.2f}")
     print(f"T = executed duration (s), bounds {SUBBEHAVIORS['translate'].duration} s; dJ = (J − J_SQP)/J_SQP "
           "over the segments both solved, ms/it = median time per iteration, "
           "J = Σu² (every solver minimises the same scaled obj_scale·Σu²); times are the "
@@ -246,7 +269,22 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
     for line in iteration_notes(rows, names, med, TRANSLATE_SOLVERS):
         print(line)
     return {"machine": machine(), "key_points": TRANSLATE_KEY_POINTS, "full": full, "jit": jit,
-            "build_s": build, "rows": rows, "median": med}
+            "build_s": build, "rows": rows, "median": med, "sqp_ratio": ratio}
+
+
+def sqp_ratio(med: dict, n: int) -> dict | None:
+    """The best peer's median time over the SQP's (> 1: the SQP is faster), among the peers
+    that solved all ``n`` segments, in wall time and in process CPU time (on a shared
+    machine wall times stretch with the load, CPU times much less); ``None`` when no peer
+    solved all or the SQP did not."""
+    peers = [p for p in med if p != "sqp" and med[p]["solved"] == n]
+    if not peers or med["sqp"]["solved"] != n:
+        return None
+    best = min(peers, key=lambda p: med[p]["time_s"])
+    best_cpu = min(peers, key=lambda p: med[p]["cpu_s"])
+    return {"best": best, "best_s": med[best]["time_s"], "sqp_s": med["sqp"]["time_s"],
+            "ratio": med[best]["time_s"] / med["sqp"]["time_s"], "best_cpu": best_cpu,
+            "ratio_cpu": med[best_cpu]["cpu_s"] / med["sqp"]["cpu_s"]}
 
 
 def _flip_row(plan) -> dict:
@@ -426,12 +464,12 @@ def _warm_worker(_) -> None:
     plan_flip(TABLE1_LOCATIONS[1], solver="sqp")
 
 
-def _plain(obj):
+def plain_json(obj):
     """``obj`` with NaN as None and numpy numbers as floats (strict JSON)."""
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
+        return {k: plain_json(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
+        return [plain_json(v) for v in obj]
     if isinstance(obj, (float, np.floating)):
         return float(obj) if np.isfinite(obj) else None
     return obj.item() if isinstance(obj, np.generic) else obj
@@ -457,7 +495,7 @@ def main(argv=None) -> int:
                              "L-BFGS IPOPT only (default: the comparison NLP without them, four "
                              "solvers)")
     parser.add_argument("--jit", action="store_true",
-                        help="translate: JIT-compile FATROP's and exact IPOPT's functions")
+                        help="translate: JIT-compile the exact-derivative peers' functions")
     parser.add_argument("--atlas", metavar="FILE",
                         help="flip: warm-start atlas for the SQP-with-atlas column (default: "
                              "the package's, when it serves the default options)")
@@ -489,7 +527,7 @@ def main(argv=None) -> int:
                             args.baseline, args.cook)
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(_plain(result), fh, indent=1)
+            json.dump(plain_json(result), fh, indent=1)
     return 0
 
 

@@ -3,7 +3,7 @@
 For each (N, solver) the six translate segments of the solver comparison
 (:func:`flipkit.experiments.bench.translate_nlps`: the NLP without the arm's clearance rows,
 which have no symbolic form) are solved from the same start ``nlp.x0`` by the SQP, FATROP,
-exact-Hessian IPOPT or L-BFGS IPOPT, as :func:`flipkit.experiments.bench.bench_translate`
+exact-Hessian IPOPT, ``sqpmethod`` or L-BFGS IPOPT, as :func:`flipkit.experiments.bench.bench_translate`
 solves them at N = 20. One (N, solver) item is one job of a sweep: one solver runs per
 worker process, single-threaded, so on a machine with one core per worker the times are
 one-core times. Set-up is not counted: the SQP's subproblem compile (one SQP iteration
@@ -23,7 +23,7 @@ from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.bench import TRANSLATE_SOLVERS, translate_nlps, warm_up
 from flipkit.experiments.sweep import run_sweep
 from flipkit.planning.planners.chain import solve_segment
-from flipkit.solvers.exact import ExactSolver
+from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES
 from flipkit.transcription.ocp_graph import OcpGraph
 
@@ -52,7 +52,7 @@ def scaling_item(item: dict) -> dict:
     for k, nlp in enumerate(nlps):
         if plugin is not None:
             t0 = time.perf_counter()
-            graph = OcpGraph(nlp)
+            graph = OcpGraph(nlp, **ExactOptions().graph_options(plugin))
             if graph.key not in built:
                 built[graph.key] = ExactSolver(nlp, plugin, graph=graph)
             setup += time.perf_counter() - t0

@@ -35,9 +35,10 @@ RC = {
 # Semantic colours: the paper's where it names them (Figs. 6-7: desired red, actual blue).
 DESIRED_COLOR, ACTUAL_COLOR = "#D55E00", "#0072B2"  # paper Figs. 6-7: desired red, actual blue
 SOLVER_COLORS = {"sqp": "#0072B2", "ipopt": "#E69F00", "ipopt_exact": "#D55E00",
-                 "fatrop": "#009E73"}
+                 "fatrop": "#009E73", "sqpmethod": "#CC79A7"}
 SOLVER_LABELS = {"sqp": "SQP (cvxpy/OSQP)", "ipopt": "IPOPT (L-BFGS, MUMPS)",
-                 "ipopt_exact": "IPOPT (exact Hessian, MUMPS)", "fatrop": "FATROP"}
+                 "ipopt_exact": "IPOPT (exact Hessian, MUMPS)", "fatrop": "FATROP",
+                 "sqpmethod": "CasADi sqpmethod (HPIPM)"}
 BURGER_COLOR = "#8B4513"
 # both admit, physical only, paper only, neither
 CONE_CLASS_COLORS = ("#CFE8D8", "#0072B2", "#D55E00", "white")

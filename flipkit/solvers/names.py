@@ -18,12 +18,12 @@ SOLVERS = (*NLP_SOLVERS, "auto")
 ``"auto"``, the SQP and then IPOPT from the same start where the SQP fails (the planners'
 default)."""
 
-EXACT_SOLVERS = ("fatrop", "ipopt")
+EXACT_SOLVERS = ("fatrop", "ipopt", "sqpmethod")
 """The CasADi plugins of the exact-derivative solvers (:class:`flipkit.solvers.exact.ExactSolver`,
-on the NLP's stage-wise SX graph): FATROP and exact-Hessian IPOPT. Used by benchmarks, not by
-the planner."""
+on the NLP's stage-wise SX graph): FATROP, exact-Hessian IPOPT and CasADi's SQP with HPIPM.
+Used by benchmarks, not by the planner."""
 
-EXACT_RESULT_NAMES = {"fatrop": "fatrop", "ipopt": "ipopt_exact"}
+EXACT_RESULT_NAMES = {"fatrop": "fatrop", "ipopt": "ipopt_exact", "sqpmethod": "sqpmethod"}
 """The name an exact-derivative solve records as its result's ``solver``, by plugin
 (:data:`EXACT_SOLVERS`): ``"ipopt_exact"`` keeps exact-Hessian IPOPT apart from the L-BFGS
 ``"ipopt"`` of :data:`NLP_SOLVERS`."""
