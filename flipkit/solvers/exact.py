@@ -45,10 +45,9 @@ from flipkit.solvers.result import SolveResult, Status
 from flipkit.solvers.step_profile import StepProfile, fatrop_profile, ipopt_profile
 from flipkit.solvers.stdout_redirect import captured_stdout
 
-#: FATROP's objective is Σ u_i² (N²·m²) times this: 1e-4 puts it at 1.6–4 at the translates'
-#: optima. With the SQP's scale (1/(21·1e4), ~0.1 there) FATROP failed one translate of six and
-#: took 29–95 iterations on the others; 3e-5, 1e-4 and 2e-4 solved all six in 24–58, and
-#: 1e-3 and 1e-2 up to 533 and the cap (docs/benchmarks/2026-11-29-honest-peers.md).
+#: FATROP's objective is Σ u_i² (N²·m²) times this, which puts it of order 1 at the translates'
+#: optima, the scale FATROP's cookbook asks for; the SQP's own scale, an order of magnitude
+#: smaller there, made FATROP fail a translate (docs/peers.md has the scales tried).
 FATROP_OBJ_SCALE = 1e-4
 
 #: The proximal term of ``sqpmethod``'s Gauss–Newton Hessian (scaled units). On translate 1
