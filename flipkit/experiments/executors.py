@@ -57,11 +57,7 @@ class RenewablePool(cf.Executor):
                           initializer=_single_threaded)
 
     def __exit__(self, exc_type, exc, tb):
-        if exc_type is None:
-            self.shutdown(wait=True)
-        else:
-            self.terminate()
-        return False
+        return self._pool.__exit__(exc_type, exc, tb)  # the current pool's: wait or terminate
 
     def terminate(self) -> None:
         """End the current pool's workers at once (:meth:`WorkerPool.terminate`)."""
