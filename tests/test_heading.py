@@ -14,7 +14,7 @@ from flipkit.errors import UnreachableError
 from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.model.task_frame import TaskFrame, rz
 from flipkit.transcription.constraints.kinematic import KinematicBlock
-from flipkit.transcription.constraints.quantities import QUANTITIES
+from flipkit.transcription.constraints.quantities import QUANTITIES, framed
 from flipkit.transcription.layout import Evaluation
 
 FRAME = TaskFrame(0.5, (0.69, -0.16))
@@ -70,7 +70,7 @@ def test_framed_symbolic_form_equals_numeric(flip_nlp, cell, name):
                   rng.uniform(-3, 3, 6))
     Q, Qd, Qdd = ca.SX.sym("q", 6), ca.SX.sym("qd", 6), ca.SX.sym("qdd", 6)
     quantity = QUANTITIES[name]()
-    k = FRAME.kinematics(CasadiArm(robot).frame(Q, Qd, Qdd))
+    k = framed(CasadiArm(robot).frame(Q, Qd, Qdd), FRAME)
     f = ca.Function("f", [Q, Qd, Qdd], [quantity.symbolic(k, {})])
     numeric = quantity(FRAME.state(robot.state(q, qd, qdd)), {})[0]
     np.testing.assert_allclose(np.asarray(f(q, qd, qdd)).ravel(), numeric, atol=1e-10)

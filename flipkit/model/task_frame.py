@@ -7,8 +7,9 @@ p^b's (x, y), so that their bounds and targets are the paper's, unchanged. Heigh
 anything seen in the blade's own frame (the friction cone), do not depend on ψ.
 
 A :class:`TaskFrame` maps world quantities into that frame (``point``, ``vector``, a numeric
-:class:`~flipkit.model.robot.SpatulaState` with its Jacobians, CasADi kinematics) and
-task-frame poses back into the world (``pose``). ψ = 0 is the identity.
+:class:`~flipkit.model.robot.SpatulaState` with its Jacobians) and task-frame poses back into
+the world (``pose``); :func:`~flipkit.transcription.constraints.quantities.framed` does the
+same for CasADi kinematics. ψ = 0 is the identity.
 """
 
 from __future__ import annotations
@@ -90,17 +91,6 @@ class TaskFrame:
                        a=self.vector(st.a), dp_dq=A @ st.dp_dq, Jw=A @ st.Jw,
                        dv_dq=A @ st.dv_dq, dv_dqd=A @ st.dv_dqd, da_dq=A @ st.da_dq,
                        da_dqd=A @ st.da_dqd, da_dqdd=A @ st.da_dqdd)
-
-    def kinematics(self, k):
-        """Symbolic kinematics (:class:`~flipkit.model.casadi_dynamics.Kinematics`) in the
-        task frame."""
-        if self.identity:
-            return k
-        import casadi as ca  # the symbolic path only: a frame is made where casadi is not loaded
-
-        A, c = ca.DM(self._to_task), ca.DM(self._c)
-        return replace(k, p=A @ (k.p - c) + c, R=A @ k.R, v=A @ k.v, a=A @ k.a, w=A @ k.w,
-                       dw=A @ k.dw)
 
 
 WORLD = TaskFrame()

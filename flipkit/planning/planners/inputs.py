@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from flipkit.behaviors.targets import check_heading, default_heading
 from flipkit.config import CellConfig
 from flipkit.config.checks import real_number, real_vector
 from flipkit.errors import AtlasError, ConfigError, UnreachableError, brief
@@ -146,8 +147,6 @@ def resolve_heading(cell: CellConfig, pb, heading) -> tuple[float, bool]:
     atlas holds plans at the default heading only): ``heading`` checked
     (:func:`~flipkit.behaviors.targets.check_heading`), or ``None`` for the default
     (:func:`~flipkit.behaviors.targets.default_heading`)."""
-    from flipkit.behaviors.targets import check_heading, default_heading
-
     default = default_heading(cell, pb)
     if heading is None:
         return default, True

@@ -12,7 +12,7 @@ import numpy as np
 from flipkit.errors import InvalidChoiceError
 from flipkit.model.task_frame import WORLD, TaskFrame
 from flipkit.transcription.constraints.base import Block
-from flipkit.transcription.constraints.quantities import QUANTITIES
+from flipkit.transcription.constraints.quantities import QUANTITIES, framed
 from flipkit.transcription.constraints.registry import Check
 
 
@@ -81,7 +81,7 @@ class KinematicBlock(Block):
         point = getattr(self.quantity, "point", None)
         for r, i in enumerate(self.nodes):
             s = acc.stage_of(i)
-            k_i = self.frame.kinematics(acc.kinematics(i, s, point))
+            k_i = framed(acc.kinematics(i, s, point), self.frame)
             value = self.quantity.symbolic(k_i, self.ctx)
             out.append((s, value, np.arange(r * k, (r + 1) * k)))
         return out
