@@ -182,4 +182,10 @@ def test_pressed_blade_is_the_blades_spring_and_does_not_bounce(flip_plan):
     f_end = force[-1]
     assert f_end == pytest.approx(k * np.mean(flex) * len(flex) / 2, rel=0.1)
     assert 0.2 * k * 0.003 < f_end <= 1.05 * k * 0.003
-    assert np.ptp(force) < 0.3 * force.mean()  # steady, no chatter
+    # no chatter: the force moves less than 5 % of its mean from one control step to the next
+    assert np.abs(np.diff(force)).max() < 0.05 * force.mean()
+    # steady while the plan's feed-forward torques are the scoop's (the later segments' carry
+    # the burger's weight, which this held run does not hold: the press shifts with them)
+    t0, t1 = ex.bounds["scoop"]
+    scoop_window = ex.force_blade_grill[(ex.run.t > 0.5) & (ex.run.t <= t1)]
+    assert np.ptp(scoop_window) < 0.1 * scoop_window.mean()
