@@ -85,7 +85,7 @@ def run_flip(args: argparse.Namespace) -> int:
     plan = plan_flip(args.burger, q_start, cell=cell, solver=args.solver, land=args.land,
                      options=options, atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
-    if atlas is not None and args.heading is None:
+    if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} locations")
     return _report(plan, args.json)
 
@@ -110,7 +110,7 @@ def run_serve(args: argparse.Namespace) -> int:
     plan = plan_serve(args.burger, args.table_spot, q_start, cell=cell, solver=args.solver,
                       atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
-    if atlas is not None and args.heading is None:
+    if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
     return _report(plan, args.json)
 

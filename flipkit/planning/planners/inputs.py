@@ -142,16 +142,11 @@ def check_approach_height(height) -> float | None:
     return h
 
 
-def resolve_heading(cell: CellConfig, pb, heading) -> tuple[float, bool]:
-    """The scoop heading (rad) of a plan at ``pb`` and whether it is the default one (the
-    atlas holds plans at the default heading only): ``heading`` checked
+def resolve_heading(cell: CellConfig, pb, heading) -> float:
+    """The scoop heading (rad) of a plan at ``pb``: ``heading`` checked
     (:func:`~flipkit.behaviors.targets.check_heading`), or ``None`` for the default
     (:func:`~flipkit.behaviors.targets.default_heading`)."""
-    default = default_heading(cell, pb)
-    if heading is None:
-        return default, True
-    psi = check_heading(heading)
-    return psi, abs(psi - default) < 1e-9
+    return default_heading(cell, pb) if heading is None else check_heading(heading)
 
 
 def check_replan(plan, behavior: str, on_blade) -> tuple:

@@ -132,7 +132,8 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         heading: The scoop heading ψ (rad, :mod:`flipkit.model.task_frame`): the go to
             burger, scoop, pickup and flip run along (cos ψ, sin ψ); ``None`` (default):
             radially outward from the arm's base (:func:`~flipkit.behaviors.targets.default_heading`).
-            The atlas seeds the default heading only.
+            The atlas holds plans at the default headings; at another heading they still seed
+            the solver (the plan is verified as every plan is).
 
     Returns:
         The plan. On a segment failure the chain stops there: the plan holds the segments
@@ -151,12 +152,12 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
     on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
-    psi, seeded = resolve_heading(cell, pb, heading)
+    psi = resolve_heading(cell, pb, heading)
     q, qd = check_start(planner.models.bare, q_start, qd_start)
     task = Task(location=pb, land=spot, on_blade=on_blade,
                 approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("flip", task, q, qd,
-                         guess=seeding(atlas, pb) if seeded else None, t0=t0)
+                         guess=seeding(atlas, pb), t0=t0)
 
 
 def covers(landing: dict, on_blade) -> bool:

@@ -86,11 +86,11 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
         except UnreachableError as exc:
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
-    psi, seeded = resolve_heading(cell, pb, heading)
+    psi = resolve_heading(cell, pb, heading)
     task = Task(location=pb, spot=spot, on_blade=on_blade,
                 approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("serve", task, q, qd,
-                         guess=seeding(atlas, pb) if seeded else None, t0=t0)
+                         guess=seeding(atlas, pb), t0=t0)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
