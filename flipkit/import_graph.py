@@ -4,7 +4,9 @@ Every import statement counts, at module level and inside functions alike (a laz
 that runs is still a dependency); imports under ``if TYPE_CHECKING:`` are marked
 ``typing_only`` and left out of :func:`import_graph`. Names loaded by ``importlib`` from a
 string (``flipkit.__getattr__``) are not seen. ``tests/test_layers.py`` checks the layer
-rules on this graph; :mod:`flipkit.figures.inputs` hashes the sources a notebook imports.
+rules on this graph, and that the core (:mod:`flipkit.extras`) imports none of the extras'
+packages when it is imported; :mod:`flipkit.figures.inputs` hashes the sources a
+notebook imports.
 """
 
 from __future__ import annotations
@@ -15,7 +17,6 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 PACKAGE = Path(__file__).resolve().parent
-
 
 @dataclass(frozen=True)
 class Import:
@@ -127,20 +128,39 @@ def flipkit_imports(path: Path, root: Path = PACKAGE,
                           root, modules)
 
 
+def external_imports(path: Path) -> list[tuple[int, str, bool]]:
+    """(line, top-level name, inside a function) of every import of a package other than
+    flipkit in the file (``import a.b`` and ``from a.b import c``: ``a``); relative imports
+    and ``TYPE_CHECKING`` imports are left out."""
+    out = []
+    for node, local, typing_only in import_statements(ast.parse(Path(path).read_text())):
+        if typing_only:
+            continue
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            names = [node.module] if node.module and not node.level else []
+        out += [(node.lineno, n.split(".")[0], local) for n in names
+                if n.split(".")[0] != PACKAGE.name]
+    return out
+
+
 def local_imports(path: Path) -> list[int]:
     """Lines of the import statements (of any package) inside a function of the file."""
     return [node.lineno for node, local, _ in import_statements(ast.parse(Path(path).read_text()))
             if local]
 
 
-def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
+def import_graph(root: Path = PACKAGE, module_level: bool = False) -> dict[str, set[str]]:
     """Module → the other modules of the package it imports when it runs (``TYPE_CHECKING``
-    imports are annotations, not dependencies)."""
+    imports are annotations, not dependencies); with ``module_level``, only those its
+    import runs (not the imports inside its functions)."""
     modules, graph = package_modules(root), {}
     for f in package_files(root):
         name = module_name(f, root)
         graph[name] = {i.target for i in flipkit_imports(f, root, modules)
-                       if not i.typing_only and i.target != name}
+                       if not i.typing_only and i.target != name
+                       and not (module_level and i.local)}
     return graph
 
 

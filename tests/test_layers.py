@@ -4,7 +4,9 @@
 * no import cycle between modules;
 * no private name (leading underscore) imported from another module;
 * function-local imports only where a heavy optional dependency needs them, at most
-  :data:`MAX_LOCAL_IMPORTS` in the package.
+  :data:`MAX_LOCAL_IMPORTS` in the package;
+* the core (:mod:`flipkit.extras`) imports no package of an extra when it is imported, and
+  the extras named there are pyproject's.
 
 Every import is read from the source with ``ast`` by :mod:`flipkit.import_graph` — at module
 level and inside functions alike (a lazy import that runs up a layer, or closes a cycle, is
@@ -16,14 +18,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import tomllib
+from importlib.metadata import packages_distributions
+
 import pytest
 
-from flipkit.import_graph import PACKAGE, flipkit_imports, import_graph, local_imports
-from flipkit.import_graph import module_name, package_files
+from flipkit.extras import EXTRAS, extra_of, is_core
+from flipkit.import_graph import PACKAGE, closure, external_imports, flipkit_imports
+from flipkit.import_graph import import_graph, local_imports, module_name, package_files
 
 # Lowest first. A module may import its own layer and the layers below it.
 LAYERS = (
-    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "csv_header", "import_graph"),
+    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "csv_header", "import_graph",
+     "extras"),
     ("config", ""),  # "" is the package root (flipkit/__init__.py: version, CellConfig)
     ("model",),
     ("transcription",),
@@ -155,3 +162,70 @@ def test_the_checkers_catch_a_cycle_a_private_import_and_a_local_import(monkeypa
     assert local_imports(PACKAGE / "model" / "robot.py") == [5, 7]
     assert [i.typing_only for i in flipkit_imports(PACKAGE / "model" / "bezier.py")] == [
         False, True]
+
+
+# ---------------------------------------------------------------- the core and the extras
+def extras_at_import(paths: dict[str, Path]) -> dict[str, list[str]]:
+    """Core module -> ``"<module>:<line> <package> (extra)"`` for every import of an extra's
+    package that importing it runs (its own module-level imports and those of every flipkit
+    module it imports at module level, transitively)."""
+    graph = {name: {i.target for i in flipkit_imports(path) if not (i.local or i.typing_only)
+                    and i.target != name} for name, path in paths.items()}
+    found = {name: [f"{name}:{line} {top} ({extra_of(top)})"
+                    for line, top, local in external_imports(path)
+                    if not local and extra_of(top)] for name, path in paths.items()}
+    return {m: sorted(x for dep in closure(graph, [m]) for x in found.get(dep, ()))
+            for m in paths if is_core(m)}
+
+
+def test_the_core_imports_no_extra_when_imported():
+    paths = {module_name(f): f for f in FILES}
+    core = [m for m in paths if is_core(m)]
+    assert {"flipkit.model.robot", "flipkit.cli.commands.plan", "flipkit.cli.figures",
+            "flipkit.planning.plans.verify", "flipkit.baseline.ik_track"} <= set(core)
+    assert not is_core("flipkit.simulation.scene") and not is_core("flipkit.cli.commands.view")
+    bad = {m: v for m, v in extras_at_import(paths).items() if v}
+    assert not bad, "core modules that import an extra's package:\n" + "\n".join(
+        f"{m}: {'; '.join(v)}" for m, v in sorted(bad.items()))
+
+
+def test_the_core_check_catches_an_extra_reached_through_a_module(monkeypatch):
+    """A core module importing (at its top) a module that imports MuJoCo at its top is
+    reported; one that imports MuJoCo inside a function is not (the test can fail)."""
+    sources = {
+        PACKAGE / "model" / "robot.py": "from flipkit.model import scoop\nimport numpy\n",
+        PACKAGE / "model" / "scoop.py": "import flipkit.simulation.scene\n",
+        PACKAGE / "simulation" / "scene.py": "import os\nfrom mujoco import MjModel\n",
+        PACKAGE / "model" / "ik.py": "def f():\n    import meshcat\n",
+    }
+    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: sources[self])
+    found = extras_at_import({module_name(p): p for p in sources})
+    assert found["flipkit.model.robot"] == ["flipkit.simulation.scene:2 mujoco (sim)"]
+    assert found["flipkit.model.scoop"] == found["flipkit.model.robot"]
+    assert found["flipkit.model.ik"] == [] and "flipkit.simulation.scene" not in found
+
+
+def test_the_extras_are_pyprojects():
+    """:data:`flipkit.extras.EXTRAS` names pyproject's extras, each import name installed by a
+    distribution its extra requires; the core requires none of them."""
+    project = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["project"]
+    optional = project["optional-dependencies"]
+    assert set(optional) == set(EXTRAS) | {"all"}
+    assert optional["all"] == [f"flipkit[{','.join(EXTRAS)}]"]
+
+    def dist(requirement: str) -> str:
+        return requirement.split("[")[0].split("=")[0].split("<")[0].split(">")[0].lower()
+
+    installed = {k: {d.lower() for d in v} for k, v in packages_distributions().items()}
+    via_matplotlib = {"PIL"}  # Pillow: matplotlib's dependency, the GIF writer
+    core = {dist(r) for r in project["dependencies"]}
+    for extra, names in EXTRAS.items():
+        required = {dist(r) for r in optional[extra]}
+        for name in names:
+            if name in via_matplotlib:
+                assert "matplotlib" in required
+                continue
+            dists = installed.get(name, {name.lower()})
+            assert dists & required or name in ("nbclient", "jupyter_client", "distributed"), (
+                extra, name)
+            assert not dists & core, (extra, name)
