@@ -15,7 +15,7 @@ from __future__ import annotations
 # Extra of pyproject.toml -> the top-level import names of its packages (the first extra
 # that lists a name is the one named when it is missing).
 EXTRAS = {
-    "sim": ("mujoco", "matplotlib", "PIL"),
+    "sim": ("mujoco", "matplotlib"),
     "kitchen": ("ortools",),
     "viewer": ("meshcat",),
     "lab": ("papermill", "nbformat", "nbclient", "jupyter_client", "ipykernel", "jupyterlab",

@@ -3,17 +3,20 @@ notebooks themselves (parameters cell, no outputs)."""
 
 import json
 import os
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import nbformat
 import pytest
 
+import flipkit
 from flipkit import cli
 from flipkit import figures
 from flipkit.figures import execute
 from flipkit.errors import InvalidChoiceError
 
-NOTEBOOKS = sorted(figures.NOTEBOOKS_DIR.glob("*.ipynb"))
+REPO = Path(flipkit.__file__).resolve().parents[1]
+NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 
 
 def run_cli(argv, cwd):
@@ -30,7 +33,8 @@ def run_cli(argv, cwd):
 def made(tmp_path_factory):
     work = tmp_path_factory.mktemp("figures")
     out = work / "figures"
-    code = run_cli(["figures", "--quick", "--only", "cell", "--out", str(out)], work)
+    code = run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--notebooks",
+                    str(REPO / "notebooks")], work)
     return code, work, out
 
 
@@ -59,8 +63,8 @@ def test_second_run_is_reproducible(made):
     _, work, out = made
     first = json.loads((out / "manifest.json").read_text())
     pdf = (out / "cell.pdf").read_bytes()
-    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--force"],
-                   work) == 0
+    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--force",
+                    "--notebooks", str(REPO / "notebooks")], work) == 0
     second = json.loads((out / "manifest.json").read_text())
     assert second == first
     assert (out / "cell.pdf").read_bytes() == pdf  # no dates: byte-identical PDF
@@ -76,7 +80,7 @@ def test_unknown_id_is_a_one_line_error(capsys):
 def test_missing_notebook_is_skipped_and_reported(tmp_path, monkeypatch):
     monkeypatch.setitem(figures.FIGURES, "forces", "not_written_yet.ipynb")
     report = figures.run_notebooks(only=["forces"], out_dir=tmp_path / "f",
-                                   build_dir=tmp_path / "b")
+                                   build_dir=tmp_path / "b", notebooks_dir=REPO / "notebooks")
     assert report.made == [] and report.missing == ["forces"]
     assert json.loads(report.manifest.read_text())["figures"] == {}
 
@@ -106,7 +110,7 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
         nbformat.v4.new_code_cell("raise ValueError('burnt\\nbadly')")]), notebook)
     with pytest.raises(figures.NotebookError) as info:
         execute.execute_notebook(notebook, tmp_path / "executed.ipynb", {"quick": True},
-                                 figures.kernel_name())
+                                 figures.kernel_name(), cwd=tmp_path)
     message = str(info.value)
     assert "\n" not in message
     assert "broken.ipynb" in message and "ValueError: burnt badly" in message

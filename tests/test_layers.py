@@ -217,14 +217,10 @@ def test_the_extras_are_pyprojects():
         return requirement.split("[")[0].split("=")[0].split("<")[0].split(">")[0].lower()
 
     installed = {k: {d.lower() for d in v} for k, v in packages_distributions().items()}
-    via_matplotlib = {"PIL"}  # Pillow: matplotlib's dependency, the GIF writer
     core = {dist(r) for r in project["dependencies"]}
     for extra, names in EXTRAS.items():
         required = {dist(r) for r in optional[extra]}
         for name in names:
-            if name in via_matplotlib:
-                assert "matplotlib" in required
-                continue
             dists = installed.get(name, {name.lower()})
             assert dists & required or name in ("nbclient", "jupyter_client", "distributed"), (
                 extra, name)
