@@ -56,13 +56,16 @@ def extra_of(name: str) -> str | None:
 
 def missing_extra_message(command: str | None, missing: str | None) -> str | None:
     """One line saying which extra the sub-command ``command`` needs, given the name of the
-    module that could not be imported (``ModuleNotFoundError.name``); None when ``missing``
-    belongs to no extra (a broken install, not a missing extra)."""
+    module that could not be imported (``ModuleNotFoundError.name``): the extra of that
+    module, else the command's own (a package its extra brings along, such as matplotlib's
+    cycler); None for a module of flipkit, and for a command of the core missing a module of
+    no extra (a broken install, not a missing extra)."""
     top = (missing or "").split(".")[0]
-    extra = extra_of(top)
-    if extra is None:
+    own = COMMAND_EXTRAS.get(command or "", ())
+    needed = [e for e in own if top in EXTRAS[e]] or (
+        [extra_of(top)] if extra_of(top) else list(own[:1]))
+    if top in ("", "flipkit") or not needed:
         return None
-    needed = [e for e in COMMAND_EXTRAS.get(command or "", ()) if top in EXTRAS[e]] or [extra]
     what = f"flipkit {command}" if command else "this command"
     return (f"{what} needs the '{needed[0]}' extra (no module named {top!r}): "
             f"pip install 'flipkit[{needed[0]}]'")

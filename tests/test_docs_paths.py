@@ -232,6 +232,27 @@ def test_adding_a_behaviour_numbers_are_the_codes():
     assert limits == {CellConfig().robot.accel_limit}
 
 
+def test_adding_a_behaviour_names_and_counts_are_the_codes():
+    """The constants the page names exist, and the serve is what the page says: its first
+    three steps are the flip's, its last three declared in ``flipkit/behaviors/table.py``."""
+    from flipkit.behaviors import table
+    from flipkit.behaviors.library import BEHAVIORS
+
+    text = ADDING.read_text(encoding="utf-8")
+    constants = {span for span in code_spans(text) if re.fullmatch(r"[A-Z][A-Z0-9_]+", span)}
+    assigned = {t.id for path in PACKAGE.rglob("*.py")
+                for node in ast.parse(path.read_text(encoding="utf-8")).body
+                if isinstance(node, (ast.Assign, ast.AnnAssign))
+                for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                if isinstance(t, ast.Name)}
+    assert {"FLIP_TOOL_FRACTION", "GO_TO_BURGER", "SCOOP", "PICKUP"} <= constants
+    assert constants <= assigned, constants - assigned
+    serve, flip = BEHAVIORS["serve"].steps, BEHAVIORS["flip"].steps
+    assert "Its first three\nsegments are the flip's" in text and "Its last three" in text
+    assert serve[:3] == flip[:3] and len(serve) == 6
+    assert all(any(step is v for v in vars(table).values()) for step in serve[3:])
+
+
 def test_a_changed_bound_is_not_the_code():
     """The quote check fails on the carry with another duration bound."""
     block = PYTHON_BLOCK.findall(ADDING.read_text(encoding="utf-8"))[0]

@@ -18,10 +18,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import re
+import sys
 import tomllib
-from importlib.metadata import packages_distributions
+from importlib.metadata import distribution, packages_distributions
 
 import pytest
+from packaging.requirements import Requirement
 
 from flipkit.extras import EXTRAS, extra_of, is_core
 from flipkit.import_graph import PACKAGE, closure, external_imports, flipkit_imports
@@ -165,27 +168,83 @@ def test_the_checkers_catch_a_cycle_a_private_import_and_a_local_import(monkeypa
 
 
 # ---------------------------------------------------------------- the core and the extras
-def extras_at_import(paths: dict[str, Path]) -> dict[str, list[str]]:
-    """Core module -> ``"<module>:<line> <package> (extra)"`` for every import of an extra's
-    package that importing it runs (its own module-level imports and those of every flipkit
-    module it imports at module level, transitively)."""
+PROJECT = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["project"]
+
+
+def dist_name(name: str) -> str:
+    """A distribution's name, normalised (PEP 503)."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def core_distributions() -> set[str]:
+    """The distributions ``pip install flipkit`` installs: pyproject's dependencies and theirs,
+    transitively (from the installed metadata, extras left out)."""
+    seen, todo = set(), [Requirement(r) for r in PROJECT["dependencies"]]
+    while todo:
+        req = todo.pop()
+        name = dist_name(req.name)
+        if name in seen:
+            continue
+        seen.add(name)
+        for line in distribution(name).requires or ():
+            sub = Requirement(line)
+            if sub.marker is None or sub.marker.evaluate({"extra": ""}):
+                todo.append(sub)
+    return seen
+
+
+def import_names(name: str) -> set[str]:
+    """The top-level import names of an installed distribution, from its files (cmeel's
+    wheels, pinocchio and placo, put theirs under ``cmeel.prefix/.../site-packages``)."""
+    names = set()
+    for f in distribution(name).files or ():
+        parts = f.parts
+        if "site-packages" in parts:
+            parts = parts[parts.index("site-packages") + 1:]
+        if not parts or parts[0].endswith((".dist-info", ".pth", ".data")) or parts[0] in (
+                "..", "__pycache__", "cmeel.prefix", "bin"):
+            continue
+        if len(parts) > 1 or parts[0].endswith((".py", ".so")):
+            names.add(parts[0].split(".")[0])
+    return names
+
+
+def core_import_names() -> set[str]:
+    """The top-level names a core module may import: the standard library's, and those of
+    the core's distributions."""
+    core = core_distributions()
+    return set(sys.stdlib_module_names) | {"flipkit", "__future__"} | {
+        top for top, dists in packages_distributions().items()
+        if any(dist_name(d) in core for d in dists)} | {
+        top for name in core for top in import_names(name)}
+
+
+def outside_the_core(paths: dict[str, Path], allowed: set[str]) -> dict[str, list[str]]:
+    """Core module -> ``"<module>:<line> <package> (<extra>)"`` for every import of a package
+    outside ``allowed`` that importing it runs (its own module-level imports and those of
+    every flipkit module it imports at module level, transitively)."""
     graph = {name: {i.target for i in flipkit_imports(path) if not (i.local or i.typing_only)
                     and i.target != name} for name, path in paths.items()}
-    found = {name: [f"{name}:{line} {top} ({extra_of(top)})"
+    found = {name: [f"{name}:{line} {top} ({extra_of(top) or 'not a core dependency'})"
                     for line, top, local in external_imports(path)
-                    if not local and extra_of(top)] for name, path in paths.items()}
+                    if not local and top not in allowed] for name, path in paths.items()}
     return {m: sorted(x for dep in closure(graph, [m]) for x in found.get(dep, ()))
             for m in paths if is_core(m)}
 
 
-def test_the_core_imports_no_extra_when_imported():
+def test_the_core_imports_only_the_cores_dependencies():
+    """Importing a core module (``flipkit.extras``) imports the standard library and the
+    core's dependencies alone: no package of an extra, nor one an extra brings along."""
     paths = {module_name(f): f for f in FILES}
     core = [m for m in paths if is_core(m)]
     assert {"flipkit.model.robot", "flipkit.cli.commands.plan", "flipkit.cli.figures",
             "flipkit.planning.plans.verify", "flipkit.baseline.ik_track"} <= set(core)
     assert not is_core("flipkit.simulation.scene") and not is_core("flipkit.cli.commands.view")
-    bad = {m: v for m, v in extras_at_import(paths).items() if v}
-    assert not bad, "core modules that import an extra's package:\n" + "\n".join(
+    allowed = core_import_names()
+    assert {"numpy", "pinocchio", "casadi", "cvxpy", "yaml", "placo"} <= allowed
+    assert not {"mujoco", "matplotlib", "cycler", "ortools", "papermill", "dask"} & allowed
+    bad = {m: v for m, v in outside_the_core(paths, allowed).items() if v}
+    assert not bad, "core modules that import beyond the core's dependencies:\n" + "\n".join(
         f"{m}: {'; '.join(v)}" for m, v in sorted(bad.items()))
 
 
@@ -197,18 +256,20 @@ def test_the_core_check_catches_an_extra_reached_through_a_module(monkeypatch):
         PACKAGE / "model" / "scoop.py": "import flipkit.simulation.scene\n",
         PACKAGE / "simulation" / "scene.py": "import os\nfrom mujoco import MjModel\n",
         PACKAGE / "model" / "ik.py": "def f():\n    import meshcat\n",
+        PACKAGE / "model" / "bezier.py": "import cycler.x\n",
     }
     monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: sources[self])
-    found = extras_at_import({module_name(p): p for p in sources})
+    found = outside_the_core({module_name(p): p for p in sources}, {"os", "numpy", "meshcat"})
     assert found["flipkit.model.robot"] == ["flipkit.simulation.scene:2 mujoco (sim)"]
     assert found["flipkit.model.scoop"] == found["flipkit.model.robot"]
     assert found["flipkit.model.ik"] == [] and "flipkit.simulation.scene" not in found
+    assert found["flipkit.model.bezier"] == ["flipkit.model.bezier:1 cycler (not a core dependency)"]
 
 
 def test_the_extras_are_pyprojects():
     """:data:`flipkit.extras.EXTRAS` names pyproject's extras, each import name installed by a
     distribution its extra requires; the core requires none of them."""
-    project = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["project"]
+    project = PROJECT
     optional = project["optional-dependencies"]
     assert set(optional) == set(EXTRAS) | {"all"}
     assert optional["all"] == [f"flipkit[{','.join(EXTRAS)}]"]
