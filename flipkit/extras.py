@@ -5,8 +5,9 @@ baseline, and the command line's ``plan``, ``verify``, ``export``, ``atlas`` and
 ``compare-ik``) installs with the dependencies of ``pyproject.toml``; the simulation, the
 kitchen scheduler, the viewer and the lab (figures, notebooks, Dask sweeps) are extras:
 ``pip install 'flipkit[sim,kitchen,viewer,lab]'``. ``tests/test_layers.py`` checks that
-importing a core module imports no package of an extra, and that :data:`EXTRAS` lists
-pyproject's extras; a command that needs a missing extra fails with
+importing a core module imports only the standard library and the core's dependencies, and
+that :data:`EXTRAS` lists pyproject's extras; ``tests/test_core_install.py`` installs the
+core alone and runs it. A command that needs a missing extra fails with one line,
 :func:`missing_extra_message`.
 """
 

@@ -4,9 +4,9 @@ Every import statement counts, at module level and inside functions alike (a laz
 that runs is still a dependency); imports under ``if TYPE_CHECKING:`` are marked
 ``typing_only`` and left out of :func:`import_graph`. Names loaded by ``importlib`` from a
 string (``flipkit.__getattr__``) are not seen. ``tests/test_layers.py`` checks the layer
-rules on this graph, and that the core (:mod:`flipkit.extras`) imports none of the extras'
-packages when it is imported; :mod:`flipkit.figures.inputs` hashes the sources a
-notebook imports.
+rules on this graph, and (with :func:`external_imports`) that importing the core
+(:mod:`flipkit.extras`) imports only the core's dependencies; :mod:`flipkit.figures.inputs`
+hashes the sources a notebook imports.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 PACKAGE = Path(__file__).resolve().parent
+
 
 @dataclass(frozen=True)
 class Import:
@@ -151,16 +152,14 @@ def local_imports(path: Path) -> list[int]:
             if local]
 
 
-def import_graph(root: Path = PACKAGE, module_level: bool = False) -> dict[str, set[str]]:
+def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
     """Module → the other modules of the package it imports when it runs (``TYPE_CHECKING``
-    imports are annotations, not dependencies); with ``module_level``, only those its
-    import runs (not the imports inside its functions)."""
+    imports are annotations, not dependencies)."""
     modules, graph = package_modules(root), {}
     for f in package_files(root):
         name = module_name(f, root)
         graph[name] = {i.target for i in flipkit_imports(f, root, modules)
-                       if not i.typing_only and i.target != name
-                       and not (module_level and i.local)}
+                       if not i.typing_only and i.target != name}
     return graph
 
 
