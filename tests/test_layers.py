@@ -263,7 +263,8 @@ def test_the_core_check_catches_an_extra_reached_through_a_module(monkeypatch):
     assert found["flipkit.model.robot"] == ["flipkit.simulation.scene:2 mujoco (sim)"]
     assert found["flipkit.model.scoop"] == found["flipkit.model.robot"]
     assert found["flipkit.model.ik"] == [] and "flipkit.simulation.scene" not in found
-    assert found["flipkit.model.bezier"] == ["flipkit.model.bezier:1 cycler (not a core dependency)"]
+    assert found["flipkit.model.bezier"] == [
+        "flipkit.model.bezier:1 cycler (not a core dependency)"]
 
 
 def test_the_extras_are_pyprojects():

@@ -4,11 +4,11 @@ For each (N, solver) the six translate segments of the solver comparison
 (:func:`flipkit.experiments.speed.translate_nlps`: the NLP without the arm's clearance rows,
 which have no symbolic form) are solved from the same start ``nlp.x0`` by the SQP, FATROP,
 exact-Hessian IPOPT, ``sqpmethod`` or L-BFGS IPOPT, as ``bench_translate`` of the
-repository's ``bench/bench.py`` solves them at N = 20. One (N, solver) item is one job of a sweep: one solver runs per
-worker process, single-threaded, so on a machine with one core per worker the times are
-one-core times. Set-up is not counted: the SQP's subproblem compile (one SQP iteration
-first, :func:`~flipkit.experiments.speed.warm_up`) and the exact solvers' SX graph and
-solver build are reported apart.
+repository's ``bench/bench.py`` solves them at N = 20. One (N, solver) item is one job of a
+sweep: one solver runs per worker process, single-threaded, so on a machine with one core
+per worker the times are one-core times. Set-up is not counted: the SQP's subproblem compile
+(one SQP iteration first, :func:`~flipkit.experiments.speed.warm_up`) and the exact solvers'
+SX graph and solver build are reported apart.
 """
 
 from __future__ import annotations

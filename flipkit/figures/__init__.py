@@ -23,5 +23,6 @@ from flipkit.figures.pipeline import RunReport, run_notebooks, write_manifest
 from flipkit.figures.style import COLORS, COLUMN_WIDTH, PAGE_WIDTH, PNG_DPI, save, style
 
 __all__ = ["COLORS", "COLUMN_WIDTH", "FIGURES", "FIGURE_IDS", "PAGE_WIDTH", "PNG_DPI", "Inputs",
-           "NotebookError", "NotebookInputsError", "RunReport", "flatten_numbers", "format_number", "hash_inputs", "kernel_name",
-           "run_notebooks", "save", "style", "tex_escape", "write_macros", "write_manifest"]
+           "NotebookError", "NotebookInputsError", "RunReport", "flatten_numbers",
+           "format_number", "hash_inputs", "kernel_name", "run_notebooks", "save",
+           "style", "tex_escape", "write_macros", "write_manifest"]
