@@ -3,6 +3,7 @@ notebooks themselves (parameters cell, no outputs)."""
 
 import json
 import os
+import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -114,6 +115,27 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
     message = str(info.value)
     assert "\n" not in message
     assert "broken.ipynb" in message and "ValueError: burnt badly" in message
+
+
+@pytest.mark.slow
+def test_a_notebook_naming_an_unregistered_kernel_runs_in_this_python(tmp_path):
+    """The notebooks name ``flipkit-python3``, which only ``make lab`` registers; papermill is
+    given :func:`flipkit.figures.kernel_name`'s kernel, so a notebook naming a kernel that
+    is registered nowhere still runs, in this Python, in ``cwd``."""
+    notebook = tmp_path / "nb.ipynb"
+    nb = nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell("quick = False", metadata={"tags": ["parameters"]}),
+        nbformat.v4.new_code_cell("import os, sys\nprint(sys.prefix)\nprint(os.getcwd())")])
+    nb.metadata["kernelspec"] = {"name": "flipkit-unregistered", "display_name": "nowhere",
+                                 "language": "python"}
+    nbformat.write(nb, notebook)
+    (tmp_path / "run").mkdir()
+    execute.execute_notebook(notebook, tmp_path / "executed.ipynb", {"quick": True},
+                             figures.kernel_name(), cwd=tmp_path / "run")
+    out = nbformat.read(tmp_path / "executed.ipynb", as_version=4).cells[-1].outputs
+    prefix, cwd = "".join(o.get("text", "") for o in out).split()
+    assert Path(prefix).resolve() == Path(sys.prefix).resolve()
+    assert Path(cwd).resolve() == (tmp_path / "run").resolve()
 
 
 def test_every_figure_id_has_a_notebook_name():
