@@ -12,6 +12,7 @@ from flipkit.config import PHYSICAL_RANGES
 from flipkit.config.task import APPROACH_CLEARANCE, APPROACH_LOW
 from flipkit.behaviors.options import SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.model.robot import Robot
+from flipkit.model.task_frame import TaskFrame
 from flipkit.planning.plans.verify import verify_plan
 
 PB = (0.69, -0.16, 0.072)  # the flip_plan fixture's burger
@@ -37,13 +38,16 @@ def test_the_phases_and_the_limits_follow_the_ranges(cell):
 
 
 def _tips(plan, cell):
+    """The go to burger's tip positions (m), in the plan's scoop-heading frame (x along the
+    heading, about the burger)."""
     seg = plan.segment("go_to_burger")
     robot = Robot(cell, with_burger=False)
+    frame = TaskFrame(plan.burger["heading"], plan.burger["location"][:2])
     tips = []
     for q in seg.q:
         M = robot.placement(q)
         tips.append(M.translation + M.rotation @ np.array([cell.spatula.length / 2, 0, 0]))
-    return seg, np.array(tips)
+    return seg, frame.point(np.array(tips))
 
 
 def test_the_planned_blade_comes_down_behind_the_rim_and_slides_in(flip_plan, cell):

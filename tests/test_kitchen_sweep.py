@@ -250,7 +250,7 @@ def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypa
     tl, fps = fake_timeline()
     calls = []
 
-    def schedule(lands):
+    def schedule(lands, headings):
         calls.append(dict(lands))
         moved = lands.get("b1")
         t, f = fake_timeline(moved if moved else (0.64, -0.33))
@@ -259,12 +259,12 @@ def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypa
         return t
 
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
-    timeline, lands = clear_cook(schedule, CELL)
-    assert set(lands) == {"b1"} and calls[0] == {} and calls[-1] == lands
+    timeline, lands, headings = clear_cook(schedule, CELL)
+    assert set(lands) == {"b1"} and calls[0] == {} and calls[-1] == lands and headings == {}
     blade = blade_at(0.64, -0.33).blade[0][2]
     assert point_polygon_distance(lands["b1"], blade) >= R + M - 1e-9
 
-    def unflipped(lands):  # b1 still lies where it was dropped when b2's blade comes
+    def unflipped(lands, headings):  # b1 still lies where it was dropped when b2's blade comes
         t, f = fake_timeline()
         t.motions = [m for m in t.motions if m.burger != "b1"]
         fps.clear()
@@ -283,7 +283,7 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
 
     calls = []
 
-    def schedule(lands, moves=True):
+    def schedule(lands, headings, moves=True):
         calls.append(dict(lands))
         t, f = fake_timeline()
         t.motions = [m for m in t.motions if m.burger != "b1"]  # b1 not flipped yet
@@ -295,12 +295,44 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
 
     fps = {}
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
-    timeline, lands = clear_cook(schedule, CELL)
-    assert set(lands) == {"b2"} and calls[0] == {} and len(calls) == 2
+    timeline, lands, headings = clear_cook(schedule, CELL)
+    assert set(lands) == {"b2"} and calls[0] == {} and len(calls) == 2 and headings == {}
     calls.clear()
-    with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped"):
-        clear_cook(lambda lands: schedule(lands, moves=False), CELL)
-    assert len(calls) == 3 and len({tuple(c.get("b2", ())) for c in calls}) == 3
+    with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped.*every "
+                                                "scoop heading tried"):
+        clear_cook(lambda lands, headings: schedule(lands, headings, moves=False), CELL)
+    # two other landing spots, then the headings within 60° of +x: b2's radial heading
+    # (−31°) turned by −15°, +15° and +30° (−30° is past the limit); the toss is fixed here
+    assert len(calls) == 6 and len({tuple(c.get("b2", ())) for c in calls}) == 3
+
+
+def test_a_scoop_that_meets_a_dropped_burger_is_turned_away_from_it(monkeypatch):
+    """b2's scoop passes over b1 while b1 still lies where it was dropped: the cook turns
+    b2's scoop heading 15° away from b1 (b1 lies to the left of b2's radial heading) and
+    plans again; the turned scoop keeps clear."""
+    import math
+
+    import flipkit.planning.kitchen.clearance as clearance
+    from flipkit.behaviors.targets import default_heading
+
+    seen = []
+
+    def schedule(lands, headings):
+        seen.append(dict(headings))
+        t, f = fake_timeline()
+        t.motions = [m for m in t.motions if m.burger != "b1"]  # b1 not flipped yet
+        if "b2" in headings:  # turned: its blade passes beside b1
+            f[t.motions[0].plan] = blade_at(0.80, -0.10, t=1.0)
+        fps.clear()
+        fps.update(f)
+        return t
+
+    fps = {}
+    monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
+    timeline, lands, headings = clear_cook(schedule, CELL)
+    psi0 = default_heading(CELL, (0.75, -0.45, 0.0))
+    assert lands == {} and seen[0] == {}
+    assert headings == {"b2": pytest.approx(psi0 - math.radians(15.0))}
 
 
 def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():

@@ -8,6 +8,7 @@ import scipy.sparse as sp
 
 from flipkit.behaviors.models import Models
 from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.targets import scoop_ready
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import NoSymbolicFormError
@@ -38,6 +39,17 @@ def pickup(models):
     return nlp, OcpGraph(nlp)
 
 
+@pytest.fixture(scope="module")
+def scoop_headed(models):
+    """The scoop along a heading of 0.4 rad: its lateral and attitude bands in the turned
+    frame (flipkit.model.task_frame)."""
+    start = scoop_ready(models.cell, TABLE1_LOCATIONS[1], heading=0.4)
+    q = solve_pose(models.bare, start.p, start.o, models.bare.q_home)
+    nlp = transcribe("scoop", models, q, location=TABLE1_LOCATIONS[1], heading=0.4,
+                     options=NO_CLEARANCE)
+    return nlp, OcpGraph(nlp)
+
+
 def _random_point(nlp, seed):
     rng = np.random.default_rng(seed)
     return nlp.x0 + rng.normal(0.0, 0.1, nlp.n) * nlp.x_scale
@@ -61,7 +73,7 @@ def _simpson_rows(nlp):
     return rows[(np.arange(len(rows)) // nq) % 2 == 1]
 
 
-@pytest.mark.parametrize("which", ["translate", "pickup"])
+@pytest.mark.parametrize("which", ["translate", "pickup", "scoop_headed"])
 def test_rows_equal_nlp_evaluate(which, request):
     """At a random point on the dynamics every path row is the NLP's scaled row and the
     Simpson rows vanish; every other NLP row appears once; the bounds are the NLP's."""

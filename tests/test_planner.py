@@ -156,15 +156,18 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
 
 
 def test_a_segment_infeasible_within_its_bound_gets_a_longer_one():
-    """The scoop at (0.630, −0.347) — wrist 2 near its singularity — has no solution within
-    0.6 s; the planner tries once more with the bound × T_STRETCH and the plan verifies."""
+    """The scoop at (0.630, −0.347) along the paper's +x — wrists 1 and 3 undoing the base's
+    turn — has no solution within 0.6 s; the planner tries once more with the bound ×
+    T_STRETCH and the plan verifies. (Along the default, radial heading it needs no stretch.)"""
     from flipkit.behaviors.library import SUBBEHAVIORS
     from flipkit.behaviors.options import T_STRETCH
     from flipkit.planning.planners.planner import plan_flip
     from flipkit.planning.plans.verify import verify_plan
 
-    plan = plan_flip((0.629686, -0.347136, 0.072))
+    plan = plan_flip((0.629686, -0.347136, 0.072), heading=0.0)
     assert plan.status == "solved", plan.failure
+    radial = plan_flip((0.629686, -0.347136, 0.072))
+    assert radial.status == "solved" and radial.segment("scoop").T <= 0.6 + 1e-9
     scoop = plan.segment("scoop")
     assert SUBBEHAVIORS["scoop"].duration[1] < scoop.T <= T_STRETCH * SUBBEHAVIORS["scoop"].duration[1] + 1e-9
     # Stretched only where needed: the pickup and flip are not; the turn back from a robust

@@ -121,3 +121,23 @@ def test_no_replan_for_a_burger_the_scoop_missed(flip_plan):
     assert ex.replan_failure.startswith("burger not on the blade after the scoop")
     assert abs(ex.sensed_on_blade[1]) > flip_plan.spatula["width"] / 2
     assert not judge_scoop(ex.run, ex.bounds["scoop"]).ok
+
+
+def test_a_replan_too_slow_for_the_run_leaves_the_verified_plan_under_way(flip_plan,
+                                                                             monkeypatch):
+    """A re-plan whose wall time would hold the arm past the run's room (a loaded machine)
+    is dropped: the run ends on the verified plan, the record says why, nothing raises."""
+    import flipkit.simulation.execute as execute
+
+    clock = [0.0]
+    monkeypatch.setattr(execute.time, "perf_counter", lambda: clock[0])
+
+    def slow(plan, on_blade):
+        clock[0] += 1000.0  # the re-plan took 1000 s
+        return plan
+
+    ex = execute_plan(flip_plan, "feedforward", replan=slow)
+    assert ex.plan is flip_plan
+    assert "re-plan took 1000.00 s" in ex.replan_failure
+    assert "verified plan ran on" in ex.replan_failure
+    assert judge_flip(ex.run, ex.bounds["flip"], landing_target(flip_plan)).ok

@@ -45,7 +45,8 @@ def slide_node(N: int) -> int:
 
 
 def approach_limits(cell: CellConfig, pb) -> tuple[float, float]:
-    """(rim, start) (m, world x, the scoop's direction): the furthest the blade's tip comes
+    """(rim, start) (m, x of the scoop heading's frame, :meth:`~flipkit.behaviors.spec.Task.frame`,
+    the scoop's direction): the furthest the blade's tip comes
     during the descent (the near rim of the largest burger of the range, put
     ``ScoopUncertainty().placement`` toward the arm), and during the slide (the scoop's
     start). ``rim`` never lies past ``start``."""
@@ -67,15 +68,15 @@ def arrival_floor(cell: CellConfig, N: int) -> np.ndarray:
 
 def approach_path(ctx) -> list:
     """The descent's and the slide's bounds on the tip's position (module docstring)."""
-    L, cell = ctx.layout, ctx.cell
+    L, cell, frame = ctx.layout, ctx.cell, ctx.task.frame()
     rim, start = approach_limits(cell, ctx.location)
     tip = {"length": cell.spatula.length, "width": cell.spatula.width}
     return [KinematicBlock("approach_descent", L, "tip_position",
                            range(descent_node(L.N), slide_node(L.N)), -np.inf,
-                           np.array([rim, np.inf, np.inf]), ctx=tip),
+                           np.array([rim, np.inf, np.inf]), ctx=tip, frame=frame),
             KinematicBlock("approach_slide", L, "tip_position", range(slide_node(L.N), L.N + 1),
                            -np.inf, np.array([start, np.inf, cell.grill.height + APPROACH_LOW]),
-                           ctx=tip)]
+                           ctx=tip, frame=frame)]
 
 
 def approach_guess(ctx, T, pose):
@@ -86,7 +87,7 @@ def approach_guess(ctx, T, pose):
     L, robot = ctx.layout, ctx.robot
     rim, start = approach_limits(ctx.cell, ctx.location)
     end = np.asarray(pose.p, float)
-    low = end - np.array([start - rim + 0.005, 0.0, -0.002])
+    low = end - ctx.task.frame().world_vector([start - rim + 0.005, 0.0, -0.002])
     high = low + np.array([0.0, 0.0, PHYSICAL_RANGES["burger.thickness"][1]
                            + APPROACH_CLEARANCE + 0.01])
     o1 = np.asarray(pose.o, float)

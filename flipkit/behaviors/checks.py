@@ -32,10 +32,10 @@ def starts_at_rest_and_ends_flat(p: Probe) -> None:
 def approach_tip(p: Probe) -> None:
     """Go to burger: the tip behind the burger's rim over the descent, then low and not past
     the scoop's start over the slide (:mod:`flipkit.behaviors.approach`)."""
-    N, hg = p.seg.N, p.cell.grill.height
+    N, hg, frame = p.seg.N, p.cell.grill.height, p.task.frame()
     rim, start = approach_limits(p.cell, p.location)
     for i in range(descent_node(N), N + 1):
-        tip = p.tip(i)
+        tip = frame.point(p.tip(i))  # x along the scoop heading
         if i < slide_node(N):
             p.add("behavior_path", [max(tip[0] - rim, 0.0)], i)
         else:
@@ -52,13 +52,14 @@ def scoop_tip(p: Probe) -> None:
 
 
 def flip_end_set(p: Probe) -> None:
-    """Flip (eq. 26): the blade's normal and height at the end, its x axis on every node."""
-    N, hg, end = p.seg.N, p.cell.grill.height, p.states[-1]
-    p.add("behavior_path", outside(end.R[:, 2], *tg.FLIP_NORMAL_BOUNDS), N)
+    """Flip (eq. 26): the blade's normal and height at the end, its x axis on every node,
+    seen along the scoop heading."""
+    N, hg, end, frame = p.seg.N, p.cell.grill.height, p.states[-1], p.task.frame()
+    p.add("behavior_path", outside(frame.rotation(end.R)[:, 2], *tg.FLIP_NORMAL_BOUNDS), N)
     lo, hi = tg.FLIP_HEIGHT_BAND
     p.add("behavior_path", outside(end.p[2], hg + lo, hg + hi), N)
     for i, st in enumerate(p.states):
-        p.add("behavior_path", outside(st.R[:, 0], *tg.FLIP_XAXIS_BOUNDS), i)
+        p.add("behavior_path", outside(frame.rotation(st.R)[:, 0], *tg.FLIP_XAXIS_BOUNDS), i)
 
 
 def table_spot(p: Probe):

@@ -97,9 +97,10 @@ def flip_path(ctx) -> list:
                                           grill_height=hg, gravity=cell.gravity))
         blocks += release_blocks(ctx)
     (lo_n, hi_n), (lo_x, hi_x), band = tg.FLIP_NORMAL_BOUNDS, tg.FLIP_XAXIS_BOUNDS, tg.FLIP_HEIGHT_BAND
+    frame = task.frame()  # the end set is the paper's, along the scoop heading
     return blocks + [
-        KinematicBlock("flip_normal", L, "normal", [L.N], lo_n, hi_n),
-        KinematicBlock("flip_xaxis", L, "xaxis", range(1, L.n_nodes), lo_x, hi_x),
+        KinematicBlock("flip_normal", L, "normal", [L.N], lo_n, hi_n, frame=frame),
+        KinematicBlock("flip_xaxis", L, "xaxis", range(1, L.n_nodes), lo_x, hi_x, frame=frame),
         KinematicBlock("flip_height", L, "height", [L.N], hg + band[0], hg + band[1]),
     ]
 

@@ -19,10 +19,12 @@ from flipkit.model.orientation import rpy
 from flipkit.transcription.guess import bezier_guess, fit_guess
 
 
-def flip_guess_pose(cell: CellConfig, pb) -> tg.Pose:
-    """A pose inside the flip end set, used only to seed the initial guess."""
+def flip_guess_pose(cell: CellConfig, pb, heading: float = 0.0) -> tg.Pose:
+    """A pose inside the flip end set along the scoop ``heading`` (rad), used only to seed
+    the initial guess."""
     p = tg.pickup_end(cell, pb).p
-    return tg.Pose((p[0] + 0.02, p[1], cell.grill.height + 0.22), (-2.6, 0.0, 0.0))
+    pose = tg.Pose((p[0] + 0.02, p[1], cell.grill.height + 0.22), (-2.6, 0.0, 0.0))
+    return tg.headed(pose, pb, heading)
 
 
 def withdraw_then_home(L, robot, q_start, qd_start, T):
@@ -113,7 +115,7 @@ def end_pose_guess(ctx, T, pose):
 def flip_guess(ctx, T, pose):
     """A joint-space Bezier path to a pose in the flip's end set (:func:`flip_guess_pose`),
     the blade rolled over about its own axis (wrist 3 − 2.6 rad)."""
-    seed_pose = flip_guess_pose(ctx.cell, ctx.location)
+    seed_pose = flip_guess_pose(ctx.cell, ctx.location, ctx.task.heading)
     guess = ctx.q_start.copy()
     guess[-1] -= 2.6
     q_end = solve_pose(ctx.robot, seed_pose.p, seed_pose.o, guess)

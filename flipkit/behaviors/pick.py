@@ -43,16 +43,18 @@ def scoop_path(ctx) -> list:
     """The tip on the grill (eq. 24), pressed in, within ±SCOOP_TIP_BAND, on nodes 1..N−1;
     the blade straight under the burger (lateral and attitude bands). With q held to a
     degree-6 polynomial by the outputs (18), tip equalities on every node plus the end pose
-    and rest would leave a square, generically infeasible system: hence the band."""
+    and rest would leave a square, generically infeasible system: hence the band. The bands
+    are stated in the scoop heading's frame (:meth:`~flipkit.behaviors.spec.Task.frame`)."""
     L, hg, pb = ctx.layout, ctx.cell.grill.height, np.asarray(ctx.location)
-    inner = range(1, L.N)
+    frame, inner = ctx.task.frame(), range(1, L.N)
     tip = {"length": ctx.cell.spatula.length, "width": ctx.cell.spatula.width}
     band = np.array([np.inf, SCOOP_LATERAL_BAND, np.inf])
     ang = np.array([SCOOP_ANGLE_BAND, np.inf, SCOOP_ANGLE_BAND])
     return [KinematicBlock("scoop_tip", L, "tip_height", inner, hg - SCOOP_PRESS - SCOOP_TIP_BAND,
                            hg - SCOOP_PRESS + SCOOP_TIP_BAND, ctx=tip),
-            KinematicBlock("scoop_lateral", L, "position", inner, pb - band, pb + band),
-            KinematicBlock("scoop_attitude", L, "rpy", inner, -ang, ang)]
+            KinematicBlock("scoop_lateral", L, "position", inner, pb - band, pb + band,
+                           frame=frame),
+            KinematicBlock("scoop_attitude", L, "rpy", inner, -ang, ang, frame=frame)]
 
 
 def scoop_scenarios(segment, location, models,
@@ -103,13 +105,14 @@ def predict_on_blade(segment, task: Task, models, options) -> Task:
 GO_TO_BURGER = Subbehavior(
     "go_to_burger", duration=(0.3, 0.5), carries_burger=False, free_motion=True, end="rest",
     needs=("location",), floor=arrival_floor, approach=True, pressed=True, exempt=tool_at_grill,
-    path=approach_path, end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location),
+    path=approach_path,
+    end_pose=lambda ctx: tg.scoop_ready(ctx.cell, ctx.location, heading=ctx.task.heading),
     guess=approach_guess, role="approach", checks=(approach_tip,),
     doc="eq. (22): to the scoop's start, tip pressed into the grill before the burger")
 SCOOP = Subbehavior(
     "scoop", duration=(0.2, 0.6), carries_burger=False, end="rest", needs=("location",),
     floor=pressed_floor, pressed=True, exempt=tool_at_grill, path=scoop_path,
-    end_pose=lambda ctx: tg.scoop_end(ctx.cell, ctx.location),
+    end_pose=lambda ctx: tg.scoop_end(ctx.cell, ctx.location, heading=ctx.task.heading),
     cone=lambda ctx: tg.scoop_cone_nodes(ctx.cell, ctx.layout.N),
     guess=partial(task_path_guess, tip_pressed=True), after_solve=predict_on_blade,
     role="scoop", checks=(scoop_tip,),
@@ -117,6 +120,6 @@ SCOOP = Subbehavior(
 PICKUP = Subbehavior(
     "pickup", duration=(0.2, 0.25), carries_burger=True, end="moving", needs=("location",),
     floor=pressed_floor, pressed=True, exempt=tool_at_grill,
-    end_pose=lambda ctx: tg.pickup_end(ctx.cell, ctx.location),
+    end_pose=lambda ctx: tg.pickup_end(ctx.cell, ctx.location, ctx.task.heading),
     cone=lambda ctx: list(range(ctx.layout.n_nodes)), guess=task_path_guess,
     role="lift", doc="eq. (25): lift the burger 5 cm, tipped back")

@@ -22,6 +22,7 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
+from flipkit.model.task_frame import WORLD, TaskFrame
 
 END_CONDITIONS = ("rest", "home", "moving")  # at rest; at q_home at rest; moving (braking room)
 # What a segment is asked for by: where it comes down (approach), slides under the burger
@@ -51,6 +52,8 @@ class Task:
             segment that comes down to the grill (``Subbehavior.approach``) until its
             descent, e.g. above other burgers lying on the grill; ``None``: the segment's
             own floor.
+        heading: The scoop heading ψ (rad): the go to burger, scoop, pickup and flip run
+            along (cos ψ, sin ψ) (:mod:`flipkit.model.task_frame`); 0 is the paper's +x.
     """
 
     location: object = None
@@ -60,6 +63,14 @@ class Task:
     spot: object = None
     scenarios: tuple = ()
     approach_height: object = None
+    heading: float = 0.0
+
+    def frame(self) -> TaskFrame:
+        """The scoop heading's :class:`~flipkit.model.task_frame.TaskFrame` about the burger
+        (the world's for a task without a location)."""
+        if self.location is None:
+            return WORLD
+        return TaskFrame(self.heading, np.asarray(self.location, float)[:2])
 
     def blade_point(self) -> np.ndarray:
         """(x, y) (m) of the burger on the blade that the constraints use."""

@@ -12,10 +12,11 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.config.task import (FLIP_CONE_FRACTION, FLIP_HEIGHT_BAND,  # noqa: F401
-                                 FLIP_NORMAL_BOUNDS, FLIP_XAXIS_BOUNDS, PICKUP_OFFSET,
+                                 FLIP_NORMAL_BOUNDS, FLIP_XAXIS_BOUNDS, HEADING_LIMIT, PICKUP_OFFSET,
                                  PICKUP_PITCH, SCOOP_PITCH, SCOOP_PRESS, SCOOP_START_MARGIN)
 from flipkit.config.checks import real_vector
 from flipkit.errors import UnreachableError
+from flipkit.model.task_frame import TaskFrame
 
 
 @dataclass(frozen=True)
@@ -66,14 +67,44 @@ def check_location(cell: CellConfig, location) -> np.ndarray:
     return loc
 
 
-def scoop_ready(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
+def headed(pose: Pose, pb, heading: float) -> Pose:
+    """A pose stated along the paper's +x, turned by the scoop ``heading`` (rad) about the
+    burger ``pb`` (:class:`~flipkit.model.task_frame.TaskFrame`)."""
+    if heading == 0.0:
+        return pose
+    return Pose(*TaskFrame(heading, np.asarray(pb, float)[:2]).pose(pose.p, pose.o))
+
+
+def default_heading(cell: CellConfig, pb) -> float:
+    """The scoop heading (rad) a plan takes when none is given: radially outward from the
+    arm's base axis through the burger. Along it the base's turn and the tool's yaw move
+    together, so the wrists barely turn during the scoop; along the paper's +x at the grill's
+    near corner, the wrists must undo the base's turn as the blade slides
+    (``docs/heading.md``)."""
+    base = np.asarray(cell.robot.base_in_world, float)[:2, 3]
+    return float(math.atan2(pb[1] - base[1], pb[0] - base[0]))
+
+
+def check_heading(heading) -> float:
+    """A scoop heading (rad) as a float, or :class:`UnreachableError`: finite and within
+    ±:data:`~flipkit.config.task.HEADING_LIMIT` of the paper's +x (the flip's end set,
+    eq. 26, keeps the blade pointing away from the arm)."""
+    psi = real_vector("scoop heading", [heading], 1, "rad", UnreachableError)[0]
+    if abs(psi) > HEADING_LIMIT + 1e-12:
+        raise UnreachableError(f"scoop heading {math.degrees(psi):.1f} deg is outside "
+                               f"[-{math.degrees(HEADING_LIMIT):.0f}, "
+                               f"{math.degrees(HEADING_LIMIT):.0f}] deg of the world's +x")
+    return float(psi)
+
+
+def scoop_ready(cell: CellConfig, pb, press: float = SCOOP_PRESS, heading: float = 0.0) -> Pose:
     """End of go-to-burger / start of scoop (eqs. 22–23): tip :data:`SCOOP_START_MARGIN`
     before the burger's near edge, pressed ``press`` (m) into the grill (0: on its surface,
-    the paper's eq. 24)."""
+    the paper's eq. 24), along the scoop ``heading`` (rad)."""
     d, l, oy = cell.burger.diameter, cell.spatula.length, SCOOP_PITCH
     z = cell.grill.height - press  # on the grill (Table I's z differs from h_g by ≤ 1 mm)
     x = pb[0] - d / 2 - SCOOP_START_MARGIN - l / 2 * math.cos(oy)
-    return Pose((x, pb[1], z + l / 2 * math.sin(oy)), (0.0, oy, 0.0))
+    return headed(Pose((x, pb[1], z + l / 2 * math.sin(oy)), (0.0, oy, 0.0)), pb, heading)
 
 
 def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
@@ -96,14 +127,15 @@ def scoop_cone_nodes(cell: CellConfig, N: int) -> list[int]:
     return [int(i) for i in np.flatnonzero(s * s * (3 - 2 * s) >= covered - 1e-12)]
 
 
-def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS) -> Pose:
+def scoop_end(cell: CellConfig, pb, press: float = SCOOP_PRESS, heading: float = 0.0) -> Pose:
     """End of scoop (eq. 23): the blade centred under the burger, its tip pressed ``press``
     (m) into the grill and its back edge, the neck, on the grill's surface: pitched
     asin(press / l) tip down (1.1° for 3 mm on a 16 cm blade), the pose of a blade that
-    flexes from its neck (the paper's blade lies flat on the grill)."""
+    flexes from its neck (the paper's blade lies flat on the grill); heading ``heading`` (rad)."""
     hg, l = cell.grill.height, cell.spatula.length  # Table I's z differs from h_g by ≤ 1 mm
     pitch = math.asin(press / l)
-    return Pose((float(pb[0]), float(pb[1]), hg - press / 2), (0.0, pitch, 0.0))
+    return headed(Pose((float(pb[0]), float(pb[1]), hg - press / 2), (0.0, pitch, 0.0)), pb,
+                  heading)
 
 
 def tip_pressed(cell: CellConfig, tip_floor: float) -> np.ndarray:
@@ -115,9 +147,11 @@ def tip_pressed(cell: CellConfig, tip_floor: float) -> np.ndarray:
     return np.array([tip_floor, tip_floor, hg, hg])
 
 
-def pickup_end(cell: CellConfig, pb) -> Pose:
-    """End of pickup (eq. 25): 2 cm forward, 5 cm up, slightly tipped back."""
-    return Pose(tuple(float(pb[k] + PICKUP_OFFSET[k]) for k in range(3)), (0.0, PICKUP_PITCH, 0.0))
+def pickup_end(cell: CellConfig, pb, heading: float = 0.0) -> Pose:
+    """End of pickup (eq. 25): 2 cm forward (along the scoop ``heading``, rad), 5 cm up,
+    slightly tipped back."""
+    return headed(Pose(tuple(float(pb[k] + PICKUP_OFFSET[k]) for k in range(3)),
+                       (0.0, PICKUP_PITCH, 0.0)), pb, heading)
 
 
 def check_spot(cell: CellConfig, spot) -> np.ndarray:

@@ -22,7 +22,7 @@ import argparse
 
 from flipkit.behaviors.targets import check_table_spot
 from flipkit.cli.common import MAX_WORKERS, check_int, deferred
-from flipkit.cli.plan_inputs import batch_locations, burger, numbers, r_land, yaw
+from flipkit.cli.plan_inputs import batch_locations, burger, heading, numbers, r_land, yaw
 from flipkit.config import CellConfig
 from flipkit.errors import UnreachableError
 from flipkit.fileio import check_output, check_output_dir
@@ -80,6 +80,10 @@ def register(subparsers) -> None:
                    help="radius (m) of the landing disc about the spot, in [0.0001, 0.1] "
                         "(below 0.1 mm is within the landing's spread) "
                         "(default: the planner's R_LAND, which the package's atlas serves)")
+    f.add_argument("--heading", default=None, metavar="DEG",
+                   help="scoop heading (degrees from the world's +x, within +-60): the go to "
+                        "burger, scoop, pickup and flip run along it; default: radially outward "
+                        "from the arm's base, which the package's atlas serves")
     atlas_arguments(f)
     common(f)
     f.set_defaults(run=run_flip)
@@ -96,6 +100,10 @@ def register(subparsers) -> None:
                    help="start configuration Q1 .. Q6 (rad), default q_home; at rest, within "
                         "the joint limits, q3 and q5 on q_home's side of the elbow and wrist "
                         "singularities and 0.2 rad from them")
+    s.add_argument("--heading", default=None, metavar="DEG",
+                   help="scoop heading (degrees from the world's +x, within +-60): the go to "
+                        "burger, scoop, pickup run along it; default: radially outward "
+                        "from the arm's base, which the package's atlas serves")
     atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
     s.set_defaults(run=run_serve)
@@ -163,6 +171,7 @@ def run_flip(args: argparse.Namespace) -> int:
     args.land = None if args.land is None else numbers("--land", args.land, 2)
     args.r_land = None if args.r_land is None else r_land(args.r_land)
     args.start_q = _start_q(args.start_q)
+    args.heading = heading(args.heading)
     _atlas_file(args)
     return deferred("plan", "run_flip")(args)
 
@@ -178,6 +187,7 @@ def run_serve(args: argparse.Namespace) -> int:
     except UnreachableError as exc:
         raise UnreachableError(f"--table-spot: {exc}") from None
     args.start_q = _start_q(args.start_q)
+    args.heading = heading(args.heading)
     _atlas_file(args)
     return deferred("plan", "run_serve")(args)
 

@@ -12,11 +12,11 @@ from __future__ import annotations
 import csv
 import math
 
-from flipkit.behaviors.targets import check_burger_height
+from flipkit.behaviors.targets import check_burger_height, check_heading
 from flipkit.config.task import R_LAND_RANGE
 from flipkit.csv_header import header_columns
 from flipkit.decimal_text import decimal
-from flipkit.errors import ConfigError
+from flipkit.errors import ConfigError, UnreachableError
 from flipkit.fileio import InputFileError, data_lines, read_text
 from flipkit.planning.planners.inputs import MAX_BATCH, check_spacing
 
@@ -47,6 +47,18 @@ def yaw(value) -> float:
     """``--yaw`` (rad) wrapped to (−π, π]: 2π plans as 0."""
     y = numbers("--yaw", value)[0]
     return math.pi - (math.pi - y) % (2 * math.pi)
+
+
+def heading(value):
+    """``--heading DEG`` as the scoop heading (rad), within
+    :func:`~flipkit.behaviors.targets.check_heading`'s range; ``None`` (the default heading)
+    without one."""
+    if value is None:
+        return None
+    try:
+        return check_heading(math.radians(numbers("--heading", value)[0]))
+    except UnreachableError as exc:
+        raise UnreachableError(f"--heading: {exc}") from None
 
 
 def burger(values, cell) -> list[float]:

@@ -40,6 +40,10 @@ APPROACH_FRACTION = 0.2
 APPROACH_SLIDE_FRACTION = 0.1
 APPROACH_CLEARANCE = 0.005  # m
 APPROACH_LOW = 0.005  # m
+# The scoop heading ψ (flipkit.model.task_frame) lies within this of the world's +x: the
+# flip's end set (eq. 26) keeps the blade's x axis pointing away from the arm, and the grill's
+# area is seen from the base within −40° to +15°. Ours.
+HEADING_LIMIT = 1.0471975511965976  # rad (60°)
 SCOOP_LATERAL_BAND = 0.01  # m, |p_y − p^b_y| during the scoop: slide straight under it
 SCOOP_ANGLE_BAND = 0.05  # rad, |o_x|, |o_z| during the scoop: no yaw or roll that pushes it
 

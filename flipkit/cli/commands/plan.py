@@ -83,9 +83,9 @@ def run_flip(args: argparse.Namespace) -> int:
     q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, options, cell)
     plan = plan_flip(args.burger, q_start, cell=cell, solver=args.solver, land=args.land,
-                     options=options, atlas=atlas)
+                     options=options, atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
-    if atlas is not None:
+    if atlas is not None and args.heading is None:
         print(f"  warm start: atlas of {len(atlas)} locations")
     return _report(plan, args.json)
 
@@ -108,9 +108,9 @@ def run_serve(args: argparse.Namespace) -> int:
     q_start = _start_q(args.start_q, cell)
     atlas = _atlas(args, SegmentOptions(), cell)
     plan = plan_serve(args.burger, args.table_spot, q_start, cell=cell, solver=args.solver,
-                      atlas=atlas)
+                      atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
-    if atlas is not None:
+    if atlas is not None and args.heading is None:
         print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
     return _report(plan, args.json)
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import os
 import re
 import sys
@@ -71,12 +72,15 @@ def run(args: argparse.Namespace) -> int:
         if executor is None:
             planners = motions.cached_planners(planners)
         common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
-        lands = {}
+        lands, headings = {}, {}
         try:
             if args.policy == "cpsat":
-                timeline, lands = clear_cook(lambda lands: schedule_cook_cpsat(
-                    burgers, planners, cell.robot.q_home, **common, lands=lands,
-                    time_limit_s=args.time_limit, seed=args.seed), cell)
+                def cpsat(lands, headings):
+                    return schedule_cook_cpsat(burgers, planners, cell.robot.q_home, **common,
+                                               lands=lands, headings=headings,
+                                               time_limit_s=args.time_limit, seed=args.seed)
+
+                timeline, lands, headings = clear_cook(cpsat, cell)
             else:
                 timeline = schedule_cook(burgers, planners, cell.robot.q_home, **common,
                                          progress=not args.no_progress)
@@ -110,7 +114,9 @@ def run(args: argparse.Namespace) -> int:
         raise FlipkitError(f"{plans}: cannot write plans ({exc.strerror or exc})") from None
     doc = timeline.to_dict()
     doc["clearance"] = {"landings_moved": {b: [round(v, 4) for v in xy]
-                                           for b, xy in sorted(lands.items())}}
+                                           for b, xy in sorted(lands.items())},
+                        "headings_turned_deg": {b: round(math.degrees(psi), 2)
+                                                for b, psi in sorted(headings.items())}}
     if stream:
         doc["stream"] = stream_report(timeline, args.policy, args.stream,
                                       args.minutes).to_dict()
@@ -129,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
     late = doc["max_lateness_s"]
     # a failed plan leaves the schedule unjudged: the windows and the meetings are checked only
     # on a schedule of solved motions (clear_cook returns a failed one unchecked)
-    checks = (f"windows {args.windows.describe()} met; {_moved(lands)}" if timeline.ok else
+    checks = (f"windows {args.windows.describe()} met; {_moved(lands, headings)}" if timeline.ok else
               "windows and meetings with other burgers not checked: a motion failed to plan")
     print(f"flipkit schedule: {len(timeline.burgers)} burgers, {len(timeline.motions)} "
           f"motions ({'+'.join(kinds)}), {doc['status']}, policy {args.policy}"
@@ -208,11 +214,12 @@ def _modelled_stream(args, cell, atlas, executor, timeline_path: Path) -> int:
     return 0
 
 
-def _moved(lands: dict) -> str:
-    if not lands:
+def _moved(lands: dict, headings: dict) -> str:
+    if not lands and not headings:
         return "no motion meets another burger"
     return ("no motion meets another burger with " + ", ".join(
-        f"{b} landed at ({x:.3f}, {y:.3f})" for b, (x, y) in sorted(lands.items())))
+        [f"{b} landed at ({x:.3f}, {y:.3f})" for b, (x, y) in sorted(lands.items())]
+        + [f"{b} scooped at {math.degrees(psi):.0f} deg" for b, psi in sorted(headings.items())]))
 
 
 def _cpsat_why(solver: dict | None) -> str:

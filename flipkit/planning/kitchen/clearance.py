@@ -5,7 +5,7 @@ of a timeline against the burgers lying on the grill while it runs (known from t
 schedule: dropped, not yet lifted by their own motions), with the geometry of
 :mod:`flipkit.planning.kitchen.sweep`.
 
-:func:`clear_cook` then uses the one freedom the planners leave that changes who lies where:
+:func:`clear_cook` then uses two freedoms the planners leave. The first changes who lies where:
 **where a flip lands its burger** (``plan_flip(..., land=...)``; by default where it was
 picked up). A burger met where it landed is landed elsewhere; a serve that meets a burger
 (or a flip whose landing does) moves its own burger's landing, which moves where the serve
@@ -14,11 +14,15 @@ burger elsewhere, which changes the toss (up to two other spots). The new spot i
 nearest the burger's drop place that keeps clear, over the burger's stay on its second side,
 of every other motion's footprint and of every other burger, and from which its serve's
 footprint (the present one, moved with it) meets nobody.
-The cook is planned and scheduled again with the new spots and checked again. The scoop
-itself cannot be turned: the scoop subbehaviour slides the blade along +x at the burger
-(:mod:`flipkit.behaviors.targets`), so a scoop or pickup that meets a burger still lying where
-it was dropped, or a flip that still does from two other landing spots, cannot be avoided
-this way: the cook is refused (:class:`CookConflictError`).
+The cook is planned and scheduled again with the new spots and checked again.
+
+The second freedom is **the scoop heading of a flip** (``plan_flip(..., heading=...)``;
+by default radial from the base, :mod:`flipkit.model.task_frame`). A flip whose go to burger,
+scoop or pickup meets a burger still lying where it was dropped, or whose toss still does
+from two other landing spots, is turned (:class:`~flipkit.planning.kitchen.turns.Turns`): 15° then 30° away from
+the burger it meets, then toward it, within ±:data:`~flipkit.config.task.HEADING_LIMIT`. A
+flip turned every way and still meeting it, or whose plan fails at every heading tried, refuses the cook
+(:class:`CookConflictError`, naming the burger, the headings tried and the one it meets).
 """
 
 from __future__ import annotations
@@ -30,22 +34,19 @@ import numpy as np
 
 from flipkit.behaviors.library import PICKUP_AND_FLIP, SERVE
 from flipkit.config import CellConfig
-from flipkit.errors import FlipkitError
 from flipkit.model.robot import Robot
 from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
 from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
+from flipkit.planning.kitchen.turns import CookConflictError, Turns
 
-MAX_ROUNDS = 4  # plan-schedule-check rounds before a cook with meetings left is refused
+MAX_ROUNDS = 8  # plan-schedule-check rounds before a cook with meetings left is refused
+
 LOW_SEGMENTS = SERVE.before("carry")  # a serve's segments at the grill: they move with its burger
 TOSS_SEGMENTS = PICKUP_AND_FLIP.since("release")  # a flip's that change with its landing spot
 # Footprint samples tested at once against the candidate spots still in. Each test removes
 # most of them, so small chunks keep the later tests small (the five-burger cook's
 # free_landing: 2.0 s in chunks of 4, 2.9 s of 16, 2.8 s of 64, 2.3 s one sample at a time).
 CHUNK = 4
-
-
-class CookConflictError(FlipkitError):
-    """A motion of the cook would meet another burger and no landing spot avoids it."""
 
 
 def lying_burgers(timeline, cell: CellConfig | None = None,
@@ -224,40 +225,48 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
     """Schedule a cook whose motions meet no other burger.
 
     Args:
-        schedule: ``lands -> Timeline``: plans and schedules the cook with each burger of
-            ``lands`` (id -> (x, y) m) landed there by its flip (e.g.
-            :func:`~flipkit.planning.kitchen.optimal.schedule_cook_cpsat` with ``lands``).
+        schedule: ``(lands, headings) -> Timeline``: plans and schedules the cook with each
+            burger of ``lands`` (id -> (x, y) m) landed there by its flip and each of
+            ``headings`` (id -> rad) scooped along that heading (e.g.
+            :func:`~flipkit.planning.kitchen.optimal.schedule_cook_cpsat`).
         cell: The cell. margin: As :func:`~flipkit.planning.kitchen.sweep.meetings`.
         max_rounds: Plan-schedule-check rounds at most.
 
     Returns:
-        ``(timeline, lands)``: the first timeline without meetings (or one with a failed
-        plan, which the caller reports as such) and the landing spots it moved.
+        ``(timeline, lands, headings)``: the first timeline without meetings (or one with a
+        failed plan, which the caller reports as such), the landing spots it moved and the
+        scoop headings it turned.
 
     Raises:
-        CookConflictError: A meeting that no landing spot avoids (one line naming the
-            motion, the burger it meets and why it cannot be moved).
+        CookConflictError: A meeting that no landing spot or heading avoids (one line naming
+            the motion, the burger it meets and why it cannot be moved).
     """
     lands: dict[str, tuple] = {}
     tried: dict[str, list] = {}
+    turns = Turns(cell)
     fps = Footprints(cell)  # kept over the rounds: a plan made again is a new key
     for round_ in range(max_rounds + 1):
-        timeline = schedule(dict(lands))
-        failed = [b for b in lands if any(m.burger == b and m.kind == "flip" and not m.ok
-                                          for m in timeline.motions)]
+        timeline = schedule(dict(lands), dict(turns.headings))
+        flops = {m.burger for m in timeline.motions if m.kind == "flip" and not m.ok}
+        failed = [b for b in lands if b in flops]
         if failed:  # a flip that cannot land there: try the next spot
             for b in failed:
                 tried.setdefault(b, []).append(lands.pop(b))
             continue
+        unplanned = [b for b in turns.headings if b in flops]
+        if unplanned:  # a flip that cannot be planned at that heading: the next one
+            for b in unplanned:
+                turns.next(b, None, timeline, failed=True)
+            continue
         if not timeline.ok:
-            return timeline, lands
+            return timeline, lands, turns.headings
         found = cook_meetings(timeline, cell, fps, margin)
         if not found:
-            return timeline, lands
+            return timeline, lands, turns.headings
         if round_ == max_rounds:
             raise CookConflictError(f"{found[0][0].describe()}; still after {max_rounds} "
                                     f"rounds of moving landing spots")
-        move = []
+        move, turn = [], {}
         for meet, lie in found:
             kind, owner = meet.motion.split(":", 1)
             if lie.landed:
@@ -267,12 +276,13 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
                 # a flip's toss goes where it lands its burger: a toss that meets a burger
                 # still lying where it was dropped lands its own elsewhere (two spots tried)
                 who = owner
-            else:
-                raise CookConflictError(
-                    f"{meet.describe()}; burger {lie.burger} still lies where it was dropped "
-                    f"then, and the scoop's direction is fixed: drop them farther apart")
+            else:  # the scoop, or a toss moved twice: the flip is turned
+                turn.setdefault(owner, (meet, lie))
+                continue
             if who not in move:
                 move.append(who)
+        for owner, (meet, lie) in turn.items():
+            turns.next(owner, lie, timeline, meet=meet)
         for who in move:
             spot = free_landing(who, timeline, cell, fps, margin,
                                 exclude=tried.get(who, []) + ([lands[who]] if who in lands

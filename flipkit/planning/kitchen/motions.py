@@ -41,6 +41,9 @@ class MotionJob:
         table_spot: Serve only: the spot (x, y) (m) on the table; ``None`` for a flip.
         land: Flip only: where the flipped burger lands (x, y) (m); ``None``: where it was
             picked up (:mod:`flipkit.planning.kitchen.clearance` moves it out of the way).
+        heading: Flip only: the scoop heading (rad); ``None``: the default
+            (:func:`~flipkit.behaviors.targets.default_heading`;
+            :mod:`flipkit.planning.kitchen.clearance` turns it out of the way).
     """
 
     kind: str
@@ -48,13 +51,15 @@ class MotionJob:
     location: tuple
     table_spot: tuple | None = None
     land: tuple | None = None
+    heading: float | None = None
 
     @property
     def key(self) -> tuple:
         """What makes two jobs the same motion: every field, positions to 1e-9 m."""
         def r(v):
             return None if v is None else tuple(np.round(np.asarray(v, float), 9))
-        return (self.kind, self.burger, r(self.location), r(self.table_spot), r(self.land))
+        return (self.kind, self.burger, r(self.location), r(self.table_spot), r(self.land),
+                None if self.heading is None else round(float(self.heading), 9))
 
 
 @dataclass
@@ -138,14 +143,16 @@ def refused(job: MotionJob, q_start, exc: UnreachableError, t0: float) -> Planne
 def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                  ) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planners.planner.plan_flip` from ``q_start``, landing
-    at the job's ``land`` (default where the burger was picked up), coming in above the other
+    at the job's ``land`` (default where the burger was picked up), scooping along the job's
+    ``heading`` (default the radial one), coming in above the other
     burgers on the grill (:func:`~flipkit.planning.kitchen.sweep.approach_height`),
     warm-started from ``atlas`` if given."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         try:
             p = plan_flip(job.location, q_start, cell=cell, solver=solver, land=job.land,
-                          atlas=atlas, approach_height=approach_height(cell or CellConfig()))
+                          atlas=atlas, approach_height=approach_height(cell or CellConfig()),
+                          heading=job.heading)
         except UnreachableError as exc:
             return refused(job, q_start, exc, t0)
         return from_plan(p, "flip", time.perf_counter() - t0)

@@ -44,7 +44,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
                         windows: Windows = Windows(), dwell_s: float = DWELL_S,
                         plan_start: float | None = None, time_limit_s: float = 10.0,
                         workers: int = 1, seed: int = 0, relax: str = "max",
-                        lands: Mapping | None = None) -> Timeline:
+                        lands: Mapping | None = None,
+                        headings: Mapping | None = None) -> Timeline:
     """Plan every motion of a cook order from rest, then schedule them with CP-SAT.
 
     Args:
@@ -55,6 +56,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             :func:`~flipkit.planning.kitchen.cpsat_process.solve_schedule`.
         lands: Burger id -> where its flip lands it (x, y) (m); a burger not in it lands
             where it was picked up.
+        headings: Burger id -> its flip's scoop heading (rad); a burger not in it gets the
+            default heading.
 
     Returns:
         The timeline (``policy`` :data:`CPSAT`; ``solver``: status, objectives, wall time).
@@ -93,7 +96,8 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
 
     flips = [MotionJob("flip", b.burger, b.location(cell),
                        land=None if (lands or {}).get(b.burger) is None
-                       else tuple(lands[b.burger])) for b in order]
+                       else tuple(lands[b.burger]),
+                       heading=(headings or {}).get(b.burger)) for b in order]
     for job in flips:  # planners that plan ahead start every flip now
         getattr(planners, "prefetch", lambda job: None)(job)
     for b, job in zip(order, flips):

@@ -50,6 +50,10 @@ SEEDED = FLIP_NAMES  # the atlas holds every segment of the pickup-and-flip
 # "shift": q(t) = q_atlas(t) + (q_start − q_atlas(0)) (the flip's free end moves with its
 # start); "blend": the offset fades out by a smoothstep (the turn back ends at q_home).
 ANCHORED = {s.name: s.atlas_anchor for s in PICKUP_AND_FLIP.steps if s.atlas_anchor}
+# The atlas's plans take each location's default scoop heading (radial from the base,
+# flipkit.behaviors.targets.default_heading); the hash names the rule, so an atlas built
+# with another one is refused as stale.
+HEADING_RULE = "radial"
 K_NEAREST = 4
 BRANCH_TOL = 0.5  # rad: entries whose joint path departs more from the nearest one's are left out
 DEFAULT_NAME = "atlas.npz"
@@ -61,13 +65,14 @@ def default_path() -> Path:
 
 
 def options_hash(cell: CellConfig, options: SegmentOptions) -> str:
-    """SHA-256 of the cell and transcription options (canonical JSON): equal hashes, same NLPs.
+    """SHA-256 of the cell, the heading rule and the transcription options (canonical JSON):
+    equal hashes, same NLPs.
     The simulation's numerical settings (:data:`flipkit.config.physics.SIMULATION_ONLY`) are
     left out: no NLP depends on them."""
     record = dataclasses.asdict(cell)
     for name in SIMULATION_ONLY:
         record["physics"].pop(name)
-    text = json.dumps({"format": FORMAT, "cell": record,
+    text = json.dumps({"format": FORMAT, "cell": record, "heading": HEADING_RULE,
                        "options": dataclasses.asdict(options)}, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode()).hexdigest()
 

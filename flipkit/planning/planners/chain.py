@@ -248,7 +248,7 @@ class Planner:
                 task = spec.after_solve(seg, task, self.models, self.options)
             q, qd = seg.q[-1], seg.qd[-1]
         plan = Plan.from_segments(behavior.name, self.cell, segments, location=task.location,
-                                  cone=self.options.cone, status="failed")
+                                  heading=task.heading, cone=self.options.cone, status="failed")
         return finish_plan(plan, failure, t0, self.cell)
 
     def _solve(self, spec, task: Task, q, qd, stretch: bool, guess):

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from flipkit.behaviors.targets import check_heading, default_heading
 from flipkit.config import CellConfig
 from flipkit.config.checks import real_number, real_vector
 from flipkit.errors import AtlasError, ConfigError, UnreachableError, brief
@@ -139,6 +140,18 @@ def check_approach_height(height) -> float | None:
     if h < 0:
         raise ConfigError(f"approach_height must be a finite height >= 0 m, got {height!r}")
     return h
+
+
+def resolve_heading(cell: CellConfig, pb, heading) -> tuple[float, bool]:
+    """The scoop heading (rad) of a plan at ``pb`` and whether it is the default one (the
+    atlas holds plans at the default heading only): ``heading`` checked
+    (:func:`~flipkit.behaviors.targets.check_heading`), or ``None`` for the default
+    (:func:`~flipkit.behaviors.targets.default_heading`)."""
+    default = default_heading(cell, pb)
+    if heading is None:
+        return default, True
+    psi = check_heading(heading)
+    return psi, abs(psi - default) < 1e-9
 
 
 def check_replan(plan, behavior: str, on_blade) -> tuple:

@@ -39,7 +39,7 @@ from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
-from flipkit.planning.planners.inputs import (MAX_BATCH, check_approach_height,
+from flipkit.planning.planners.inputs import (MAX_BATCH, check_approach_height, resolve_heading,
                                               check_joint_vector, check_on_blade,
                                               check_position, check_replan, check_start)
 from flipkit.planning.plans.plan_file import Plan
@@ -107,7 +107,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
               solver: str = "auto", land=None, on_blade=None,
               options: SegmentOptions = SegmentOptions(), atlas=None,
-              approach_height=None) -> Plan:
+              approach_height=None, heading=None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.behaviors.library.FLIP_NAMES` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -129,6 +129,10 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         approach_height: Height (m) above the grill that the go to burger keeps the blade's
             edges until its descent (over other burgers lying on the grill,
             :mod:`flipkit.behaviors.approach`); ``None`` (default): the approach's own floor.
+        heading: The scoop heading ψ (rad, :mod:`flipkit.model.task_frame`): the go to
+            burger, scoop, pickup and flip run along (cos ψ, sin ψ); ``None`` (default):
+            radially outward from the arm's base (:func:`~flipkit.behaviors.targets.default_heading`).
+            The atlas seeds the default heading only.
 
     Returns:
         The plan. On a segment failure the chain stops there: the plan holds the segments
@@ -147,11 +151,12 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     pb = tg.check_location(cell, location)
     spot = None if land is None else tg.check_spot(cell, land)
     on_blade = None if on_blade is None else check_on_blade(on_blade, cell)
+    psi, seeded = resolve_heading(cell, pb, heading)
     q, qd = check_start(planner.models.bare, q_start, qd_start)
     task = Task(location=pb, land=spot, on_blade=on_blade,
-                approach_height=check_approach_height(approach_height))
+                approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("flip", task, q, qd,
-                         guess=seeding(atlas, pb), t0=t0)
+                         guess=seeding(atlas, pb) if seeded else None, t0=t0)
 
 
 def covers(landing: dict, on_blade) -> bool:
@@ -258,6 +263,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
         return nlp.layout.pack(s.q, s.qd, s.qdd, s.u, s.alpha, s.T)
 
     task = Task(location=np.asarray(plan.burger["location"], float),
+                heading=plan.burger["heading"],
                 land=np.asarray(flip.landing["target"]), on_blade=on_blade,
                 scenarios=sensed_scenarios(cell, on_blade, sensing) if robust else ())
     return planner.chain("flip", task, done[-1].q[-1], done[-1].qd[-1], done=done, guess=own,

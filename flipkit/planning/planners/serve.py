@@ -26,14 +26,14 @@ from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import (check_approach_height, check_on_blade,
-                                              check_replan, check_start)
+                                              check_replan, check_start, resolve_heading)
 from flipkit.planning.plans.plan_file import Plan
 
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
                solver: str = "auto", on_blade=(0.0, 0.0),
                options: SegmentOptions = SegmentOptions(), atlas=None,
-               approach_height=None) -> Plan:
+               approach_height=None, heading=None) -> Plan:
     """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
     22–25), carry with the friction cone throughout, place by a tilt-off, return home.
 
@@ -56,6 +56,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             and ``options``: go to burger, scoop and pickup (the flip's first three
             segments, the same NLPs) start from its interpolated solutions, carry, place
             and return home from their own guesses; ``None`` (default): cold starts.
+        heading: The scoop heading (rad), as :func:`~flipkit.planning.planners.planner.plan_flip`.
         approach_height: As :func:`~flipkit.planning.planners.planner.plan_flip`.
 
     Returns:
@@ -85,10 +86,11 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
         except UnreachableError as exc:
             raise UnreachableError(f"table spot ({spot[0]:.3f}, {spot[1]:.3f}): {what}: "
                                    f"{exc}") from None
+    psi, seeded = resolve_heading(cell, pb, heading)
     task = Task(location=pb, spot=spot, on_blade=on_blade,
-                approach_height=check_approach_height(approach_height))
+                approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("serve", task, q, qd,
-                         guess=seeding(atlas, pb), t0=t0)
+                         guess=seeding(atlas, pb) if seeded else None, t0=t0)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
@@ -115,7 +117,7 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
     planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone))
     done = [s for s in plan.segments if s.name in SERVE.kept()]
     task = Task(location=np.asarray(plan.burger["location"], float), spot=table_spot(plan),
-                on_blade=on_blade)
+                on_blade=on_blade, heading=plan.burger["heading"])
     return planner.chain("serve", task, done[-1].q[-1], done[-1].qd[-1], done=done, t0=t0)
 
 

@@ -124,7 +124,8 @@ class Plan:
             carries; each segment names the ones its dynamics carry (``Segment.payload``).
         gravity: (3,) m/s². grill_height: h_g (m). spatula: ``length``, ``width`` (m).
         burger: ``location`` p^b (3,) m or None, ``diameter``, ``thickness`` (m), ``mass``
-            (kg), ``mu``. cone: Friction-cone form. segments: The :class:`Segment` list.
+            (kg), ``mu``, ``heading``: the scoop heading (rad; 0, the world's +x, in a file
+            written without it). cone: Friction-cone form. segments: The :class:`Segment` list.
         created_by: ``{"flipkit": version, "git": commit or None}``. format: the file's
             format (one of :data:`FORMATS`; written as :data:`FORMAT`).
         report: The planner's :class:`~flipkit.planning.plans.verify_report.VerificationReport`
@@ -186,10 +187,13 @@ class Plan:
                                   f"grill_height {self.grill_height}")
         self.spatula = {k: check_number(f"spatula.{k}", v, positive=True)
                         for k, v in check_keys(self.spatula, "spatula", ("length", "width")).items()}
-        b = check_keys(self.burger, "burger", _BURGER_KEYS)
+        raw_burger = self.burger
+        b = check_keys(raw_burger, "burger", _BURGER_KEYS)
         self.burger = {k: check_number(f"burger.{k}", b[k], positive=True) for k in _BURGER_KEYS[1:]}
         self.burger["location"] = None if b["location"] is None else check_array(
             "burger.location", b["location"], (3,))
+        heading = raw_burger.get("heading", 0.0) if isinstance(raw_burger, dict) else 0.0
+        self.burger["heading"] = check_number("burger.heading", heading)
         self._check_segments()
 
     @staticmethod
@@ -240,7 +244,8 @@ class Plan:
     # ------------------------------------------------------------------ building
     @classmethod
     def from_segments(cls, behavior: str, cell: CellConfig, segments: list, *, location=None,
-                      cone: str = "physical", status: str | None = None) -> "Plan":
+                      heading: float = 0.0, cone: str = "physical",
+                      status: str | None = None) -> "Plan":
         """A plan of ``segments`` planned in ``cell``; status ``solved`` if every segment's
         solver says so (check it with :func:`flipkit.planning.plans.verify.verify_plan` before writing)."""
         robot = Robot(cell, with_burger=True)
@@ -257,7 +262,8 @@ class Plan:
             np.asarray(cell.gravity, float), cell.grill.height,
             {"length": cell.spatula.length, "width": cell.spatula.width},
             {"location": None if location is None else list(location),
-             **{k: getattr(cell.burger, k) for k in _BURGER_KEYS[1:]}}, cone, list(segments),
+             **{k: getattr(cell.burger, k) for k in _BURGER_KEYS[1:]}, "heading": float(heading)},
+            cone, list(segments),
             cell_geometry=cell_geometry(cell))
 
     def cell(self) -> CellConfig:
@@ -400,7 +406,8 @@ class Plan:
                "gravity": self.gravity.tolist(), "grill_height": self.grill_height,
                "spatula": dict(self.spatula),
                "burger": {"location": None if loc is None else loc.tolist(),
-                          **{k: self.burger[k] for k in _BURGER_KEYS[1:]}},
+                          **{k: self.burger[k] for k in _BURGER_KEYS[1:]},
+                          "heading": self.burger["heading"]},
                "cone": self.cone, "segments": [s.to_json() for s in self.segments]}
         if self.cell_geometry is not None:
             doc["cell_geometry"] = self.cell_geometry

@@ -189,7 +189,8 @@ def _probe(report, k, seg, robot, plan, cell, states, tol) -> Probe:
     placing, landing = seg.placing or {}, seg.landing or {}
     pb = plan.burger["location"]
     on_blade = placing.get("on_blade", landing.get("burger_on_blade"))
-    task = Task(location=pb, goal=seg.goal, spot=placing.get("spot"), on_blade=on_blade)
+    task = Task(location=pb, goal=seg.goal, spot=placing.get("spot"), on_blade=on_blade,
+                heading=plan.burger["heading"])
     options = RecordedOptions(landing=seg.release is not None,
                               release=seg.release["node"] if seg.release else 0)
     return Probe(SUBBEHAVIORS[seg.name], seg, Layout(robot.nq, seg.N), cell, task,

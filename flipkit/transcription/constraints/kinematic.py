@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from flipkit.errors import InvalidChoiceError
+from flipkit.model.task_frame import WORLD, TaskFrame
 from flipkit.transcription.constraints.base import Block
-from flipkit.transcription.constraints.quantities import QUANTITIES
+from flipkit.transcription.constraints.quantities import QUANTITIES, framed
 from flipkit.transcription.constraints.registry import Check
 
 
@@ -31,15 +32,19 @@ class KinematicBlock(Block):
             :class:`~flipkit.transcription.constraints.quantities.Cone`).
         nodes: Node indices. lo, hi: Bounds, broadcast to (len(nodes), size).
         scale: Row scale. ctx: Geometry the quantity needs (blade length, width).
+        frame: The :class:`~flipkit.model.task_frame.TaskFrame` the quantity is seen in
+            (the scoop heading's); default the world's.
     """
 
-    def __init__(self, name, layout, quantity, nodes, lo, hi, scale=1.0, ctx=None):
+    def __init__(self, name, layout, quantity, nodes, lo, hi, scale=1.0, ctx=None,
+                 frame: TaskFrame = WORLD):
         super().__init__(name, layout)
         if isinstance(quantity, str):
             if quantity not in QUANTITIES:
                 raise InvalidChoiceError("spatula quantity", quantity, QUANTITIES)
             quantity = QUANTITIES[quantity]()
         self.quantity, self.nodes, self.ctx = quantity, [int(i) for i in nodes], ctx or {}
+        self.frame = frame
         point = getattr(quantity, "point", None)
         self.points = () if point is None else (tuple(float(c) for c in point),)
         self._point = self.points[0] if self.points else None
@@ -65,7 +70,8 @@ class KinematicBlock(Block):
     def evaluate(self, ev):
         if not self.nodes:
             return np.zeros(0), np.zeros(0)
-        out = self.quantity.batch(ev.states(self._index, self._point), self.ctx)
+        st = self.frame.state(ev.states(self._index, self._point))
+        out = self.quantity.batch(st, self.ctx)
         # ∂/∂q, ∂/∂q̇, ∂/∂q̈ side by side per row
         jac = np.concatenate(out[1:], axis=-1) if len(out) > 2 else out[1]
         return np.ravel(out[0]), np.ravel(jac)
@@ -75,6 +81,7 @@ class KinematicBlock(Block):
         point = getattr(self.quantity, "point", None)
         for r, i in enumerate(self.nodes):
             s = acc.stage_of(i)
-            value = self.quantity.symbolic(acc.kinematics(i, s, point), self.ctx)
+            k_i = framed(acc.kinematics(i, s, point), self.frame)
+            value = self.quantity.symbolic(k_i, self.ctx)
             out.append((s, value, np.arange(r * k, (r + 1) * k)))
         return out

@@ -9,6 +9,8 @@ check is its block's (:mod:`flipkit.transcription.constraints.registry`).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import casadi as ca
 import numpy as np
 
@@ -24,6 +26,18 @@ def rpy(R: ca.SX) -> ca.SX:
     ``rpy.matrixToRpy`` away from o_y = ±π/2 (its gimbal-lock branch is not used)."""
     m = ca.sqrt(R[2, 1] ** 2 + R[2, 2] ** 2)
     return ca.vertcat(ca.atan2(R[2, 1], R[2, 2]), ca.atan2(-R[2, 0], m), ca.atan2(R[1, 0], R[0, 0]))
+
+
+def framed(k, frame):
+    """Symbolic kinematics (:class:`~flipkit.model.casadi_dynamics.Kinematics`) seen in a
+    :class:`~flipkit.model.task_frame.TaskFrame`: positions turned about its centre, vectors
+    and the rotation turned by −ψ (the numeric counterpart is ``TaskFrame.state``)."""
+    if frame.identity:
+        return k
+    A = ca.DM(frame.rotation(np.eye(3)))
+    c = ca.DM([*frame.centre, 0.0])
+    return replace(k, p=A @ (k.p - c) + c, R=A @ k.R, v=A @ k.v, a=A @ k.a, w=A @ k.w,
+                   dw=A @ k.dw)
 
 
 def _blade_height(k, r) -> ca.SX:
