@@ -48,7 +48,7 @@ paper: $(STAMP)
 	cd paper && latexmk -pdf -interaction=nonstopmode -halt-on-error main.tex
 
 bench: $(STAMP)
-	$(PY) -m flipkit.experiments.bench translate
+	$(PY) -m bench.bench translate
 
 # Regenerate the lock from requirements.in (needs uv: pip install uv).
 lock:

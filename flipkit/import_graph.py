@@ -4,7 +4,9 @@ Every import statement counts, at module level and inside functions alike (a laz
 that runs is still a dependency); imports under ``if TYPE_CHECKING:`` are marked
 ``typing_only`` and left out of :func:`import_graph`. Names loaded by ``importlib`` from a
 string (``flipkit.__getattr__``) are not seen. ``tests/test_layers.py`` checks the layer
-rules on this graph; :mod:`flipkit.figures.inputs` hashes the sources a notebook imports.
+rules on this graph, and (with :func:`external_imports`) that importing the core
+(:mod:`flipkit.extras`) imports only the core's dependencies; :mod:`flipkit.figures.inputs`
+hashes the sources a notebook imports.
 """
 
 from __future__ import annotations
@@ -125,6 +127,23 @@ def flipkit_imports(path: Path, root: Path = PACKAGE,
     path = Path(path)
     return source_imports(path.read_text(), module_name(path, root), path.name == "__init__.py",
                           root, modules)
+
+
+def external_imports(path: Path) -> list[tuple[int, str, bool]]:
+    """(line, top-level name, inside a function) of every import of a package other than
+    flipkit in the file (``import a.b`` and ``from a.b import c``: ``a``); relative imports
+    and ``TYPE_CHECKING`` imports are left out."""
+    out = []
+    for node, local, typing_only in import_statements(ast.parse(Path(path).read_text())):
+        if typing_only:
+            continue
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            names = [node.module] if node.module and not node.level else []
+        out += [(node.lineno, n.split(".")[0], local) for n in names
+                if n.split(".")[0] != PACKAGE.name]
+    return out
 
 
 def local_imports(path: Path) -> list[int]:

@@ -44,7 +44,7 @@ def edge_heights(cell, p, R):
 
 def test_all_five_subbehaviours_run(benign):
     """(Their EE and IK times against the paper's < 1 s: ``python -m
-    flipkit.experiments.bench flip --baseline``.)"""
+    bench.bench flip --baseline``.)"""
     assert [s.subbehavior for s in benign.segments] == list(FLIP_NAMES)
     assert len(benign.trajectories) == len(benign.tracks) == 5
     for seg, traj in zip(benign.segments, benign.trajectories):
@@ -55,7 +55,7 @@ def test_all_five_subbehaviours_run(benign):
 def test_the_bench_reports_the_ee_and_ik_times(cell, capsys):
     """The EE optimisation and IK times, against the paper's < 1 s, are the bench's to print
     (``bench flip --baseline``): one per subbehaviour run, with each EE method."""
-    from flipkit.experiments.bench import _bench_baseline
+    from bench.bench import _bench_baseline
 
     out = _bench_baseline(cell, [BENIGN])
     assert set(out) == set(EE_METHODS)

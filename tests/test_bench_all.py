@@ -1,9 +1,9 @@
-"""The one-run summary of the benches (flipkit.experiments.bench_all)."""
+"""The one-run summary of the benches (bench/bench_all.py)."""
 
 from pytest import approx
 
-from flipkit.experiments.bench import sqp_ratio
-from flipkit.experiments.bench_all import print_summary, summarise
+from bench.bench import sqp_ratio
+from bench.bench_all import print_summary, summarise
 
 
 def _translate(times, cpus, solved):

@@ -3,8 +3,8 @@ the machine it ran on."""
 
 from pathlib import Path
 
-from flipkit.experiments.bench import TRANSLATE_SOLVERS
-from flipkit.experiments.iteration_notes import ITERATION_RATIO, iteration_notes
+from flipkit.experiments.speed import TRANSLATE_SOLVERS
+from bench.iteration_notes import ITERATION_RATIO, iteration_notes
 
 
 def _row(iterations, profile):
@@ -41,7 +41,7 @@ def test_the_machine_line_names_the_cpu_and_its_simd_kernels():
     loops use AVX-512, on which the last bits of a plan depend."""
     from numpy._core._multiarray_umath import __cpu_features__
 
-    from flipkit.experiments import bench
+    from bench import bench
 
     line = bench.machine()
     assert line.startswith("machine: ") and "Python " in line

@@ -86,7 +86,7 @@ def test_the_replan_keeps_the_plan_uses_a_contingency_or_solves(flip_plan, side)
 
 
 def test_bench_replan_times_the_replan_with_and_without_contingencies(capsys):
-    from flipkit.experiments.bench_replan import bench_replan
+    from bench.bench_replan import bench_replan
 
     loc, x0 = [0.69, -0.16, 0.072], 0.036
     result = {"locations": [{"location": loc, "landings": [
@@ -107,7 +107,7 @@ def test_bench_replan_times_the_replan_with_and_without_contingencies(capsys):
 def test_bench_replan_records_a_place_off_the_blade_as_refused(capsys):
     """A sensed place past the blade's edge is refused by the planner: the bench records and
     counts it apart instead of stopping, and times the others."""
-    from flipkit.experiments.bench_replan import bench_replan
+    from bench.bench_replan import bench_replan
 
     result = {"locations": [{"location": [0.69, -0.16, 0.072], "landings": [
         {"replan": {"sensed_on_blade": [0.083, 0.0]}},

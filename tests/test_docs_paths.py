@@ -1,8 +1,9 @@
 """The docs name what the code has.
 
 * Every module path (``flipkit.x.y``, ``flipkit.x.y.Name``, or a dotted path inside the
-  package such as ``planning.plans.verify``) and every repository file named in
-  ``docs/*.md``, ``README.md`` and ``notebooks/README.md`` exists.
+  package such as ``planning.plans.verify``), every module run with ``python -m`` (the
+  benchmarks: ``bench.bench``) and every repository file named in ``docs/*.md``,
+  ``README.md``, ``notebooks/README.md`` and ``bench/README.md`` exists.
 * ``docs/adding-a-behaviour.md`` quotes the code: its declarations are the code's, and the
   numbers in its prose are the code's.
 * ``notebooks/README.md`` lists every notebook, and every notebook names the project's kernel.
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import importlib.util
 import json
 import os
 import re
@@ -24,7 +26,8 @@ import flipkit
 
 REPO = Path(flipkit.__file__).resolve().parents[1]
 PACKAGE = REPO / "flipkit"
-DOCS = sorted((REPO / "docs").glob("*.md")) + [REPO / "README.md", REPO / "notebooks" / "README.md"]
+DOCS = sorted((REPO / "docs").glob("*.md")) + [REPO / "README.md", REPO / "notebooks" / "README.md",
+                                               REPO / "bench" / "README.md"]
 
 # The subpackages and top-level modules of flipkit: a dotted name in a code span that starts
 # with one of them (``planning.plans.verify``) is a path inside the package.
@@ -32,6 +35,7 @@ TOP_NAMES = sorted({p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__"
                    | {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()})
 CODE_SPAN = re.compile(r"(`+)([^`\n]+?)\1")
 LINK = re.compile(r"\]\(([^)\s]+)\)")
+RUN_MODULE = re.compile(r"python -m ([A-Za-z_][\w.]*)")
 DOTTED = re.compile(r"(?<![\w.])(flipkit(?:\.[A-Za-z_]\w*)+)")
 SHORT_DOTTED = re.compile(r"(?:%s)(?:\.[A-Za-z_]\w*)+" % "|".join(TOP_NAMES))
 FILE_SUFFIXES = (".py", ".md", ".json", ".csv", ".npz", ".ipynb", ".tex", ".toml", ".txt",
@@ -115,6 +119,18 @@ def resolves(dotted: str) -> bool:
     return True
 
 
+def runs_a_module(dotted: str, root: Path = REPO) -> bool:
+    """``python -m dotted`` from the repository's root finds a module: one of flipkit's, a
+    module file or package of the repository (``bench.bench``), or an installed one."""
+    if dotted.split(".")[0] == "flipkit":
+        return resolves(dotted)
+    stem = root.joinpath(*dotted.split("."))
+    if stem.with_suffix(".py").is_file() or (stem / "__main__.py").is_file():
+        return True
+    return dotted.split(".")[0] not in {p.name for p in root.iterdir()} and (
+        importlib.util.find_spec(dotted.split(".")[0]) is not None)
+
+
 def file_paths(text: str) -> tuple[set[str], set[str]]:
     """(code spans that look like a path, relative link targets) in ``text``."""
     spans = set()
@@ -146,6 +162,8 @@ def dead_paths(doc: Path, root: Path = REPO) -> list[str]:
     dead += [f"{where}: file {p}" for p in sorted(spans)
              if p not in NOT_REPO_FILES and not names_a_file(p)]
     dead += [f"{where}: link {p}" for p in sorted(links) if not (doc.parent / p).exists()]
+    dead += [f"{where}: python -m {m}" for m in sorted(set(RUN_MODULE.findall(text)))
+             if not runs_a_module(m, root)]
     return dead
 
 
@@ -160,12 +178,14 @@ def test_a_dead_path_is_found(tmp_path):
     doc.write_text("`planning.chain.Planner`, `flipkit.planning.planners.chain.Plannr`, "
                    "`flipkit/planning/verify.py`, `plans/nowhere.py`, [a](missing.md), "
                    "`flipkit.planning.planners.chain.Planner`, `planning/plans/verify.py`, "
-                   "`behaviors.spec.Subbehavior.duration`, `verify*.py`, `flipkit-plan/2`")
+                   "`behaviors.spec.Subbehavior.duration`, `verify*.py`, `flipkit-plan/2`, "
+                   "`python -m bench.nowhere`, `python -m pytest`, `python -m flipkit.nowhere`")
+    (tmp_path / "bench").mkdir()
     found = [d.split(": ", 1)[1] for d in dead_paths(doc, root=tmp_path)]
-    assert found == ["module flipkit.planning.chain.Planner",
+    assert found == ["module flipkit.nowhere", "module flipkit.planning.chain.Planner",
                      "module flipkit.planning.planners.chain.Plannr",
                      "file flipkit/planning/verify.py", "file plans/nowhere.py",
-                     "link missing.md"]
+                     "link missing.md", "python -m bench.nowhere", "python -m flipkit.nowhere"]
 
 
 def test_citing_names_only_config_keys_the_macros_define():
@@ -210,6 +230,27 @@ def test_adding_a_behaviour_numbers_are_the_codes():
     assert f'"carry", duration={SUBBEHAVIORS["carry"].duration!r}' in text
     limits = {float(v) for v in re.findall(r"(\d+(?:\.\d+)?) rad/s²", text)}
     assert limits == {CellConfig().robot.accel_limit}
+
+
+def test_adding_a_behaviour_names_and_counts_are_the_codes():
+    """The constants the page names exist, and the serve is what the page says: its first
+    three steps are the flip's, its last three declared in ``flipkit/behaviors/table.py``."""
+    from flipkit.behaviors import table
+    from flipkit.behaviors.library import BEHAVIORS
+
+    text = ADDING.read_text(encoding="utf-8")
+    constants = {span for span in code_spans(text) if re.fullmatch(r"[A-Z][A-Z0-9_]+", span)}
+    assigned = {t.id for path in PACKAGE.rglob("*.py")
+                for node in ast.parse(path.read_text(encoding="utf-8")).body
+                if isinstance(node, (ast.Assign, ast.AnnAssign))
+                for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                if isinstance(t, ast.Name)}
+    assert {"FLIP_TOOL_FRACTION", "GO_TO_BURGER", "SCOOP", "PICKUP"} <= constants
+    assert constants <= assigned, constants - assigned
+    serve, flip = BEHAVIORS["serve"].steps, BEHAVIORS["flip"].steps
+    assert "Its first three\nsegments are the flip's" in text and "Its last three" in text
+    assert serve[:3] == flip[:3] and len(serve) == 6
+    assert all(any(step is v for v in vars(table).values()) for step in serve[3:])
 
 
 def test_a_changed_bound_is_not_the_code():

@@ -111,15 +111,15 @@ def test_the_code_digest_covers_every_package_file_and_the_lock(tmp_path):
     (pkg / "data" / "atlas.json").write_text("{}")
     lock = tmp_path / "environment.lock"
     lock.write_text("numpy==2.0\n")
-    seen = {inputs.code_digest(pkg, lock)}
+    seen = {inputs.code_digest(lock, pkg)}
     for path, text in ((pkg / "sim.py", "STEP = 2\n"), (pkg / "data" / "atlas.json", "[]"),
                        (lock, "numpy==2.1\n"), (pkg / "new.py", "")):
         path.write_text(text)
-        seen.add(inputs.code_digest(pkg, lock))
+        seen.add(inputs.code_digest(lock, pkg))
     assert len(seen) == 5
     (pkg / "__pycache__").mkdir()
     (pkg / "__pycache__" / "sim.cpython-311.pyc").write_bytes(b"\0")
-    assert inputs.code_digest(pkg, lock) in seen
+    assert inputs.code_digest(lock, pkg) in seen
 
 
 def test_sweep_cache_keeps_only_the_current_version(tmp_path):
@@ -159,7 +159,7 @@ def two_notebooks(tmp_path, monkeypatch):
             notebooks / f"{name}.ipynb")
     calls = {}
 
-    def fake_execute(notebook, executed, parameters, kernel):
+    def fake_execute(notebook, executed, parameters, kernel, cwd):
         fig_id, out = Path(notebook).stem, Path(parameters["out_dir"])
         (out / f"{fig_id}.pdf").write_bytes(b"figure")
         (out / f"{fig_id}.json").write_text(json.dumps({"files": [f"{fig_id}.pdf"]}))
@@ -185,7 +185,7 @@ def test_the_runner_passes_one_cache_per_code_version(two_notebooks):
     calls = run()
     cache = Path(calls["table1"]["cache_dir"])
     assert "cache_dir" not in calls["cell"]
-    assert cache == tmp_path / "build" / "figure-cache" / inputs.code_digest()[:16]
+    assert cache == tmp_path / "build" / "figure-cache" / inputs.code_digest(tmp_path / "environment.lock")[:16]
     assert (cache / "table1-result.json").is_file()
     # the manifest's parameters (and the inputs hash) do not depend on where the cache is
     entry = json.loads((tmp_path / "figures" / "table1.json").read_text())

@@ -9,9 +9,12 @@ from pathlib import Path
 import nbformat
 import pytest
 
+import flipkit
 from flipkit import cli
-from flipkit.figures import catalog, inputs, pipeline
+from flipkit.figures import inputs, pipeline
 from flipkit.import_graph import closure, import_graph
+
+REPO = Path(flipkit.__file__).resolve().parents[1]
 
 PARAMS = {"quick": False, "out_dir": "figures", "scheduler": None}
 
@@ -104,7 +107,7 @@ def test_a_cell_that_is_not_python_is_a_one_line_error(project):
 
 def test_the_real_notebooks_import_what_they_draw_with():
     graph = import_graph()
-    cell = inputs.notebook_modules(catalog.NOTEBOOKS_DIR / "cell.ipynb", graph)
+    cell = inputs.notebook_modules(REPO / "notebooks" / "cell.ipynb", graph)
     assert {"flipkit", "flipkit.figures", "flipkit.figures.draw", "flipkit.model.robot",
             "flipkit.config.cell"} <= cell
     assert not any(m.startswith(("flipkit.cli", "flipkit.baseline")) for m in cell)
@@ -119,7 +122,7 @@ def runner(tmp_path, monkeypatch):
     write_notebook(notebooks / "cell.ipynb", "from flipkit.figures import catalog")
     calls = []
 
-    def fake_execute(notebook, executed, parameters, kernel):
+    def fake_execute(notebook, executed, parameters, kernel, cwd):
         out = Path(parameters["out_dir"])
         for name in ("cell.pdf", "cell.png"):
             (out / name).write_bytes(b"figure")
@@ -181,7 +184,7 @@ def test_the_runner_remakes_a_missing_file_or_an_edited_notebook(runner):
 
 
 def test_the_command_prints_each_skip_and_a_summary(tmp_path, monkeypatch, capsys):
-    def fake_execute(notebook, executed, parameters, kernel):
+    def fake_execute(notebook, executed, parameters, kernel, cwd):
         out = Path(parameters["out_dir"])
         for name in ("cell.pdf", "cell.png"):
             (out / name).write_bytes(b"figure")
@@ -190,7 +193,8 @@ def test_the_command_prints_each_skip_and_a_summary(tmp_path, monkeypatch, capsy
     monkeypatch.setattr(pipeline, "execute_notebook", fake_execute)
     monkeypatch.setattr(pipeline, "kernel_name", lambda: "python3")
     monkeypatch.chdir(tmp_path)
-    argv = ["figures", "--quick", "--only", "cell", "--out", "figs"]
+    argv = ["figures", "--quick", "--only", "cell", "--out", "figs", "--notebooks",
+            str(REPO / "notebooks")]
     assert cli.main(argv) == 0
     assert "run  cell.ipynb: no figure 'cell'" in capsys.readouterr().out
     assert cli.main(argv) == 0
@@ -206,7 +210,7 @@ def test_a_notebook_of_two_figures_records_both_and_reports_the_one_asked_for(tm
     notebooks.mkdir()
     write_notebook(notebooks / "landing.ipynb", "from flipkit.figures import catalog")
 
-    def fake_execute(notebook, executed, parameters, kernel):
+    def fake_execute(notebook, executed, parameters, kernel, cwd):
         out = Path(parameters["out_dir"])
         for fig_id in ("landing", "filmstrip"):
             (out / f"{fig_id}.pdf").write_bytes(b"figure")

@@ -3,17 +3,21 @@ notebooks themselves (parameters cell, no outputs)."""
 
 import json
 import os
+import sys
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import nbformat
 import pytest
 
+import flipkit
 from flipkit import cli
 from flipkit import figures
 from flipkit.figures import execute
 from flipkit.errors import InvalidChoiceError
 
-NOTEBOOKS = sorted(figures.NOTEBOOKS_DIR.glob("*.ipynb"))
+REPO = Path(flipkit.__file__).resolve().parents[1]
+NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 
 
 def run_cli(argv, cwd):
@@ -30,7 +34,8 @@ def run_cli(argv, cwd):
 def made(tmp_path_factory):
     work = tmp_path_factory.mktemp("figures")
     out = work / "figures"
-    code = run_cli(["figures", "--quick", "--only", "cell", "--out", str(out)], work)
+    code = run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--notebooks",
+                    str(REPO / "notebooks")], work)
     return code, work, out
 
 
@@ -59,8 +64,8 @@ def test_second_run_is_reproducible(made):
     _, work, out = made
     first = json.loads((out / "manifest.json").read_text())
     pdf = (out / "cell.pdf").read_bytes()
-    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--force"],
-                   work) == 0
+    assert run_cli(["figures", "--quick", "--only", "cell", "--out", str(out), "--force",
+                    "--notebooks", str(REPO / "notebooks")], work) == 0
     second = json.loads((out / "manifest.json").read_text())
     assert second == first
     assert (out / "cell.pdf").read_bytes() == pdf  # no dates: byte-identical PDF
@@ -76,7 +81,7 @@ def test_unknown_id_is_a_one_line_error(capsys):
 def test_missing_notebook_is_skipped_and_reported(tmp_path, monkeypatch):
     monkeypatch.setitem(figures.FIGURES, "forces", "not_written_yet.ipynb")
     report = figures.run_notebooks(only=["forces"], out_dir=tmp_path / "f",
-                                   build_dir=tmp_path / "b")
+                                   build_dir=tmp_path / "b", notebooks_dir=REPO / "notebooks")
     assert report.made == [] and report.missing == ["forces"]
     assert json.loads(report.manifest.read_text())["figures"] == {}
 
@@ -106,10 +111,31 @@ def test_failing_notebook_names_notebook_and_error(tmp_path):
         nbformat.v4.new_code_cell("raise ValueError('burnt\\nbadly')")]), notebook)
     with pytest.raises(figures.NotebookError) as info:
         execute.execute_notebook(notebook, tmp_path / "executed.ipynb", {"quick": True},
-                                 figures.kernel_name())
+                                 figures.kernel_name(), cwd=tmp_path)
     message = str(info.value)
     assert "\n" not in message
     assert "broken.ipynb" in message and "ValueError: burnt badly" in message
+
+
+@pytest.mark.slow
+def test_a_notebook_naming_an_unregistered_kernel_runs_in_this_python(tmp_path):
+    """The notebooks name ``flipkit-python3``, which only ``make lab`` registers; papermill is
+    given :func:`flipkit.figures.kernel_name`'s kernel, so a notebook naming a kernel that
+    is registered nowhere still runs, in this Python, in ``cwd``."""
+    notebook = tmp_path / "nb.ipynb"
+    nb = nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_code_cell("quick = False", metadata={"tags": ["parameters"]}),
+        nbformat.v4.new_code_cell("import os, sys\nprint(sys.prefix)\nprint(os.getcwd())")])
+    nb.metadata["kernelspec"] = {"name": "flipkit-unregistered", "display_name": "nowhere",
+                                 "language": "python"}
+    nbformat.write(nb, notebook)
+    (tmp_path / "run").mkdir()
+    execute.execute_notebook(notebook, tmp_path / "executed.ipynb", {"quick": True},
+                             figures.kernel_name(), cwd=tmp_path / "run")
+    out = nbformat.read(tmp_path / "executed.ipynb", as_version=4).cells[-1].outputs
+    prefix, cwd = "".join(o.get("text", "") for o in out).split()
+    assert Path(prefix).resolve() == Path(sys.prefix).resolve()
+    assert Path(cwd).resolve() == (tmp_path / "run").resolve()
 
 
 def test_every_figure_id_has_a_notebook_name():

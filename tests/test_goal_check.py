@@ -1,7 +1,7 @@
 """flipkit.model.goal_check: a translate goal no NLP can end at is refused with the limit and
 its amount (issue 28, item 4); goals the planner solves are accepted, with a branch that
 reaches the pose inside the joint bounds and clear of the cell. No wall-clock asserts: the
-check's time is measured by ``python -m flipkit.experiments.goal_check_bench``."""
+check's time is measured by ``python -m bench.goal_check_bench``."""
 
 import numpy as np
 import pytest
@@ -15,7 +15,7 @@ from flipkit.model.singular import SINGULARITY_MARGIN, branch_bounds
 
 FLAT = (0.0, 0.0, 0.0)
 README_START = (0.64, -0.33, 0.15)  # README: plan translate --from 0.64 -0.33 0.15 --to 0.75 0.0 0.15
-# flipkit.experiments.bench.TRANSLATE_KEY_POINTS (paper Fig. 6): the six translates between
+# flipkit.experiments.speed.TRANSLATE_KEY_POINTS (paper Fig. 6): the six translates between
 # them, each to the next, are solved by the SQP (docs/benchmarks/bench_translate.txt)
 KEY_POINTS = ((0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
               (0.45, 0.74, 0.19), (0.32, 0.62, 0.20), (0.50, 0.52, 0.20))

@@ -4,7 +4,9 @@
 * no import cycle between modules;
 * no private name (leading underscore) imported from another module;
 * function-local imports only where a heavy optional dependency needs them, at most
-  :data:`MAX_LOCAL_IMPORTS` in the package.
+  :data:`MAX_LOCAL_IMPORTS` in the package;
+* the core (:mod:`flipkit.extras`) imports no package of an extra when it is imported, and
+  the extras named there are pyproject's.
 
 Every import is read from the source with ``ast`` by :mod:`flipkit.import_graph` — at module
 level and inside functions alike (a lazy import that runs up a layer, or closes a cycle, is
@@ -16,14 +18,22 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
+import re
+import sys
+import tomllib
+from importlib.metadata import distribution, packages_distributions
 
-from flipkit.import_graph import PACKAGE, flipkit_imports, import_graph, local_imports
-from flipkit.import_graph import module_name, package_files
+import pytest
+from packaging.requirements import Requirement
+
+from flipkit.extras import EXTRAS, extra_of, is_core
+from flipkit.import_graph import PACKAGE, closure, external_imports, flipkit_imports
+from flipkit.import_graph import import_graph, local_imports, module_name, package_files
 
 # Lowest first. A module may import its own layer and the layers below it.
 LAYERS = (
-    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "csv_header", "import_graph"),
+    ("errors", "provenance", "fileio", "jsonread", "decimal_text", "csv_header", "import_graph",
+     "extras"),
     ("config", ""),  # "" is the package root (flipkit/__init__.py: version, CellConfig)
     ("model",),
     ("transcription",),
@@ -155,3 +165,125 @@ def test_the_checkers_catch_a_cycle_a_private_import_and_a_local_import(monkeypa
     assert local_imports(PACKAGE / "model" / "robot.py") == [5, 7]
     assert [i.typing_only for i in flipkit_imports(PACKAGE / "model" / "bezier.py")] == [
         False, True]
+
+
+# ---------------------------------------------------------------- the core and the extras
+PROJECT = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["project"]
+
+
+def dist_name(name: str) -> str:
+    """A distribution's name, normalised (PEP 503)."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def core_distributions() -> set[str]:
+    """The distributions ``pip install flipkit`` installs: pyproject's dependencies and theirs,
+    transitively (from the installed metadata, extras left out)."""
+    seen, todo = set(), [Requirement(r) for r in PROJECT["dependencies"]]
+    while todo:
+        req = todo.pop()
+        name = dist_name(req.name)
+        if name in seen:
+            continue
+        seen.add(name)
+        for line in distribution(name).requires or ():
+            sub = Requirement(line)
+            if sub.marker is None or sub.marker.evaluate({"extra": ""}):
+                todo.append(sub)
+    return seen
+
+
+def import_names(name: str) -> set[str]:
+    """The top-level import names of an installed distribution, from its files (cmeel's
+    wheels, pinocchio and placo, put theirs under ``cmeel.prefix/.../site-packages``)."""
+    names = set()
+    for f in distribution(name).files or ():
+        parts = f.parts
+        if "site-packages" in parts:
+            parts = parts[parts.index("site-packages") + 1:]
+        if not parts or parts[0].endswith((".dist-info", ".pth", ".data")) or parts[0] in (
+                "..", "__pycache__", "cmeel.prefix", "bin"):
+            continue
+        if len(parts) > 1 or parts[0].endswith((".py", ".so")):
+            names.add(parts[0].split(".")[0])
+    return names
+
+
+def core_import_names() -> set[str]:
+    """The top-level names a core module may import: the standard library's, and those of
+    the core's distributions."""
+    core = core_distributions()
+    return set(sys.stdlib_module_names) | {"flipkit", "__future__"} | {
+        top for top, dists in packages_distributions().items()
+        if any(dist_name(d) in core for d in dists)} | {
+        top for name in core for top in import_names(name)}
+
+
+def outside_the_core(paths: dict[str, Path], allowed: set[str]) -> dict[str, list[str]]:
+    """Core module -> ``"<module>:<line> <package> (<extra>)"`` for every import of a package
+    outside ``allowed`` that importing it runs (its own module-level imports and those of
+    every flipkit module it imports at module level, transitively)."""
+    graph = {name: {i.target for i in flipkit_imports(path) if not (i.local or i.typing_only)
+                    and i.target != name} for name, path in paths.items()}
+    found = {name: [f"{name}:{line} {top} ({extra_of(top) or 'not a core dependency'})"
+                    for line, top, local in external_imports(path)
+                    if not local and top not in allowed] for name, path in paths.items()}
+    return {m: sorted(x for dep in closure(graph, [m]) for x in found.get(dep, ()))
+            for m in paths if is_core(m)}
+
+
+def test_the_core_imports_only_the_cores_dependencies():
+    """Importing a core module (``flipkit.extras``) imports the standard library and the
+    core's dependencies alone: no package of an extra, nor one an extra brings along."""
+    paths = {module_name(f): f for f in FILES}
+    core = [m for m in paths if is_core(m)]
+    assert {"flipkit.model.robot", "flipkit.cli.commands.plan", "flipkit.cli.figures",
+            "flipkit.planning.plans.verify", "flipkit.baseline.ik_track"} <= set(core)
+    assert not is_core("flipkit.simulation.scene") and not is_core("flipkit.cli.commands.view")
+    allowed = core_import_names()
+    assert {"numpy", "pinocchio", "casadi", "cvxpy", "yaml", "placo"} <= allowed
+    assert not {"mujoco", "matplotlib", "cycler", "ortools", "papermill", "dask"} & allowed
+    bad = {m: v for m, v in outside_the_core(paths, allowed).items() if v}
+    assert not bad, "core modules that import beyond the core's dependencies:\n" + "\n".join(
+        f"{m}: {'; '.join(v)}" for m, v in sorted(bad.items()))
+
+
+def test_the_core_check_catches_an_extra_reached_through_a_module(monkeypatch):
+    """A core module importing (at its top) a module that imports MuJoCo at its top is
+    reported; one that imports MuJoCo inside a function is not (the test can fail)."""
+    sources = {
+        PACKAGE / "model" / "robot.py": "from flipkit.model import scoop\nimport numpy\n",
+        PACKAGE / "model" / "scoop.py": "import flipkit.simulation.scene\n",
+        PACKAGE / "simulation" / "scene.py": "import os\nfrom mujoco import MjModel\n",
+        PACKAGE / "model" / "ik.py": "def f():\n    import meshcat\n",
+        PACKAGE / "model" / "bezier.py": "import cycler.x\n",
+    }
+    monkeypatch.setattr(Path, "read_text", lambda self, *a, **k: sources[self])
+    found = outside_the_core({module_name(p): p for p in sources}, {"os", "numpy", "meshcat"})
+    assert found["flipkit.model.robot"] == ["flipkit.simulation.scene:2 mujoco (sim)"]
+    assert found["flipkit.model.scoop"] == found["flipkit.model.robot"]
+    assert found["flipkit.model.ik"] == [] and "flipkit.simulation.scene" not in found
+    assert found["flipkit.model.bezier"] == [
+        "flipkit.model.bezier:1 cycler (not a core dependency)"]
+
+
+def test_the_extras_are_pyprojects():
+    """:data:`flipkit.extras.EXTRAS` names pyproject's extras, each import name installed by a
+    distribution its extra requires; the core requires none of them."""
+    project = PROJECT
+    optional = project["optional-dependencies"]
+    assert set(optional) == set(EXTRAS) | {"all"}
+    assert optional["all"] == [f"flipkit[{','.join(EXTRAS)}]"]
+
+    def dist(requirement: str) -> str:
+        return requirement.split("[")[0].split("=")[0].split("<")[0].split(">")[0].lower()
+
+    installed = {k: {d.lower() for d in v} for k, v in packages_distributions().items()}
+    core = {dist(r) for r in project["dependencies"]}
+    for extra, names in EXTRAS.items():
+        required = {dist(r) for r in optional[extra]}
+        for name in names:
+            dists = installed.get(name, {name.lower()})
+            assert dists & required or name in ("nbclient", "jupyter_client", "distributed"), (
+                extra, name)
+            assert not dists & core, (extra, name)

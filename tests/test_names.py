@@ -43,7 +43,7 @@ def test_the_planner_and_the_command_line_accept_the_same_solvers():
 
 
 def test_exact_solver_names():
-    from flipkit.experiments.bench import TRANSLATE_SOLVERS
+    from flipkit.experiments.speed import TRANSLATE_SOLVERS
     from flipkit.solvers import exact
 
     assert exact.EXACT_SOLVERS is EXACT_SOLVERS

@@ -7,9 +7,11 @@ import json
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
+import flipkit
 from flipkit import figures
 
 # The figures of the report (paper/main.tex), in its order.
@@ -17,7 +19,8 @@ REPORT_FIGURE_IDS = ("cell", "forces", "subbehaviors", "defects", "translate", "
                      "ik_failure", "solve_times", "solve_scaling", "cone_forms", "landing",
                      "filmstrip",
                      "sensitivity", "schedule", "throughput", "kitchen")
-PAPER_DIR = figures.REPO_ROOT / "paper"
+REPO = Path(flipkit.__file__).resolve().parents[1]
+PAPER_DIR = REPO / "paper"
 MAIN_TEX = PAPER_DIR / "main.tex"
 MACRO_USE = re.compile(r"\\fk(num|mm|pct)\{([^}]*)\}\{([^}]*)\}")
 MACRO_DEF = re.compile(r"^\\fkdef(|mm|pct)\{([^}]*)\}\{([^}]*)\}\{", re.M)
@@ -38,7 +41,7 @@ def uses(fig_id=None):
 def test_design_figures_have_notebooks():
     assert figures.FIGURE_IDS == REPORT_FIGURE_IDS
     for fig_id in REPORT_FIGURE_IDS:
-        path = figures.NOTEBOOKS_DIR / figures.FIGURES[fig_id]
+        path = REPO / "notebooks" / figures.FIGURES[fig_id]
         assert path.is_file(), f"no notebook for figure {fig_id!r}"
         text = path.read_text()
         assert f'figures.save(fig, \\"{fig_id}\\"' in text
@@ -76,7 +79,7 @@ def test_paper_has_the_differences_section():
 def test_notebook_runs_quick_and_feeds_the_paper(fig_id, tmp_path):
     out = tmp_path / "figures"
     report = figures.run_notebooks(quick=True, only=[fig_id], out_dir=out,
-                                   build_dir=tmp_path / "build")
+                                   build_dir=tmp_path / "build", notebooks_dir=REPO / "notebooks")
     assert report.made == [fig_id] and report.missing == []
     manifest = json.loads(report.manifest.read_text())
     entry = manifest["figures"][fig_id]
@@ -112,7 +115,7 @@ def test_notebook_runs_quick_and_feeds_the_paper(fig_id, tmp_path):
 def test_paper_compiles_with_the_current_figures(tmp_path):
     """With LaTeX installed and a complete figures/ (make figures), the report builds and
     quotes no undefined number."""
-    manifest_path = figures.REPO_ROOT / "figures" / "manifest.json"
+    manifest_path = REPO / "figures" / "manifest.json"
     if shutil.which("latexmk") is None:
         pytest.skip("latexmk not installed (make paper installs it)")
     if not manifest_path.is_file():
@@ -123,7 +126,7 @@ def test_paper_compiles_with_the_current_figures(tmp_path):
     paper = tmp_path / "paper"
     paper.mkdir()
     shutil.copy(MAIN_TEX, paper / "main.tex")
-    (tmp_path / "figures").symlink_to(figures.REPO_ROOT / "figures")
+    (tmp_path / "figures").symlink_to(REPO / "figures")
     figures.write_macros(manifest, paper / "numbers.tex")
     run = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error",
                           "main.tex"], cwd=paper, capture_output=True, text=True, timeout=300)

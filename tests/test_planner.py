@@ -6,7 +6,7 @@ from test_plan import models  # noqa: F401  (fixture)
 
 import flipkit.planning.planners.planner as planner
 import flipkit.planning.planners.chain as chain
-from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
+from flipkit.experiments.speed import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
 from flipkit.planning.plans.plan_file import Plan
@@ -237,7 +237,7 @@ def test_a_warm_start_found_infeasible_tries_the_stretched_bound_before_the_cold
 def test_bench_flip_reports_wall_cpu_and_iterations(capsys):
     """`bench flip` on one location: the row carries the plan's wall and CPU time and the
     solver's iterations, and the printed table has the CPU column."""
-    from flipkit.experiments.bench import bench_flip
+    from bench.bench import bench_flip
 
     out = bench_flip(CellConfig(), 1, 0, atlas=None, ipopt=False)
     row = out["rows"][0]["sqp"]

@@ -44,7 +44,7 @@ def test_prefetched_cook_equals_the_serial_one():
         assert [s.name for s in a.plan.segments] == [s.name for s in b.plan.segments]
         assert b.plan.status == "solved" and verify_plan(b.plan, space=CELL.space).ok
         assert np.abs(b.plan.segments[0].q[0] - q_home).max() == 0.0  # from rest at home
-    # (the planning clocks, serial and prefetched: python -m flipkit.experiments.bench flip --cook)
+    # (the planning clocks, serial and prefetched: python -m bench.bench flip --cook)
 
 
 @pytest.mark.slow

@@ -7,7 +7,8 @@ worker died on every attempt). A worker process that dies outside a sweep (the e
 of ``plan batch`` and ``schedule``) ends the command the same way, one line and exit 1.
 SIGINT, SIGTERM and SIGHUP stop a command with everything it started
 (:mod:`flipkit.cli.signals`): one line (``flipkit: interrupted``, ``terminated``, ``hung
-up``) and exit 130, 143 or 129.
+up``) and exit 130, 143 or 129. A command whose extra is not installed (``flipkit[sim]``,
+...: :mod:`flipkit.extras`) says which, in one line, and exits 1.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import sys
 
 from flipkit.cli.signals import farewell, signals_raise
 from flipkit.errors import FlipkitError
+from flipkit.extras import missing_extra_message
 
 COMMANDS = ("plan", "verify", "export", "figures", "compare-ik", "validate", "animate",
             "view", "schedule", "atlas")
@@ -41,6 +43,12 @@ def main(argv: list[str] | None = None) -> int:
     except FlipkitError as exc:
         print(f"flipkit: error: {exc}", file=sys.stderr)
         return exc.exit_status
+    except ModuleNotFoundError as exc:
+        line = missing_extra_message(args.command, exc.name)
+        if line is None:
+            raise
+        print(f"flipkit: error: {line}", file=sys.stderr)
+        return 1
     except cf.BrokenExecutor as exc:
         print(f"flipkit: error: a worker process died ({exc})", file=sys.stderr)
         return 1

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from flipkit.errors import InvalidChoiceError
+from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.figures import FIGURE_IDS, run_notebooks
 from flipkit.fileio import check_output_dir
 
@@ -32,6 +33,9 @@ def register(subparsers) -> None:
                         help="output directory (default: figures)")
     parser.add_argument("--force", action="store_true",
                         help="run every selected notebook, even if its figures are up to date")
+    parser.add_argument("--notebooks", default="notebooks", metavar="DIR",
+                        help="the repository's notebooks directory; they run in its parent, "
+                             "whose environment.lock is hashed with them (default: notebooks)")
     parser.set_defaults(run=run)
 
 
@@ -39,11 +43,14 @@ def run(args: argparse.Namespace) -> int:
     """Make the figures; print each notebook run or skipped and why (one line each), then a
     summary: what was made, how many were skipped, what is missing, the manifest path."""
     check_output_dir(args.out, "--out")  # before any notebook runs
+    if not Path(args.notebooks).is_dir():
+        raise ConfigError(f"--notebooks: no directory {args.notebooks!r} (run from the "
+                          "repository's root, or name its notebooks directory)")
     for fig_id in args.only or ():
         if fig_id not in FIGURE_IDS:
             raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)
     report = run_notebooks(quick=args.quick, only=args.only, scheduler=args.scheduler,
-                           out_dir=args.out, force=args.force,
+                           out_dir=args.out, force=args.force, notebooks_dir=args.notebooks,
                            log=lambda line: print(f"flipkit figures: {line}", flush=True))
     made, ran = ", ".join(report.made) or "none", len(report.ran)
     print(f"flipkit figures: ran {ran} notebook{'s' * (ran != 1)}, skipped "

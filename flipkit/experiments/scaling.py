@@ -1,14 +1,14 @@
 """How solve time grows with the nodes per segment: the translate comparison at N = 10 … 80.
 
 For each (N, solver) the six translate segments of the solver comparison
-(:func:`flipkit.experiments.bench.translate_nlps`: the NLP without the arm's clearance rows,
+(:func:`flipkit.experiments.speed.translate_nlps`: the NLP without the arm's clearance rows,
 which have no symbolic form) are solved from the same start ``nlp.x0`` by the SQP, FATROP,
-exact-Hessian IPOPT, ``sqpmethod`` or L-BFGS IPOPT, as :func:`flipkit.experiments.bench.bench_translate`
-solves them at N = 20. One (N, solver) item is one job of a sweep: one solver runs per
-worker process, single-threaded, so on a machine with one core per worker the times are
-one-core times. Set-up is not counted: the SQP's subproblem compile (one SQP iteration
-first, :func:`~flipkit.experiments.bench.warm_up`) and the exact solvers' SX graph and
-solver build are reported apart.
+exact-Hessian IPOPT, ``sqpmethod`` or L-BFGS IPOPT, as ``bench_translate`` of the
+repository's ``bench/bench.py`` solves them at N = 20. One (N, solver) item is one job of a
+sweep: one solver runs per worker process, single-threaded, so on a machine with one core
+per worker the times are one-core times. Set-up is not counted: the SQP's subproblem compile
+(one SQP iteration first, :func:`~flipkit.experiments.speed.warm_up`) and the exact solvers'
+SX graph and solver build are reported apart.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import numpy as np
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
-from flipkit.experiments.bench import TRANSLATE_SOLVERS, translate_nlps, warm_up
+from flipkit.experiments.speed import TRANSLATE_SOLVERS, translate_nlps, warm_up
 from flipkit.experiments.sweep import run_sweep
 from flipkit.planning.planners.chain import solve_segment
 from flipkit.solvers.exact import ExactOptions, ExactSolver

@@ -15,14 +15,14 @@ A notebook imports ``from flipkit import figures`` and calls ``figures.style()``
 ``figures.save(...)``; the names below are the layer's public interface.
 """
 
-from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR, REPO_ROOT
+from flipkit.figures.catalog import FIGURE_IDS, FIGURES
 from flipkit.figures.macros import flatten_numbers, format_number, tex_escape, write_macros
 from flipkit.figures.execute import NotebookError, kernel_name
 from flipkit.figures.inputs import Inputs, NotebookInputsError, hash_inputs
 from flipkit.figures.pipeline import RunReport, run_notebooks, write_manifest
 from flipkit.figures.style import COLORS, COLUMN_WIDTH, PAGE_WIDTH, PNG_DPI, save, style
 
-__all__ = ["COLORS", "COLUMN_WIDTH", "FIGURES", "FIGURE_IDS", "NOTEBOOKS_DIR", "PAGE_WIDTH",
-           "PNG_DPI", "REPO_ROOT", "Inputs", "NotebookError", "NotebookInputsError",
-           "RunReport", "flatten_numbers", "format_number", "hash_inputs", "kernel_name",
-           "run_notebooks", "save", "style", "tex_escape", "write_macros", "write_manifest"]
+__all__ = ["COLORS", "COLUMN_WIDTH", "FIGURES", "FIGURE_IDS", "PAGE_WIDTH", "PNG_DPI", "Inputs",
+           "NotebookError", "NotebookInputsError", "RunReport", "flatten_numbers",
+           "format_number", "hash_inputs", "kernel_name", "run_notebooks", "save",
+           "style", "tex_escape", "write_macros", "write_manifest"]

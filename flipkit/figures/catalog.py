@@ -1,11 +1,11 @@
-"""The figures of the report (paper/main.tex) and the notebooks that make them."""
+"""The figures of the report (paper/main.tex) and the notebooks that make them.
+
+The notebooks are files of the repository, not of the package: the caller says where they
+are (``flipkit figures --notebooks DIR``, :func:`flipkit.figures.run_notebooks`).
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
-
-REPO_ROOT = Path(__file__).resolve().parents[2]
-NOTEBOOKS_DIR = REPO_ROOT / "notebooks"
 FIGURES = {  # figure id -> notebook that makes it, in the report's order
     "cell": "cell.ipynb", "forces": "forces.ipynb", "subbehaviors": "subbehaviors.ipynb",
     "defects": "defects.ipynb", "translate": "translate.ipynb", "flip": "flip.ipynb",

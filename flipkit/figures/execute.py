@@ -1,9 +1,11 @@
 """One figure notebook executed by papermill, in a kernel that runs this Python (the venv's).
 
 :func:`kernel_name` finds (or installs) the kernelspec; ``make lab`` registers the same one,
-``flipkit-python3`` ("Python 3 (flipkit)"), for JupyterLab. :func:`execute_notebook` runs a
-notebook from the repository root and turns any failure into a one-line
-:class:`NotebookError`.
+``flipkit-python3`` ("Python 3 (flipkit)"), for JupyterLab; the notebooks' kernelspec names
+it. :func:`execute_notebook` runs a notebook from the project's root in the kernel that
+:func:`kernel_name` found (papermill's ``kernel_name`` replaces the notebook's own, so a
+fresh clone where ``make lab`` never ran needs no registered kernel) and turns any failure
+into a one-line :class:`NotebookError`.
 """
 
 from __future__ import annotations
@@ -12,7 +14,6 @@ import sys
 from pathlib import Path
 
 from flipkit.errors import FlipkitError
-from flipkit.figures.catalog import REPO_ROOT
 
 # The kernel's own log (plain-TCP warning, interrupt on shutdown) is noise here; cell errors
 # still reach us through the notebook, a dead kernel through nbclient.
@@ -55,12 +56,15 @@ def one_line(text) -> str:
     return " ".join(str(text).split())
 
 
-def execute_notebook(notebook: Path, executed: Path, parameters: dict, kernel: str) -> None:
-    """Run one notebook with papermill from the repository root.
+def execute_notebook(notebook: Path, executed: Path, parameters: dict, kernel: str,
+                     cwd: Path) -> None:
+    """Run one notebook with papermill in the directory ``cwd`` (the project's root).
 
     Args:
         notebook: The ``.ipynb`` to run. executed: Where papermill writes the executed copy.
-        parameters: Injected after the ``parameters``-tagged cell. kernel: Kernelspec name.
+        parameters: Injected after the ``parameters``-tagged cell. kernel: Kernelspec name
+            (the notebooks' own kernelspec names ``flipkit-python3``; this one replaces it).
+        cwd: The directory the kernel starts in.
 
     Raises:
         NotebookError: One line: the notebook, the failing cell and its error, or why the
@@ -70,7 +74,7 @@ def execute_notebook(notebook: Path, executed: Path, parameters: dict, kernel: s
 
     try:
         papermill.execute_notebook(str(notebook), str(executed), parameters=parameters,
-                                   kernel_name=kernel, language="python", cwd=str(REPO_ROOT),
+                                   kernel_name=kernel, language="python", cwd=str(cwd),
                                    progress_bar=False, extra_arguments=KERNEL_QUIET)
     except papermill.PapermillExecutionError as exc:
         raise NotebookError(

@@ -27,10 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from flipkit.errors import FlipkitError
-from flipkit.figures.catalog import REPO_ROOT
 from flipkit.import_graph import PACKAGE, closure, import_graph, package_modules, source_imports
 
-LOCK = REPO_ROOT / "environment.lock"
 UNHASHED_PARAMETERS = ("out_dir", "cache_dir")  # where results go, not what they show
 PARTS = ("notebook", "sources", "data", "parameters", "environment_lock")
 PART_NAMES = {"notebook": "the notebook", "sources": "flipkit sources",
@@ -99,16 +97,17 @@ def notebook_modules(path: Path, graph: dict[str, set[str]], root: Path = PACKAG
     return closure(graph, start)
 
 
-def hash_inputs(notebook: Path, parameters: dict, graph: dict[str, set[str]] | None = None,
-                root: Path = PACKAGE, lock: Path = LOCK) -> Inputs:
+def hash_inputs(notebook: Path, parameters: dict, lock: Path,
+                graph: dict[str, set[str]] | None = None, root: Path = PACKAGE) -> Inputs:
     """Hash a notebook's inputs (see the module's docstring).
 
     Args:
         notebook: The ``.ipynb`` file.
         parameters: The parameters papermill passes; ``out_dir`` is left out.
+        lock: The project's ``environment.lock`` (a missing one hashes as absent).
         graph: The package's import graph (default: :func:`flipkit.import_graph.import_graph`
             of ``root``; pass it when hashing several notebooks).
-        root: The package directory. lock: The lock file (a missing one hashes as absent).
+        root: The package directory.
 
     Raises:
         NotebookInputsError: The notebook cannot be read, or a code cell is not Python.
@@ -132,7 +131,7 @@ def hash_inputs(notebook: Path, parameters: dict, graph: dict[str, set[str]] | N
     return Inputs(digest, parts, modules)
 
 
-def code_digest(root: Path = PACKAGE, lock: Path = LOCK) -> str:
+def code_digest(lock: Path, root: Path = PACKAGE) -> str:
     """SHA-256 hex of every file of the package at ``root`` (sources and data, by relative
     path) and of ``lock``: the code version a cached sweep result was computed with.
 

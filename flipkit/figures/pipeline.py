@@ -31,7 +31,7 @@ from tqdm import tqdm
 
 from flipkit import __version__
 from flipkit.errors import InvalidChoiceError
-from flipkit.figures.catalog import FIGURE_IDS, FIGURES, NOTEBOOKS_DIR
+from flipkit.figures.catalog import FIGURE_IDS, FIGURES
 from flipkit.figures.execute import NotebookError, execute_notebook, kernel_name
 from flipkit.figures.inputs import (UNHASHED_PARAMETERS, Inputs, changed, code_digest,
                                     hash_inputs)
@@ -87,19 +87,19 @@ def stale_reason(out: Path, ids, inputs: Inputs, parameters: dict) -> str | None
 CACHE_VERSION_NAME = re.compile(r"[0-9a-f]{16}")  # sweep_cache's directory names
 
 
-def sweep_cache(root, fresh: bool = False, digest: str | None = None) -> Path:
+def sweep_cache(root, digest: str, fresh: bool = False) -> Path:
     """The sweep cache directory of the current code, ``root/<digest[:16]>``, created.
 
     Args:
         root: Directory holding one cache directory per code version.
+        digest: The code version (:func:`flipkit.figures.inputs.code_digest`).
         fresh: Empty this version's directory first (a forced run).
-        digest: The code version (default :func:`flipkit.figures.inputs.code_digest`).
 
     The directories of other versions under ``root`` (names of 16 hex digits; nothing else
     is touched) are removed: their results were computed by other code.
     """
     root = Path(root)
-    name = (digest or code_digest())[:16]
+    name = digest[:16]
     if root.is_dir():
         for old in root.iterdir():
             if old.is_dir() and CACHE_VERSION_NAME.fullmatch(old.name) and (
@@ -129,7 +129,7 @@ def declared_parameters(notebook: Path) -> set[str]:
 def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
                   out_dir="figures", build_dir="build/notebooks", force: bool = False,
                   log: Callable[[str], None] | None = None,
-                  notebooks_dir: Path = NOTEBOOKS_DIR, cache_root=None) -> RunReport:
+                  notebooks_dir="notebooks", cache_root=None) -> RunReport:
     """Execute the figure notebooks whose inputs changed and write ``<out_dir>/manifest.json``.
 
     Args:
@@ -142,7 +142,9 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         force: Execute every selected notebook, up to date or not.
         log: Called with one line per notebook, before any runs: skipped and why, or to
             run and why; then one line as each notebook is made, with its wall time.
-        notebooks_dir: Where the notebooks of :data:`~flipkit.figures.catalog.FIGURES` are.
+        notebooks_dir: Where the notebooks of :data:`~flipkit.figures.catalog.FIGURES` are
+            (default: ``notebooks`` in the current directory). Its parent is the project:
+            the notebooks run there, and its ``environment.lock`` is hashed with them.
         cache_root: Where the shared sweep cache lives (:func:`sweep_cache`; default
             ``figure-cache`` beside ``build_dir``). ``force`` empties it for this version.
 
@@ -163,13 +165,16 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         if fig_id not in FIGURES:
             raise InvalidChoiceError("figure id", fig_id, FIGURE_IDS)
     out, build = Path(out_dir).absolute(), Path(build_dir).absolute()
+    notebooks_dir = Path(notebooks_dir).absolute()
+    project = notebooks_dir.parent
+    lock = project / "environment.lock"
     report = RunReport(missing=[i for i in wanted
                                 if not (notebooks_dir / FIGURES[i]).is_file()])
     recorded = {"quick": bool(quick), "out_dir": str(out_dir), "scheduler": scheduler}
     graph, jobs = import_graph(), {}
     for notebook in dict.fromkeys(FIGURES[i] for i in wanted if i not in report.missing):
         ids = [i for i in FIGURE_IDS if FIGURES[i] == notebook]
-        inputs = hash_inputs(notebooks_dir / notebook, recorded, graph)
+        inputs = hash_inputs(notebooks_dir / notebook, recorded, lock, graph)
         reason = "--force" if force else stale_reason(out, ids, inputs, recorded)
         if reason is None:
             report.skipped[notebook] = (f"up to date (inputs {inputs.digest[:19]}, "
@@ -183,7 +188,7 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
     params = {"quick": bool(quick), "out_dir": str(out), "scheduler": scheduler}
     cached = {nb for nb in jobs if "cache_dir" in declared_parameters(notebooks_dir / nb)}
     cache = (sweep_cache(Path(cache_root or build.parent / "figure-cache").absolute(),
-                         fresh=force) if cached else None)
+                         code_digest(lock), fresh=force) if cached else None)
     kernel = kernel_name() if jobs else "python3"
     bar = tqdm(jobs.items(), desc="notebooks", unit="nb", disable=not jobs, file=sys.stderr)
     for notebook, (ids, inputs) in bar:
@@ -193,7 +198,7 @@ def run_notebooks(quick: bool = False, only=None, scheduler: str | None = None,
         extra = {"cache_dir": str(cache)} if notebook in cached else {}
         began = time.perf_counter()
         execute_notebook(notebooks_dir / notebook, build / notebook, {**params, **extra},
-                         kernel)
+                         kernel, cwd=project)
         report.times_s[notebook] = time.perf_counter() - began
         log(f"made {notebook} in {report.times_s[notebook]:.1f} s")
         for fig_id in ids:

@@ -34,7 +34,7 @@ from flipkit.behaviors.models import models_for
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.experiments.bench import warm_up
+from flipkit.experiments.speed import warm_up
 from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import make_executor, run_sweep
@@ -141,7 +141,7 @@ _WARMED: set = set()
 def _warm_sqp(cell: CellConfig, location) -> float:
     """One SQP iteration on each of the five segment structures, once per process: cvxpy's
     one-off compile of each QP (~2 s per structure) is set-up, not solve time (as in
-    :mod:`flipkit.experiments.bench`). Returns the time spent (s)."""
+    :mod:`flipkit.experiments.speed`). Returns the time spent (s)."""
     if cell in _WARMED:
         return 0.0
     models = models_for(cell)

@@ -12,7 +12,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from cycler import cycler
 
 from flipkit import __version__
 from flipkit.errors import FlipkitError, InvalidChoiceError
@@ -53,7 +52,7 @@ class _Style:
         self._rc = mpl.rcParams
         self._saved = {k: self._rc[k] for k in (*RC, "axes.prop_cycle")}
         self._rc.update(RC)
-        self._rc["axes.prop_cycle"] = cycler(color=COLORS)
+        self._rc["axes.prop_cycle"] = mpl.cycler(color=COLORS)
 
     def __enter__(self):
         return self

@@ -17,7 +17,7 @@ With ``--contingencies`` it also prepares each plan's contingency flips
 process, timed) and times the re-plan that uses them at the same places: kept, handed a
 contingency, or solved.
 
-Run as ``python -m flipkit.experiments.bench replan [--validate FILE] [--contingencies]``.
+Run as ``python -m bench.bench replan [--validate FILE] [--contingencies]``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Every command stream of a set of plans, checked as written against the arm profile.
 
-``python -m flipkit.experiments.stream_audit`` plans the Table I flips, the five "more"
+``python -m bench.stream_audit`` plans the Table I flips, the five "more"
 locations, three serves and the six translates between the paper's key points (from the
 package's atlas where it serves), writes each plan's URScript at 125 and 500 Hz, ROS 2 and
 CSV at 500 Hz, in the default command and (URScript) the compensated one, and prints one row
@@ -17,7 +17,7 @@ from pathlib import Path
 
 from flipkit.config import MORE_LOCATIONS, TABLE1_LOCATIONS
 from flipkit.errors import FlipkitError
-from flipkit.experiments.bench import TRANSLATE_KEY_POINTS
+from flipkit.experiments.speed import TRANSLATE_KEY_POINTS
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.planners.planner import plan_flip, plan_translate
 from flipkit.planning.planners.serve import plan_serve

@@ -1,14 +1,14 @@
 """Every speed claim in one run: the translates with every peer, the flips, the batch and the
 replan, side by side, printed and returned for JSON.
 
-    python -m flipkit.experiments.bench_all [--jit] [--locations N] [--json OUT]
+    python -m bench.bench_all [--jit] [--locations N] [--json OUT]
 
-Runs, one after the other in this process, :func:`~flipkit.experiments.bench.bench_translate`
+Runs, one after the other in this process, :func:`~bench.bench.bench_translate`
 (the six translates, the SQP beside FATROP, exact IPOPT, ``sqpmethod`` and L-BFGS IPOPT),
-:func:`~flipkit.experiments.bench.bench_flip` (the first N Table I pickup-and-flips with the
+:func:`~bench.bench.bench_flip` (the first N Table I pickup-and-flips with the
 SQP from the atlas and cold and with L-BFGS IPOPT, then the batch of five cold and from the
 atlas, one after the other and on one worker per CPU) and
-:func:`~flipkit.experiments.bench_replan.bench_replan` (a fresh sense-plan-act validation's
+:func:`~bench.bench_replan.bench_replan` (a fresh sense-plan-act validation's
 sensed places), then prints one summary: medians, iterations and milliseconds per
 iteration, the SQP's ratio to the best peer, and each target of the speed work beside its
 measurement.
@@ -22,10 +22,10 @@ import statistics
 import sys
 import warnings
 
+from bench.bench import bench_flip, bench_translate, machine, plain_json
+from bench.bench_replan import bench_replan, run_validation
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
-from flipkit.experiments.bench import (TRANSLATE_SOLVERS, bench_flip, bench_translate, machine,
-                                       plain_json)
-from flipkit.experiments.bench_replan import bench_replan, run_validation
+from flipkit.experiments.speed import TRANSLATE_SOLVERS
 from flipkit.planning.planners.atlas import default_atlas
 
 #: The speed targets (s): translate median, flip from the atlas (solve) and cold (solve),
@@ -127,7 +127,7 @@ def bench_all(cell: CellConfig, jit: bool, n_locations: int) -> dict:
 
 def main(argv=None) -> int:
     """Command-line entry point (see the module docstring)."""
-    parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench_all",
+    parser = argparse.ArgumentParser(prog="python -m bench.bench_all",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--jit", action="store_true",
                         help="JIT-compile the exact-derivative peers' functions")

@@ -1,6 +1,6 @@
 """Where an SQP iteration's milliseconds go, on a flip segment.
 
-    python -m flipkit.experiments.profile [--location K] [--atlas] [--out FILE]
+    python -m bench.profile [--location K] [--atlas] [--out FILE]
 
 Plans pickup-and-flip at Table I location K (default 7, (0.73, −0.13)) — from cold starts, or
 warm-started from the package's atlas (``--atlas``, as ``flipkit plan flip`` plans) — once to
@@ -26,7 +26,7 @@ import cProfile
 import pstats
 
 from flipkit.config import TABLE1_LOCATIONS
-from flipkit.experiments.bench import machine
+from bench.bench import machine
 from flipkit.planning.planners import planner
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.solvers import sqp
@@ -109,7 +109,7 @@ def format_profile(result: dict) -> str:
 
 def main(argv=None) -> int:
     """Command-line entry point (see the module docstring)."""
-    parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.profile",
+    parser = argparse.ArgumentParser(prog="python -m bench.profile",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--location", type=int, default=7, metavar="K",
                         help=f"Table I location 1..{len(TABLE1_LOCATIONS)} (default 7)")

@@ -1,10 +1,10 @@
 """Time of the goal pre-check (:func:`flipkit.model.goal_check.check_goal`).
 
-    python -m flipkit.experiments.goal_check_bench [--repeat R]
+    python -m bench.goal_check_bench [--repeat R]
 
 Prints, per goal, the verdict and the median wall time (ms) of R checks, then the medians over
 the issue's two known-infeasible translate goals (refused) and over the six Table I
-translate-like goals (the key points of ``flipkit.experiments.bench.TRANSLATE_KEY_POINTS``,
+translate-like goals (the key points of ``flipkit.experiments.speed.TRANSLATE_KEY_POINTS``,
 paper Fig. 6, each from the previous one; accepted). Each check starts from the README's
 translate start (or the previous key point), as ``flipkit plan translate`` does. The models
 (robot, shapes) are built once, as the planner caches them; their build time and the first
@@ -27,7 +27,7 @@ from flipkit.model.robot import Robot
 FLAT = (0.0, 0.0, 0.0)
 README_START = (0.64, -0.33, 0.15)  # m: README's `flipkit plan translate --from`
 KNOWN_BAD = ((1.10, 0.0, 0.30), (0.70, -0.20, 0.10))  # m: goals out of reach, refused
-# m: flipkit.experiments.bench.TRANSLATE_KEY_POINTS (not imported: that module loads the solvers)
+# m: flipkit.experiments.speed.TRANSLATE_KEY_POINTS (not imported: that module loads the solvers)
 KEY_POINTS = ((0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
               (0.45, 0.74, 0.19), (0.32, 0.62, 0.20), (0.50, 0.52, 0.20))
 

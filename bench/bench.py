@@ -1,12 +1,12 @@
 """Solve-time benchmarks against the paper's budgets: SQP (cvxpy/OSQP) beside IPOPT.
 
-    python -m flipkit.experiments.bench translate [--full] [--jit] [--json OUT]
-    python -m flipkit.experiments.bench flip [--locations N] [--batch K] [--atlas FILE]
+    python -m bench.bench translate [--full] [--jit] [--json OUT]
+    python -m bench.bench flip [--locations N] [--batch K] [--atlas FILE]
                                              [--no-atlas] [--no-ipopt] [--baseline] [--cook]
                                              [--json OUT]
 
-``python -m flipkit.experiments.bench_all`` runs the three side by side.
-``translate``: the six segments between :data:`TRANSLATE_KEY_POINTS` (paper Fig. 6), each
+``python -m bench.bench_all`` runs the three side by side.
+``translate``: the six segments between :data:`~flipkit.experiments.speed.TRANSLATE_KEY_POINTS` (paper Fig. 6), each
 NLP solved by every solver from the same start point ``nlp.x0``: the SQP, FATROP,
 exact-Hessian IPOPT and ``sqpmethod`` (:mod:`flipkit.solvers.exact`, on the NLP as a CasADi
 OCP) and
@@ -46,46 +46,29 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.bench_replan import bench_replan, load_result, run_validation
+from bench.iteration_notes import iteration_notes
 from flipkit.baseline import EE_METHODS, run_baseline
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
-from flipkit.behaviors.options import SegmentOptions
-from flipkit.behaviors.transcribe import flat_pose, transcribe
-from flipkit.config import TABLE1_LOCATIONS, CellConfig
-from flipkit.model.ik import solve_pose
-from flipkit.planning.planners.atlas import Atlas, default_atlas
 from flipkit.behaviors.models import models_for
-from flipkit.planning.planners.chain import solve_segment
+from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.transcribe import transcribe
+from flipkit.config import TABLE1_LOCATIONS, CellConfig
+from flipkit.experiments.speed import (PAPER_EE_OPT_S, PAPER_FIVE_BURGERS_S,
+                                       PAPER_PER_TRAJECTORY_S, TRANSLATE_KEY_POINTS,
+                                       TRANSLATE_SOLVERS, translate_nlps, warm_up)
+from flipkit.experiments.sweep import make_executor
+from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.planning.kitchen.cook import EXAMPLE_ORDER, check_cook, read_cook_csv, table_spots
 from flipkit.planning.kitchen.motions import default_planners
-from flipkit.planning.planners.planner import plan_batch, plan_flip
-from flipkit.experiments.bench_replan import bench_replan, load_result, run_validation
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 from flipkit.planning.kitchen.schedule import schedule_cook
-from flipkit.experiments.iteration_notes import iteration_notes
-from flipkit.experiments.sweep import make_executor
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE
+from flipkit.planning.planners.atlas import Atlas, default_atlas
+from flipkit.planning.planners.chain import solve_segment
+from flipkit.planning.planners.planner import plan_batch, plan_flip
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES, NLP_SOLVERS
-from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
-from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.transcription.ocp_graph import OcpGraph
-
-# Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
-# table), blade-centre positions (m) with the spatula flat, yaw 0. Grill: h_g = 0.072 m,
-# area x 0.60–0.88, y −0.50–0.16 -> blade 7.8 cm above it. Table: 0.10 m, area x 0.20–0.55,
-# y 0.45–0.80 -> blade 9–10 cm above it. All reachable; the order (grill, then the table point
-# farthest from it, ending at the one nearest) lets IK from each point find the next. The table
-# points are 2 cm above where a chain planned without the arm's 2 cm space margin would put
-# them: there it brings the arm into contact with a box of the cell, and the translate from
-# (0.32, 0.62) to (0.50, 0.52) has no solution with the margin.
-TRANSLATE_KEY_POINTS = (
-    (0.65, -0.30, 0.15), (0.80, -0.10, 0.15), (0.70, 0.10, 0.15),
-    (0.45, 0.74, 0.19), (0.32, 0.62, 0.20), (0.50, 0.52, 0.20),
-)
-PAPER_PER_TRAJECTORY_S = 20.0  # Sec. I: < 20 s per trajectory
-PAPER_FIVE_BURGERS_S = 90.0  # Sec. I: 4–5 burgers within 90 s
-PAPER_EE_OPT_S = 1.0  # Sec. I: the end-effector optimisation takes < 1 s
-
 
 def cpu_model() -> str:
     """The CPU's model name (Linux ``/proc/cpuinfo``; else ``platform.processor()``), and
@@ -117,32 +100,9 @@ def machine() -> str:
             f"{os.environ.get('OMP_NUM_THREADS', 'unset')}{load}")
 
 
-def warm_up(nlps) -> float:
-    """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
-    workspace) and run one SQP iteration on it, which compiles the condensed hard QP;
-    returns the time (s). The workspace is the process's default, which the planner's
-    solves use."""
-    t0, seen = time.perf_counter(), set()
-    for nlp in nlps:
-        if nlp.structure_key not in seen:
-            seen.add(nlp.structure_key)
-            for form in ("elastic", "condensed_elastic"):
-                DEFAULT_WORKSPACE.get(nlp, form).compile()
-            solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=1)),
-                      raise_on_failure=False, workspace=DEFAULT_WORKSPACE)
-    return time.perf_counter() - t0
-
-
 def _med(values) -> float:
     values = [v for v in values if v is not None and np.isfinite(v)]
     return statistics.median(values) if values else float("nan")
-
-
-# The translate comparison's solvers: the SQP and IPOPT (L-BFGS, callbacks) on the NLP, FATROP,
-# exact-Hessian IPOPT and CasADi's sqpmethod on its stage-wise graph (flipkit.solvers.exact);
-# labels for the table.
-TRANSLATE_SOLVERS = {"sqp": "SQP", "fatrop": "FATROP", "ipopt_exact": "IPOPT exact",
-                     "sqpmethod": "sqpmethod", "ipopt": "IPOPT L-BFGS"}
 
 
 def _exact_solvers(nlps, jit: bool) -> tuple[dict, dict, dict]:
@@ -170,19 +130,6 @@ def _exact_solvers(nlps, jit: bool) -> tuple[dict, dict, dict]:
         first[name] = graphs[spec][0]
         built.clear()
     return solvers, build, first
-
-
-def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
-    """The six translate segments between :data:`TRANSLATE_KEY_POINTS`, each to the next,
-    as NLPs built with ``options`` (each start pose by IK from q_home)."""
-    models = models_for(cell)
-    robot = models.for_segment("translate")
-    pts, nlps = TRANSLATE_KEY_POINTS, []
-    for k, a in enumerate(pts):
-        q0 = solve_pose(robot, a, (0.0, 0.0, 0.0), robot.q_home)
-        nlps.append(transcribe("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)]),
-                                  options=options))
-    return nlps
 
 
 def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> dict:
@@ -477,7 +424,7 @@ def plain_json(obj):
 
 def main(argv=None) -> int:
     """Command-line entry point (see the module docstring)."""
-    parser = argparse.ArgumentParser(prog="python -m flipkit.experiments.bench",
+    parser = argparse.ArgumentParser(prog="python -m bench.bench",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("which", choices=("translate", "flip", "replan"))
     parser.add_argument("--validate", metavar="FILE",
