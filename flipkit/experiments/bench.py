@@ -63,9 +63,9 @@ from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 from flipkit.planning.kitchen.schedule import schedule_cook
 from flipkit.experiments.iteration_notes import iteration_notes
 from flipkit.experiments.sweep import make_executor
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES, NLP_SOLVERS
+from flipkit.planning.planners.workspaces import thread_workspace
 from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
 from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.transcription.ocp_graph import OcpGraph
@@ -120,16 +120,17 @@ def machine() -> str:
 def warm_up(nlps) -> float:
     """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
     workspace) and run one SQP iteration on it, which compiles the condensed hard QP;
-    returns the time (s). The workspace is the process's default, which the planner's
-    solves use."""
-    t0, seen = time.perf_counter(), set()
+    returns the time (s). The workspace is this thread's planning workspace
+    (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), which the planner's
+    solves here use."""
+    t0, seen, workspace = time.perf_counter(), set(), thread_workspace()
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
             for form in ("elastic", "condensed_elastic"):
-                DEFAULT_WORKSPACE.get(nlp, form).compile()
+                workspace.get(nlp, form).compile()
             solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=1)),
-                      raise_on_failure=False, workspace=DEFAULT_WORKSPACE)
+                      raise_on_failure=False, workspace=workspace)
     return time.perf_counter() - t0
 
 
