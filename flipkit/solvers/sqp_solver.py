@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from flipkit.errors import ConfigError, NoSolutionFound
 from flipkit.solvers.compiled import SQPWorkspace
@@ -232,6 +233,7 @@ class SQPSolver:
             raise ConfigError(f"options: expected SQPOptions, got {type(options).__name__}")
         self.options = options
         self.workspace = SQPWorkspace() if workspace is None else workspace
+        self._blas = None  # the threadpoolctl controller of single_threaded_blas, on first use
 
     # ------------------------------------------------------------------ public
     def solve(self, nlp: NLP, x0=None, raise_on_failure: bool = True) -> SolveResult:
@@ -250,7 +252,9 @@ class SQPSolver:
             NoSolutionFound: Not converged to a feasible point (carries the NLP, status, the
                 worst constraint group and its violation, and the result).
         """
-        with single_threaded_blas():
+        if self._blas is None:
+            self._blas = ThreadpoolController()
+        with single_threaded_blas(self._blas):
             result = self._run(nlp, x0)
         if result.status != Status.SOLVED and raise_on_failure:
             group, amount = nlp.worst_group(result.x)
