@@ -31,8 +31,10 @@ unpacking found once), not through ``unpack_results`` at each solve.
 Setup. Each OSQP object is set up on the first solve after :meth:`OSQPDriver.reset` and only
 updated after that (``update(q=…, l=…, u=…, Px=…, Ax=…)`` on the setup's sparsity, then a
 warm start); :meth:`OSQPDriver.cold` keeps it and restarts ADMM from zero with OSQP's
-initial ρ. The SQP resets its subproblems at the start of every solve, so a solve's OSQP
-objects are set up for it, never inherited from another solve.
+initial ρ. The SQP resets its subproblems at the start of every solve, so OSQP is set up once
+per structure and solve, and updated in every iteration and working-set round of the solve.
+Keeping the objects across solves too was tried: a solve on an updated object does not
+repeat a fresh setup's last bits, and results must not depend on what was solved before.
 
 Statuses are named by :mod:`flipkit.solvers.osqp_status`; cvxpy's compiled problem is read
 through :mod:`flipkit.solvers.cvxpy_adapter`.

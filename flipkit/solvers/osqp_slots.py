@@ -112,7 +112,6 @@ class RowSlots:
         alone[self.private] = np.where(pp > 0, -q[self.private] / np.where(pp > 0, pp, 1.0), 0.0)
         self._values = SimpleNamespace(table=table, priv_a=priv_a, priv_p=priv_p, priv_q=priv_q,
                                        Ps=P_data[self._p_shared], qs=q[self.shared], alone=alone)
-        self._fresh = set(self._solvers)  # every kept solver needs the new P and q
 
     def _matrices(self, slots: np.ndarray, C: int):
         """(P, q, A data) of the slot problem holding the rows ``slots`` (padded with m)."""
@@ -167,17 +166,15 @@ class RowSlots:
                          sp.csc_matrix((A_data, ai, ap), shape=ashape), lw, uw, **settings)
             self._solvers[C] = solver
         else:
-            if C in self._fresh:
-                solver.update(q=q, l=lw, u=uw, Px=P_data, Ax=A_data)
-            else:
-                solver.update(l=lw, u=uw, Ax=A_data)
+            # P and q too: a slot's private columns take its row's weights (refactorised
+            # with the A update in any case)
+            solver.update(q=q, l=lw, u=uw, Px=P_data, Ax=A_data)
             # every round from OSQP's initial ρ, as on a fresh setup: ρ adapted to another
             # working set (or another QP) can slow ADMM down on this one by an order
             solver.update_settings(rho=settings["rho"], eps_abs=settings["eps_abs"],
                                    eps_rel=settings["eps_rel"], max_iter=settings["max_iter"])
             if cold:
                 solver.warm_start(x=np.zeros(len(q)), y=np.zeros(C))
-        self._fresh.discard(C)
         if x0 is not None:
             col = self._priv_col[slots]
             xp = np.where(col >= 0, x0[np.maximum(col, 0)], 0.0)
