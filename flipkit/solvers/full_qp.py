@@ -142,7 +142,7 @@ class QPSubproblem:
         return self._driver
 
     def reset(self) -> None:
-        """Forget OSQP's state: the next solve sets up afresh (no warm start)."""
+        """Forget OSQP's state: the next solve sets OSQP up afresh (no warm start)."""
         if hasattr(self, "_driver"):
             self._driver.reset()
 

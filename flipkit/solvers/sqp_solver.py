@@ -396,12 +396,13 @@ class SQPSolver:
             restoring=s.entry is not None and p.v_max > o.restoration.exit * s.entry,
             curvature=None if s.rows is None else s.rows.curvature())
 
-    def _stationary(self, s: SolveState, step: Step) -> bool:
-        """Stopping rules 1 and 2: the hard QP predicts no more than ``ftol``·J̃, or the
-        last iterates form a plateau of Σu² at a (nearly) feasible point."""
+    def _stationary(self, s: SolveState, step: Step, inexact: bool) -> bool:
+        """Stopping rules 1 and 2: the hard QP, solved tightly enough (not ``inexact``),
+        predicts no more than ``ftol``·J̃, or the last iterates form a plateau of Σu² at a
+        (nearly) feasible point."""
         stop, nlp, p = self.options.termination, s.nlp, s.p
         recent = s.log[-stop.plateau_iterations:]
-        return step.hard and (s.pred <= stop.ftol * max(p.f, 1e-3) or (
+        return step.hard and ((not inexact and s.pred <= stop.ftol * max(p.f, 1e-3)) or (
             len(recent) == stop.plateau_iterations
             and all(r["violation"] <= 100 * stop.tol for r in recent)
             and recent[0]["objective"] - nlp.objective(p.x)
@@ -454,7 +455,7 @@ class SQPSolver:
         # loosely (d = 0 does better): not a stationary point — solve it again, tighter.
         inexact = hard and s.pred < 0 and s.p.v_max <= stop.tol and r.eps > o.qp.eps[0]
         s.tighten = 0.01 * s.tighten if inexact else 1.0
-        stationary = not inexact and self._stationary(s, step)
+        stationary = self._stationary(s, step, inexact)
         side = np.sign(sol.multipliers) * (nlp.c_lo != nlp.c_hi) if hard else None  # active rows
         if stationary and s.p.v_max > stop.tol:
             self._onto_rows(s, side)
