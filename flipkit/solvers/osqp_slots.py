@@ -89,6 +89,7 @@ class RowSlots:
         self._Ps_indptr = np.concatenate(
             [[0], np.cumsum(np.bincount(pos[p_cols[keep]], minlength=ns))]).astype(np.int32)
         self._solvers: dict[int, osqp.OSQP] = {}
+        self._adapted: set[int] = set()  # capacities whose solver's ρ ADMM has adapted
         self._values = None
 
     # ------------------------------------------------------------------ data
@@ -170,9 +171,13 @@ class RowSlots:
             # with the A update in any case)
             solver.update(q=q, l=lw, u=uw, Px=P_data, Ax=A_data)
             # every round from OSQP's initial ρ, as on a fresh setup: ρ adapted to another
-            # working set (or another QP) can slow ADMM down on this one by an order
-            solver.update_settings(rho=settings["rho"], eps_abs=settings["eps_abs"],
-                                   eps_rel=settings["eps_rel"], max_iter=settings["max_iter"])
+            # working set (or another QP) can slow ADMM down on this one by an order. (A ρ
+            # update refactorises: skipped while ADMM has not adapted ρ since the last one.)
+            if C in self._adapted:
+                solver.update_settings(rho=settings["rho"])
+                self._adapted.discard(C)
+            solver.update_settings(eps_abs=settings["eps_abs"], eps_rel=settings["eps_rel"],
+                                   max_iter=settings["max_iter"])
             if cold:
                 solver.warm_start(x=np.zeros(len(q)), y=np.zeros(C))
         if x0 is not None:
@@ -182,6 +187,8 @@ class RowSlots:
             yw[:len(rows)] = y0[rows]
             solver.warm_start(x=np.concatenate([x0[self.shared], xp.ravel()]), y=yw)
         res = solver.solve(raise_error=False)
+        if res.info.rho_updates > 0:
+            self._adapted.add(C)
         return self._full(res, rows, slots)
 
     def _full(self, res, rows: np.ndarray, slots: np.ndarray):
