@@ -4,7 +4,6 @@ updated, the full QP's solution assembled from the slots, private columns includ
 import cvxpy as cp
 import numpy as np
 import osqp
-import pytest
 
 from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
 from flipkit.solvers.osqp_slots import MIN_SLOTS, RowSlots, _capacity

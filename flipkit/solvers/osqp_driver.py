@@ -33,7 +33,7 @@ updated after that (``update(q=…, l=…, u=…, Px=…, Ax=…)`` on the setup
 warm start); :meth:`OSQPDriver.cold` keeps it and restarts ADMM from zero with OSQP's
 initial ρ. The SQP resets its subproblems at the start of every solve, so OSQP is set up once
 per structure and solve, and updated in every iteration and working-set round of the solve.
-Keeping the objects across solves too was tried: a solve on an updated object does not
+The objects are not kept from one solve to the next: a solve on an updated object does not
 repeat a fresh setup's last bits, and results must not depend on what was solved before.
 
 Statuses are named by :mod:`flipkit.solvers.osqp_status`; cvxpy's compiled problem is read

@@ -114,9 +114,10 @@ class RowSlots:
         self._values = SimpleNamespace(table=table, priv_a=priv_a, priv_p=priv_p, priv_q=priv_q,
                                        Ps=P_data[self._p_shared], qs=q[self.shared], alone=alone)
 
-    def _matrices(self, slots: np.ndarray, C: int):
-        """(P, q, A data) of the slot problem holding the rows ``slots`` (padded with m)."""
-        v, ns, K = self._values, len(self.shared), self.K
+    def _matrices(self, slots: np.ndarray):
+        """(P data, q, A data) of the slot problem holding the rows ``slots`` (padded with m,
+        the empty row), on the patterns of :meth:`_patterns`."""
+        v = self._values
         A_data = np.concatenate([v.table[slots].ravel(order="F"), v.priv_a[slots].ravel()])
         P_data = np.concatenate([v.Ps, v.priv_p[slots].ravel()])
         q = np.concatenate([v.qs, v.priv_q[slots].ravel()])
@@ -155,7 +156,7 @@ class RowSlots:
         C = _capacity(len(rows))
         slots = np.full(C, self.m)
         slots[:len(rows)] = rows
-        P_data, q, A_data = self._matrices(slots, C)
+        P_data, q, A_data = self._matrices(slots)
         lw = np.full(C, -np.inf)
         uw = np.full(C, np.inf)
         lw[:len(rows)], uw[:len(rows)] = l[rows], u[rows]
@@ -171,8 +172,8 @@ class RowSlots:
             # with the A update in any case)
             solver.update(q=q, l=lw, u=uw, Px=P_data, Ax=A_data)
             # every round from OSQP's initial ρ, as on a fresh setup: ρ adapted to another
-            # working set (or another QP) can slow ADMM down on this one by an order. (A ρ
-            # update refactorises: skipped while ADMM has not adapted ρ since the last one.)
+            # working set (or another QP) can slow ADMM down on this one. (A ρ update
+            # refactorises: skipped while ADMM has not adapted ρ since the last one.)
             if C in self._adapted:
                 solver.update_settings(rho=settings["rho"])
                 self._adapted.discard(C)

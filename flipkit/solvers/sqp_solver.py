@@ -215,8 +215,8 @@ class SQPSolver:
     """The SQP of :mod:`flipkit.solvers.sqp` with its settings and compiled subproblems.
 
     Build one and solve many NLPs with it: each NLP structure's subproblems are compiled
-    (cvxpy, 0.01–0.4 s each) and their OSQP solvers set up on its first solve, then only
-    updated. Results do not depend on the order of the solves.
+    (cvxpy) on its first solve and reused; within a solve each OSQP solver is set up once
+    and then updated. Results do not depend on the order of the solves.
 
     Args:
         options: The settings (:class:`~flipkit.solvers.sqp_options.SQPOptions`).
@@ -260,14 +260,6 @@ class SQPSolver:
             group, amount = nlp.worst_group(result.x)
             raise NoSolutionFound(nlp, result.status, group, amount, result)
         return result
-
-    def prepare(self, nlp: NLP) -> None:
-        """Compile every subproblem form the settings use for ``nlp``'s structure, so that no
-        later solve of the structure pays for cvxpy's canonicalisation."""
-        forms = (("condensed", "condensed_elastic", "elastic") if self.options.qp.condense
-                 else ("full", "elastic"))
-        for form in forms:
-            self.workspace.get(nlp, form).compile()
 
     def step(self, nlp: NLP, r: StepRequest) -> Step:
         """The step at ``r.p``: the hard QP (if OSQP runs out of iterations — not infeasible —

@@ -7,8 +7,8 @@ a second solve in a sweep worker, a notebook, another process — its threads wa
 other, and a condensed QP update takes over ten times as long as with one thread.
 :func:`single_threaded_blas` limits every BLAS library loaded in the process to one thread
 for the duration of a ``with`` block and restores the previous setting after it, through
-threadpoolctl. Building a controller scans the loaded libraries (about a millisecond), so a
-caller that enters the block often keeps its own controller and passes it in
+threadpoolctl. Building a controller scans the loaded libraries, so a caller that enters the
+block often keeps its own controller and passes it in
 (:class:`~flipkit.solvers.sqp_solver.SQPSolver` does).
 """
 

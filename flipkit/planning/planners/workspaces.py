@@ -1,9 +1,10 @@
 """The planners' SQP workspaces: one per thread, kept for the thread's life.
 
 A workspace (:class:`~flipkit.solvers.compiled.SQPWorkspace`) holds each NLP structure's
-compiled subproblems and their OSQP solvers. Compiling costs 0.01–0.4 s per subproblem, and
-every ``plan_*`` call makes a new :class:`~flipkit.planning.planners.chain.Planner`, so the
-planners share a workspace between the calls of one thread instead of compiling per plan.
+compiled subproblems and their OSQP solvers. Compiling a subproblem (cvxpy's
+canonicalisation) costs more than many of its solves, and every ``plan_*`` call makes a new
+:class:`~flipkit.planning.planners.chain.Planner`, so the planners share a workspace between
+the calls of one thread instead of compiling per plan.
 A workspace serves one solve at a time, hence one per thread: threads planning at once (a
 cell that plans while it executes) never share one. A planner given its own workspace uses
 that one instead.
