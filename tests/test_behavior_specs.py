@@ -220,12 +220,14 @@ def test_a_planner_with_its_own_workspace_plans_the_same():
     b = Planner(CELL, solver="sqp", workspace=own).chain("translate", goal, q0, qd0)
     assert a.status == b.status == "solved"
     np.testing.assert_allclose(a.segments[0].q, b.segments[0].q, atol=1e-9)
-    assert own is not thread_workspace() and own._built  # its own compiled subproblems
-    assert shared.workspace is thread_workspace()  # the thread's, passed down
+    mine = thread_workspace(SQPWorkspace)
+    assert own is not mine and own._built  # its own compiled subproblems
+    nlp_key = next(iter(own._built))[0]
+    assert any(key[0] == nlp_key for key in mine._built)  # the shared planner's: the thread's
     other = []
     import threading
 
-    t = threading.Thread(target=lambda: other.append(thread_workspace()))
+    t = threading.Thread(target=lambda: other.append(thread_workspace(SQPWorkspace)))
     t.start()
     t.join()
-    assert other[0] is not thread_workspace()  # another thread's is its own
+    assert other[0] is not mine and thread_workspace(SQPWorkspace) is mine

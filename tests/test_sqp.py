@@ -183,7 +183,7 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
     """Where the linearised rows cannot be met within a shrunken trust box, the SQP takes the
     hard QP's step in the largest box (Δ_max ∩ bounds) and lets the line search shorten it;
     only without that box does it fall back to the elastic restoration QP."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.iterate import Iterate
 
     nlp, _ = reference
@@ -211,7 +211,7 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
 def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
     """The elastic step trades Σu² for feasibility: its line search runs on ½‖v‖², and the
     step is taken even when the ℓ1 merit's model predicts no decrease of φ."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.iterate import Iterate, newton_correction
 
     nlp, _ = reference
@@ -314,7 +314,7 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     hard) is infeasible and only the full-space one (every row elastic) gives a step; within
     ``restoration.radius`` the condensed one does, it holds the linearised equalities, and it
     removes most of the linearised violation."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.condensed_qp import CondensedQP
     from flipkit.solvers.full_qp import QPSubproblem
     from flipkit.solvers.iterate import Iterate
@@ -371,7 +371,7 @@ def test_a_rejected_step_never_widens_the_trust_box():
     largest box (taken when a shrunken box is infeasible) is longer than Δ: a tenth of its
     length once set Δ back to the same value at the same point, and a flip from the atlas ran
     85 identical iterations to max_iter (measured)."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
 
     o = SQPOptions()
     trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=2.38e-3, trust=2.38e-4, mu=1.0)

@@ -66,7 +66,7 @@ from flipkit.experiments.sweep import make_executor
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES, NLP_SOLVERS
 from flipkit.planning.planners.workspaces import thread_workspace
-from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
+from flipkit.solvers.sqp import SQPOptions, SQPWorkspace, TerminationOptions, solve_sqp
 from flipkit.model.casadi_dynamics import CasadiArm
 from flipkit.transcription.ocp_graph import OcpGraph
 
@@ -123,7 +123,7 @@ def warm_up(nlps) -> float:
     returns the time (s). The workspace is this thread's planning workspace
     (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), which the planner's
     solves here use."""
-    t0, seen, workspace = time.perf_counter(), set(), thread_workspace()
+    t0, seen, workspace = time.perf_counter(), set(), thread_workspace(SQPWorkspace)
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)

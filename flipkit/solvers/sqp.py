@@ -89,9 +89,7 @@ from flipkit.solvers.compiled import SQPWorkspace
 from flipkit.solvers.result import SolveResult
 from flipkit.solvers.sqp_options import (QPOptions, RestorationOptions, SQPOptions,
                                          TerminationOptions, TrustRegionOptions)
-from flipkit.solvers.sqp_solver import (SQPSolver, Step, StepRequest, _adapt,  # noqa: F401
-                                        _descent_model, _line_search, _linearised_violation,
-                                        _square_violation)
+from flipkit.solvers.sqp_solver import SQPSolver, Step, StepRequest
 from flipkit.transcription.nlp import NLP
 
 __all__ = ["QPOptions", "RestorationOptions", "SQPOptions", "SQPSolver", "SQPWorkspace",

@@ -53,10 +53,11 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     """
     # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
     # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
-    from flipkit.solvers import ipopt, sqp
+    from flipkit.solvers import compiled, ipopt, sqp
 
     if solver == "sqp":
-        sqp_kwargs.setdefault("workspace", thread_workspace())
+        if sqp_kwargs.get("workspace") is None:
+            sqp_kwargs["workspace"] = thread_workspace(compiled.SQPWorkspace)
         try:
             return sqp.solve_sqp(nlp, x0, raise_on_failure=False, **sqp_kwargs)
         except SolverError:  # OSQP or a factorisation broke down inside a subproblem
@@ -182,10 +183,10 @@ class Planner:
         options: Transcription options.
         workspace: The SQP's compiled subproblems
             (:class:`~flipkit.solvers.compiled.SQPWorkspace`) this planner solves in, passed
-            down to every segment's solve; ``None``: the thread's
-            (:func:`~flipkit.planning.planners.workspaces.thread_workspace`, taken on the
-            first solve), so that planners made one after another in a thread (every
-            ``plan_flip`` call) compile each subproblem structure once.
+            down to every segment's solve; ``None``: the solving thread's
+            (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), so that
+            planners made one after another in a thread (every ``plan_flip`` call) compile
+            each subproblem structure once.
 
     Raises:
         InvalidChoiceError: Unknown solver.
@@ -259,9 +260,7 @@ class Planner:
         def build(options):
             return transcribe(spec, self.models, q, qd, options=options, task=task)
 
-        if self.workspace is None:
-            self.workspace = thread_workspace()
-        own = {"workspace": self.workspace}
+        own = {"workspace": self.workspace}  # None: solve_segment takes the thread's
         if not stretch:
             nlp = build(self.options)
             return nlp, solve_segment(nlp, self.solver, **own)

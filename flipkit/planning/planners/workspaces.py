@@ -13,18 +13,22 @@ that one instead.
 from __future__ import annotations
 
 import threading
+from typing import Callable
 
 __all__ = ["thread_workspace"]
 
 _local = threading.local()
 
 
-def thread_workspace():
-    """This thread's workspace (:class:`~flipkit.solvers.compiled.SQPWorkspace`), made on
-    first use; the solvers (cvxpy) are imported then, not when the planners are."""
+def thread_workspace(make: Callable):
+    """This thread's workspace, made by ``make`` on first use.
+
+    Args:
+        make: Builds the workspace (:class:`~flipkit.solvers.compiled.SQPWorkspace`). The
+            caller passes it, so that importing the planners does not load the solvers
+            (cvxpy): they are loaded by the first solve.
+    """
     workspace = getattr(_local, "workspace", None)
     if workspace is None:
-        from flipkit.solvers.compiled import SQPWorkspace
-
-        workspace = _local.workspace = SQPWorkspace()
+        workspace = _local.workspace = make()
     return workspace
