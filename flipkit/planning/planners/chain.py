@@ -260,7 +260,8 @@ class Planner:
         def build(options):
             return transcribe(spec, self.models, q, qd, options=options, task=task)
 
-        own = {"workspace": self.workspace}  # None: solve_segment takes the thread's
+        # without one of its own, solve_segment solves in the thread's
+        own = {} if self.workspace is None else {"workspace": self.workspace}
         if not stretch:
             nlp = build(self.options)
             return nlp, solve_segment(nlp, self.solver, **own)
