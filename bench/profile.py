@@ -38,7 +38,7 @@ PARTS = {
     "cvxpy": (("cvxpy/problems/problem.py", "get_problem_data"),
               ("cvxpy/problems/problem.py", "unpack_results")),
     "osqp": (("~", "<built-in method osqp.ext_builtin.solve>"),
-             ("osqp/interface.py", "setup")),
+             ("osqp/interface.py", "setup"), ("osqp/interface.py", "update")),
     "newton": (("solvers/iterate.py", "newton_correction"),),
 }
 TOTAL = ("solvers/sqp.py", "solve_sqp")

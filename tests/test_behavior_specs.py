@@ -206,8 +206,9 @@ def test_the_plan_format_names_every_registered_subbehaviour():
 
 def test_a_planner_with_its_own_workspace_plans_the_same():
     """The SQP's workspace is the planner's when given one: its compiled subproblems are
-    used, with the same plan."""
-    from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
+    used, with the same plan; without one, planners in a thread share the thread's."""
+    from flipkit.planning.planners.workspaces import thread_workspace
+    from flipkit.solvers.compiled import SQPWorkspace
 
     goal = Task(goal=flat_pose((0.70, 0.05, 0.30)))
     shared = Planner(CELL, solver="sqp")
@@ -219,4 +220,14 @@ def test_a_planner_with_its_own_workspace_plans_the_same():
     b = Planner(CELL, solver="sqp", workspace=own).chain("translate", goal, q0, qd0)
     assert a.status == b.status == "solved"
     np.testing.assert_allclose(a.segments[0].q, b.segments[0].q, atol=1e-9)
-    assert own is not DEFAULT_WORKSPACE and own._built  # its own compiled subproblems
+    mine = thread_workspace(SQPWorkspace)
+    assert own is not mine and own._built  # its own compiled subproblems
+    nlp_key = next(iter(own._built))[0]
+    assert any(key[0] == nlp_key for key in mine._built)  # the shared planner's: the thread's
+    other = []
+    import threading
+
+    t = threading.Thread(target=lambda: other.append(thread_workspace(SQPWorkspace)))
+    t.start()
+    t.join()
+    assert other[0] is not mine and thread_workspace(SQPWorkspace) is mine

@@ -12,7 +12,7 @@ from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.model.ik import solve_pose
 from flipkit.solvers.full_qp import QPSubproblem
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE
+from flipkit.solvers.compiled import SQPWorkspace
 from flipkit.solvers.condensed_qp import CondensedQP
 from flipkit.solvers.sqp import QPOptions, SQPOptions, TerminationOptions, solve_sqp
 
@@ -69,8 +69,10 @@ def test_null_space_dimension_and_basis(segments):
 
 def test_structure_shares_one_compiled_problem(segments):
     nlp = segments["translate"]
-    assert DEFAULT_WORKSPACE.get(nlp, "condensed") is DEFAULT_WORKSPACE.get(nlp, "condensed")
-    assert DEFAULT_WORKSPACE.get(nlp, "condensed").problem.is_dpp()
+    ws = SQPWorkspace()
+    assert ws.get(nlp, "condensed") is ws.get(nlp, "condensed")
+    assert ws.get(nlp, "condensed").problem.is_dpp()
+    assert SQPWorkspace().get(nlp, "condensed") is not ws.get(nlp, "condensed")
 
 
 def test_warm_start_cuts_iterations(segments):

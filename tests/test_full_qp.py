@@ -12,7 +12,7 @@ from flipkit.behaviors.models import Models
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE
+from flipkit.solvers.compiled import SQPWorkspace
 from flipkit.solvers.full_qp import QPSubproblem
 
 
@@ -46,8 +46,10 @@ def _load(qp, nlp, x, grad_scale=1.0, box=0.5):
 def test_shared_structure_shares_one_compiled_problem(setup):
     a, b = setup
     assert a.structure_key == b.structure_key
-    assert DEFAULT_WORKSPACE.get(a) is DEFAULT_WORKSPACE.get(b)
-    assert DEFAULT_WORKSPACE.get(a).problem.is_dpp()
+    ws = SQPWorkspace()
+    assert ws.get(a) is ws.get(b)
+    assert ws.get(a).problem.is_dpp()
+    assert SQPWorkspace().get(a) is not ws.get(a)  # a workspace's compiled problems are its own
 
 
 def test_step_satisfies_linearised_constraints_and_kkt(setup):

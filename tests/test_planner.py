@@ -137,7 +137,7 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
 
     calls = []
 
-    def failing_sqp(nlp, x0=None, options=None, raise_on_failure=True):
+    def failing_sqp(nlp, x0=None, options=None, raise_on_failure=True, workspace=None):
         calls.append("sqp")
         x = np.clip(nlp.x0, nlp.x_lb, nlp.x_ub)
         return SolveResult(x=x, status="stalled", iterations=3, wall_time_s=1.5,

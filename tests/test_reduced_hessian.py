@@ -137,7 +137,7 @@ def test_sqp_with_and_without_the_estimate_reach_one_optimum(translate):
 def test_the_sqp_feeds_the_estimate_to_its_subproblems(translate, monkeypatch):
     """Every accepted hard step updates M, and the later subproblems solve with it (the
     condensed QP reports ``curved``); with ``quasi_newton=False`` neither happens."""
-    from flipkit.solvers import reduced_hessian, sqp
+    from flipkit.solvers import reduced_hessian
 
     seen = {"updates": 0, "curved": 0}
     update, original = reduced_hessian.ReducedHessian.update, CondensedQP.update
@@ -150,7 +150,7 @@ def test_the_sqp_feeds_the_estimate_to_its_subproblems(translate, monkeypatch):
         original(self, *args, **kwargs)
         seen["curved"] += bool(self.curved)
 
-    monkeypatch.setattr(sqp.ReducedHessian, "update", counting_update)
+    monkeypatch.setattr(reduced_hessian.ReducedHessian, "update", counting_update)
     monkeypatch.setattr(CondensedQP, "update", counting_qp)
     res = solve_sqp(translate)
     accepted = sum(1 for r in res.log if r["step"] > 0 and not r["elastic"])

@@ -8,8 +8,8 @@ from sqp_reference import LOG_PATH, log_rows, run
 
 from flipkit.errors import NoSolutionFound
 from flipkit.solvers.ipopt import solve_ipopt
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE, SQPWorkspace
-from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
+from flipkit.solvers.compiled import SQPWorkspace
+from flipkit.solvers.sqp import SQPOptions, SQPSolver, StepRequest, TerminationOptions, solve_sqp
 
 
 @pytest.fixture(scope="module")
@@ -121,20 +121,39 @@ def test_sequential_solves_repeat_exactly(reference):
 
 
 def test_a_workspace_of_the_callers_own_gives_the_same_solves(reference):
-    """A caller's workspace compiles its own subproblems, leaves the default workspace's
-    alone, and is reset on entry like the default one: after another solve of the same
-    structure in it, the reference solve repeats exactly."""
+    """A caller's workspace compiles its own subproblems, leaves other workspaces' alone,
+    and is reset on entry: after another solve of the same structure in it, the reference
+    solve repeats exactly."""
     nlp, res = reference
     from sqp_reference import reference_nlp
 
-    default_qp = DEFAULT_WORKSPACE.get(nlp, "condensed")
+    elsewhere = SQPWorkspace()
+    elsewhere_qp = elsewhere.get(nlp, "condensed")
     own = SQPWorkspace()
     other = reference_nlp()
     solve_sqp(other, x0=other.x0 + 0.01 * other.x_scale, raise_on_failure=False, workspace=own)
     again = solve_sqp(nlp, workspace=own)
     assert np.array_equal(again.x, res.x) and again.iterations == res.iterations
-    assert own.get(nlp, "condensed") is not default_qp
-    assert DEFAULT_WORKSPACE.get(nlp, "condensed") is default_qp
+    assert own.get(nlp, "condensed") is not elsewhere_qp
+    assert elsewhere.get(nlp, "condensed") is elsewhere_qp
+
+
+def test_one_solver_solves_many_times_in_its_own_workspace(reference):
+    """An SQPSolver keeps its compiled subproblems from solve to solve (no second compile)
+    and repeats the reference solve exactly after solving another NLP of the structure."""
+    nlp, res = reference
+    from sqp_reference import reference_nlp
+
+    solver = SQPSolver()
+    first = solver.solve(nlp)
+    qp = solver.workspace.get(nlp, "condensed")
+    other = reference_nlp()
+    solver.solve(other, x0=other.x0 + 0.01 * other.x_scale, raise_on_failure=False)
+    again = solver.solve(nlp)
+    assert solver.workspace.get(nlp, "condensed") is qp
+    for r in (first, again):
+        assert np.array_equal(r.x, res.x) and r.iterations == res.iterations
+    assert SQPSolver().workspace is not solver.workspace
 
 
 def test_no_restoration_from_a_feasible_point():
@@ -164,7 +183,7 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
     """Where the linearised rows cannot be met within a shrunken trust box, the SQP takes the
     hard QP's step in the largest box (Δ_max ∩ bounds) and lets the line search shorten it;
     only without that box does it fall back to the elastic restoration QP."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.iterate import Iterate
 
     nlp, _ = reference
@@ -179,10 +198,11 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
     tiny = (np.maximum(lo, -1e-5), np.minimum(hi, 1e-5))
     big = o.trust_region.radius_max
     wide = (np.maximum(lo, -big), np.minimum(hi, big))
-    mu, ws = o.trust_region.prox, DEFAULT_WORKSPACE
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, mu, *tiny, 1e-6, workspace=ws)
-    assert qp.elastic  # no wide box: restoration
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, mu, *tiny, 1e-6, wide, workspace=ws)
+    mu, solver = o.trust_region.prox, SQPSolver(o)
+    step = solver.step(nlp, StepRequest(p, grad, hess, mu, tiny, 1e-6))
+    assert step.qp.elastic  # no wide box: restoration
+    step = solver.step(nlp, StepRequest(p, grad, hess, mu, tiny, 1e-6, wide=wide))
+    sol, qp = step.sol, step.qp
     assert not qp.elastic and sol.status == "optimal"
     assert np.abs(sol.d).max() <= big + 1e-6 and np.abs(sol.d).max() > 1e-5
     assert S._linearised_violation(nlp, p, sol.d) < 1e-3 * float(p.v.sum())
@@ -191,7 +211,7 @@ def test_an_infeasible_trust_box_gets_the_hard_step_of_the_largest_box(reference
 def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
     """The elastic step trades Σu² for feasibility: its line search runs on ½‖v‖², and the
     step is taken even when the ℓ1 merit's model predicts no decrease of φ."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.iterate import Iterate, newton_correction
 
     nlp, _ = reference
@@ -202,9 +222,9 @@ def test_a_restoration_step_is_judged_by_the_violation_it_removes(reference):
     grad = nlp.gradient(p.x) * nlp.obj_scale * D
     hess = nlp.hessian_diagonal() * nlp.obj_scale * D**2
     lo, hi = (nlp.x_lb - p.x) / D, (nlp.x_ub - p.x) / D
-    sol, qp, *_ = S._subproblem(nlp, o, p, grad, hess, o.trust_region.prox,
-                                np.maximum(lo, -1e-2), np.minimum(hi, 1e-2), 1e-6,
-                                workspace=DEFAULT_WORKSPACE)
+    step = SQPSolver(o).step(nlp, StepRequest(p, grad, hess, o.trust_region.prox,
+                                              (np.maximum(lo, -1e-2), np.minimum(hi, 1e-2)), 1e-6))
+    sol, qp = step.sol, step.qp
     assert qp.elastic
     lin = S._linearised_violation(nlp, p, sol.d, total=False)
     decrease = S._square_violation(p) - 0.5 * float(lin @ lin)
@@ -294,7 +314,7 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     hard) is infeasible and only the full-space one (every row elastic) gives a step; within
     ``restoration.radius`` the condensed one does, it holds the linearised equalities, and it
     removes most of the linearised violation."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
     from flipkit.solvers.condensed_qp import CondensedQP
     from flipkit.solvers.full_qp import QPSubproblem
     from flipkit.solvers.iterate import Iterate
@@ -309,11 +329,12 @@ def test_a_cold_flip_restores_in_condensed_form_within_the_restoration_box(cold_
     def box(radius):
         return np.maximum(lo, -radius), np.minimum(hi, radius)
 
-    big, ws = o.trust_region.radius_max, DEFAULT_WORKSPACE
-    args = (nlp, o, p, grad, hess, o.trust_region.prox, *box(big), 1e-4)
-    sol, qp, *_ = S._subproblem(*args, workspace=ws)
-    assert qp.elastic and isinstance(qp, QPSubproblem)  # the condensed form had no step
-    sol, qp, *_ = S._subproblem(*args, None, o.restoration.radius, workspace=ws)
+    big, solver = o.trust_region.radius_max, SQPSolver(o)
+    args = (p, grad, hess, o.trust_region.prox, box(big), 1e-4)
+    step = solver.step(nlp, StepRequest(*args))
+    assert step.qp.elastic and isinstance(step.qp, QPSubproblem)  # the condensed form had no step
+    step = solver.step(nlp, StepRequest(*args, restore=o.restoration.radius))
+    sol, qp = step.sol, step.qp
     assert qp.elastic and isinstance(qp, CondensedQP) and sol.status == "optimal"
     eq = nlp.c_lo == nlp.c_hi
     lin = p.cs + p.J @ sol.d
@@ -350,7 +371,7 @@ def test_a_rejected_step_never_widens_the_trust_box():
     largest box (taken when a shrunken box is infeasible) is longer than Δ: a tenth of its
     length once set Δ back to the same value at the same point, and a flip from the atlas ran
     85 identical iterations to max_iter (measured)."""
-    from flipkit.solvers import sqp as S
+    from flipkit.solvers import sqp_solver as S
 
     o = SQPOptions()
     trust, _ = S._adapt(o, False, 0.0, -6.1, d_len=2.38e-3, trust=2.38e-4, mu=1.0)

@@ -21,16 +21,20 @@ def test_single_threaded_inside_and_restored_after():
 
 
 def test_sqp_solves_inside_the_limit(monkeypatch):
-    """solve_sqp's loop runs with one BLAS thread (the limit is entered around it)."""
-    seen = []
+    """solve_sqp's loop (SQPSolver's) runs with one BLAS thread (the limit is entered around
+    it), and the previous setting is back after it."""
+    from flipkit.solvers.sqp_solver import SQPSolver
 
-    def probe(nlp, x0, options, workspace):
+    seen, before = [], _blas_threads()
+
+    def probe(self, nlp, x0):
         seen.append(_blas_threads())
         raise RuntimeError("stop")
 
-    monkeypatch.setattr(sqp_module, "_solve", probe)
+    monkeypatch.setattr(SQPSolver, "_run", probe)
     try:
         sqp_module.solve_sqp(object())
     except RuntimeError:
         pass
     assert seen and all(n == 1 for n in seen[0])
+    assert _blas_threads() == before

@@ -15,8 +15,8 @@ from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.solvers.compiled import DEFAULT_WORKSPACE
-from flipkit.solvers.sqp import SQPOptions, TerminationOptions, solve_sqp
+from flipkit.planning.planners.workspaces import thread_workspace
+from flipkit.solvers.sqp import SQPOptions, SQPWorkspace, TerminationOptions, solve_sqp
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
 # table), blade-centre positions (m) with the spatula flat, yaw 0. Grill: h_g = 0.072 m,
@@ -58,15 +58,16 @@ def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
 def warm_up(nlps) -> float:
     """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
     workspace) and run one SQP iteration on it, which compiles the condensed hard QP;
-    returns the time (s). The workspace is the process's default, which the planner's
-    solves use."""
-    t0, seen = time.perf_counter(), set()
+    returns the time (s). The workspace is this thread's planning workspace
+    (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), which the planner's
+    solves here use."""
+    t0, seen, workspace = time.perf_counter(), set(), thread_workspace(SQPWorkspace)
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
             for form in ("elastic", "condensed_elastic"):
-                DEFAULT_WORKSPACE.get(nlp, form).compile()
+                workspace.get(nlp, form).compile()
             solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=1)),
-                      raise_on_failure=False, workspace=DEFAULT_WORKSPACE)
+                      raise_on_failure=False, workspace=workspace)
     return time.perf_counter() - t0
 

@@ -2,15 +2,16 @@
 and reused.
 
 Canonicalising a subproblem with cvxpy costs 0.01–0.4 s, so a workspace compiles each
-(structure, form) once; its parameters then take each linearisation's values (DPP) and OSQP
-warm-starts. :func:`flipkit.solvers.sqp.solve_sqp` calls :meth:`SQPWorkspace.reset` on entry,
-which forgets the OSQP state of the NLP's structure, so a solve never warm-starts from another
-solve's solution: results do not depend on what the workspace solved before.
+(structure, form) once; its parameters then take each linearisation's values (DPP) and its
+OSQP solver, set up once, is updated and warm-started. :class:`~flipkit.solvers.sqp_solver.SQPSolver`
+owns one and calls :meth:`SQPWorkspace.reset` at the start of every solve, which forgets the
+OSQP state of the NLP's structure, so a solve never warm-starts from another solve's
+solution: results do not depend on what the workspace solved before.
 
-A caller may own a workspace (``solve_sqp(nlp, workspace=SQPWorkspace())``); without one,
-``solve_sqp`` uses :data:`DEFAULT_WORKSPACE`, shared by the process, so the compiled
-subproblems are reused from solve to solve. A workspace serves one solve at a time: solves
-running concurrently in threads need one each.
+Who keeps a workspace decides how long compiled subproblems live: the planners keep one per
+thread (:mod:`flipkit.planning.planners.workspaces`), so that planners made one after another
+compile each structure once. A workspace serves one solve at a time: solves running
+concurrently in threads need one each.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from flipkit.solvers.full_qp import QPSubproblem
 from flipkit.solvers.subproblem import Subproblem
 from flipkit.transcription.nlp import NLP
 
-__all__ = ["DEFAULT_WORKSPACE", "FORMS", "SQPWorkspace"]
+__all__ = ["FORMS", "SQPWorkspace"]
 
 FORMS = ("full", "elastic", "condensed", "condensed_elastic")
 
@@ -55,7 +56,3 @@ class SQPWorkspace:
             if structure == nlp.structure_key:
                 qp.reset()
 
-
-DEFAULT_WORKSPACE = SQPWorkspace()
-"""The process's workspace: :func:`flipkit.solvers.sqp.solve_sqp` uses it when called without
-one."""

@@ -47,6 +47,7 @@ import scipy.sparse.linalg as spla
 from flipkit.errors import ConfigError, SingularBasisError, SolverError
 from flipkit.solvers.fixed_sparse import FixedPattern
 from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
+from flipkit.solvers.osqp_status import PolishStatus
 from flipkit.solvers.subproblem import QPSolution
 from flipkit.transcription.nlp import NLP
 
@@ -160,9 +161,10 @@ class CondensedQP:
             self._driver.reset()
 
     def cold(self) -> None:
-        """Drop OSQP's warm start and working set (the next solve starts from zero)."""
+        """Drop OSQP's warm start and working set (the next solve starts from zero; OSQP's
+        setup is kept)."""
         if hasattr(self, "_driver"):
-            self._driver.reset()
+            self._driver.cold()
 
     def compile(self) -> OSQPDriver:
         """Canonicalise with cvxpy (once) and return the OSQP driver."""
@@ -250,4 +252,5 @@ class CondensedQP:
         residual = grad + hess * d + JI.T @ y_I + dual["box_hi"] - dual["box_lo"]
         y[self.eq_rows] = -lu.solve(residual[self.basis], trans="T")
         y[self.ineq_rows] = y_I
-        return QPSolution(d, status, iterations, y, res.info.status_polish == 1)
+        polished = res.info.status_polish == PolishStatus.OSQP_POLISH_SUCCESS
+        return QPSolution(d, status, iterations, y, polished)

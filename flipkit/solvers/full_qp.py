@@ -31,6 +31,7 @@ import scipy.sparse as sp
 
 from flipkit.errors import SolverError
 from flipkit.solvers.osqp_driver import OSQPDriver, run_osqp
+from flipkit.solvers.osqp_status import PolishStatus
 from flipkit.solvers.subproblem import QPSolution
 from flipkit.transcription.nlp import NLP
 
@@ -129,9 +130,10 @@ class QPSubproblem:
         self.slack_reg.value = slack_reg
 
     def cold(self) -> None:
-        """Drop OSQP's warm start and working set (the next solve starts from zero)."""
+        """Drop OSQP's warm start and working set (the next solve starts from zero; OSQP's
+        setup is kept)."""
         if hasattr(self, "_driver"):
-            self._driver.reset()
+            self._driver.cold()
 
     def compile(self) -> OSQPDriver:
         """Canonicalise with cvxpy (once; 0.1–0.4 s) and return the OSQP driver."""
@@ -140,7 +142,7 @@ class QPSubproblem:
         return self._driver
 
     def reset(self) -> None:
-        """Forget OSQP's state: the next solve sets up afresh (no warm start)."""
+        """Forget OSQP's state: the next solve sets OSQP up afresh (no warm start)."""
         if hasattr(self, "_driver"):
             self._driver.reset()
 
@@ -163,4 +165,5 @@ class QPSubproblem:
                 y[rows] = sign * np.asarray(con.dual_value)
         return QPSolution(d=np.zeros(self.d.shape) if d is None else np.asarray(d),
                           status=status, iterations=iterations,
-                          multipliers=y, polished=res.info.status_polish == 1)
+                          multipliers=y,
+                          polished=res.info.status_polish == PolishStatus.OSQP_POLISH_SUCCESS)

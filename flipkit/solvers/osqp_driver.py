@@ -21,12 +21,23 @@ rows being infeasible proves the full QP infeasible. The working set carried fro
 to the next holds at most :data:`INITIAL_ROWS` rows per variable (see :func:`_capped`).
 
 Compact mode (``compact=True``, used by the condensed subproblem of
-:mod:`flipkit.solvers.condensed_qp`): OSQP is set up afresh on the working rows alone each round,
-warm-started from the previous primal–dual pair. With 19–31 variables the setup is a
-fraction of a millisecond, and each ADMM iteration touches ~50 rows instead of ~1 500.
-A compact solve's solution reaches the cvxpy
+:mod:`flipkit.solvers.condensed_qp`): OSQP holds the working rows alone, in the row slots of
+a :class:`~flipkit.solvers.osqp_slots.RowSlots` solver set up once and updated round to round
+(with 19–31 variables each ADMM iteration then touches a few dozen rows instead of ~2 000),
+warm-started from the previous primal–dual pair. A compact solve's solution reaches the cvxpy
 variables and duals through a :class:`~flipkit.solvers.solution_map.SolutionMap` (cvxpy's
 unpacking found once), not through ``unpack_results`` at each solve.
+
+Setup. Each OSQP object is set up on the first solve after :meth:`OSQPDriver.reset` and only
+updated after that (``update(q=…, l=…, u=…, Px=…, Ax=…)`` on the setup's sparsity, then a
+warm start); :meth:`OSQPDriver.cold` keeps it and restarts ADMM from zero with OSQP's
+initial ρ. The SQP resets its subproblems at the start of every solve, so OSQP is set up once
+per structure and solve, and updated in every iteration and working-set round of the solve.
+The objects are not kept from one solve to the next: a solve on an updated object does not
+repeat a fresh setup's last bits, and results must not depend on what was solved before.
+
+Statuses are named by :mod:`flipkit.solvers.osqp_status`; cvxpy's compiled problem is read
+through :mod:`flipkit.solvers.cvxpy_adapter`.
 """
 
 from __future__ import annotations
@@ -37,11 +48,15 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from flipkit.errors import SolverError
-from flipkit.solvers.param_map import ParameterMap, osqp_form
-from flipkit.solvers.solution_map import SOLVED, SolutionMap
-from flipkit.solvers.stdout_redirect import c_stdout_silenced
 import osqp
+
+from flipkit.errors import SolverError
+from flipkit.solvers.cvxpy_adapter import osqp_form, problem_data, sparsity
+from flipkit.solvers.osqp_slots import RowSlots
+from flipkit.solvers.osqp_status import SOLVED, UNPACKED
+from flipkit.solvers.param_map import ParameterMap
+from flipkit.solvers.solution_map import SolutionMap
+from flipkit.solvers.stdout_redirect import c_stdout_silenced
 
 MAX_ROUNDS = 12  # then every row is handed to OSQP
 # A row whose norm is below NULL_ROW times the largest row's is numerically zero: a
@@ -74,17 +89,19 @@ class OSQPDriver:
 
     Args:
         problem: A DPP cvxpy problem (OSQP-compatible).
-        compact: Hand OSQP only the working rows (fresh setup per round) instead of
-            updating one solver holding every row; for problems with few variables.
+        compact: Hand OSQP only the working rows (in the row slots of a
+            :class:`~flipkit.solvers.osqp_slots.RowSlots` solver) instead of updating one
+            solver holding every row with the dropped rows unbounded; for problems with few
+            variables.
     """
 
     def __init__(self, problem: cp.Problem, compact: bool = False):
         self.problem, self.compact = problem, compact
         self._map, self._solution_map, self.status = None, None, None
-        if all(prm.sparse_idx is None for prm in problem.parameters()):
+        if all(sparsity(prm) is None for prm in problem.parameters()):
             # cvxpy's parameter map applied directly (fixed patterns, no round trip)
             self._map = ParameterMap(problem, self._cvxpy_data()[0])
-        elif not compact:  # compact mode sets up afresh each round: no pattern to keep
+        else:
             self._fixed_pattern()
         self.reset()
 
@@ -97,15 +114,19 @@ class OSQPDriver:
             prm.value = value
 
     def reset(self) -> None:
-        """Forget OSQP's state and the working set: the next solve sets up afresh."""
-        self._osqp, self._x, self._y, self._active = None, None, None, None
+        """Forget OSQP's objects, warm start and working set: the next solve sets up afresh."""
+        self._osqp, self._slots = None, None
+        self.cold()
+
+    def cold(self) -> None:
+        """Drop the warm start and the working set, keeping OSQP's objects: the next solve
+        starts ADMM from zero with OSQP's initial ρ."""
+        self._x, self._y, self._active, self._cold = None, None, None, True
 
     def _cvxpy_data(self):
         """cvxpy's (data, chain, inverse data) for the current parameters; the chain and inverse
         data do not depend on the values (DPP) and are kept for unpacking."""
-        with warnings.catch_warnings():  # cvxpy reads sparse parameters through `.value`
-            warnings.filterwarnings("ignore", "Reading from a sparse", RuntimeWarning)
-            data, self._chain, self._inverse = self.problem.get_problem_data(cp.OSQP)
+        data, self._chain, self._inverse = problem_data(self.problem)
         return data, self._chain, self._inverse
 
     def _data(self):
@@ -119,19 +140,20 @@ class OSQPDriver:
         """Sparsity of P and A for every parameter value: cvxpy drops explicit zeros, OSQP's
         ``update`` needs the pattern of its setup. Found once with random parameter values."""
         rng = np.random.default_rng(0)
-        saved = {prm: prm.value_sparse if prm.sparse_idx is not None else prm.value
+        saved = {prm: prm.value_sparse if sparsity(prm) is not None else prm.value
                  for prm in self.problem.parameters()}
         for prm in self.problem.parameters():
-            if prm.sparse_idx is not None:  # a sparse parameter: random values on its pattern
+            pattern = sparsity(prm)
+            if pattern is not None:  # a sparse parameter: random values on its pattern
                 prm.value_sparse = sp.coo_array(
-                    (rng.uniform(0.5, 1.5, len(prm.sparse_idx[0])), prm.sparse_idx), shape=prm.shape)
+                    (rng.uniform(0.5, 1.5, len(pattern[0])), pattern), shape=prm.shape)
             else:
                 prm.value = rng.uniform(0.5, 1.5, prm.shape) if prm.shape else 1.0
         P, A, *_ = self._data()
         for prm, val in saved.items():
             if val is None:
                 continue
-            if prm.sparse_idx is not None:
+            if sparsity(prm) is not None:
                 prm.value_sparse = val
             else:
                 prm.value = val
@@ -173,24 +195,22 @@ class OSQPDriver:
                                        max_iter=settings["max_iter"])
             if self._x is not None:
                 self._osqp.warm_start(x=self._x, y=self._y)
+            elif first and self._cold:  # from zero, with OSQP's initial ρ
+                self._osqp.update_settings(rho=settings["rho"])
+                self._osqp.warm_start(x=np.zeros(A.shape[1]), y=np.zeros(A.shape[0]))
         return self._osqp.solve(raise_error=False)
 
     def _solve_compact(self, P, q, A, l, u, work, settings, first=True):
-        """One round on a fresh solver holding the working rows only (``first`` plays no
-        part: each round sets up afresh); the result's dual vectors are returned at full
-        length (zero on the dropped rows), as cvxpy unpacks."""
-        rows = np.flatnonzero(work)
-        solver = osqp.OSQP(algebra="builtin")
-        solver.setup(P, q, A[rows], l[rows], u[rows], **settings)
-        if self._x is not None:
-            solver.warm_start(x=self._x, y=self._y[rows])
-        res = solver.solve(raise_error=False)
-        for name in ("y", "prim_inf_cert"):
-            full = np.zeros(len(l))
-            if getattr(res, name, None) is not None:
-                full[rows] = getattr(res, name)
-            setattr(res, name, full)
-        return res
+        """One round with the working rows alone, in the row slots of the solver set up once
+        (:class:`~flipkit.solvers.osqp_slots.RowSlots`; P, A and q loaded in a solve's first
+        round); the result's dual vectors are returned at full length (zero on the dropped
+        rows), as cvxpy unpacks."""
+        if self._slots is None:
+            self._slots = RowSlots(P, A)
+        if first:
+            self._slots.load(P.data, q, A.data)
+        return self._slots.solve(np.flatnonzero(work), l, u, self._x, self._y, settings,
+                                 cold=first and self._cold)
 
     def solve(self, settings: dict):
         """Solve for the current parameter values; returns (OSQP result, total ADMM iterations).
@@ -204,11 +224,7 @@ class OSQPDriver:
         :attr:`status` only).
         """
         P, A, q, l, u, chain, inverse = self._data()
-        if self.compact:  # OSQP takes 32-bit indices
-            P, A = (sp.csc_matrix((M.data, M.indices.astype(np.int32, copy=False),
-                                   M.indptr.astype(np.int32, copy=False)),
-                                  shape=M.shape) for M in (P, A))
-        elif self._map is None:  # `update` needs the setup's sparsity pattern
+        if self._map is None:  # `update` needs the setup's sparsity pattern
             P, A = self._on_pattern(0, P), self._on_pattern(1, A)
         ineq = ~(l == u)
         cap = INITIAL_ROWS * A.shape[1]
@@ -255,13 +271,15 @@ class OSQPDriver:
                 self._solution_map = False
         if self.compact and res.info.status_val in SOLVED and self._solution_map:
             self.status = self._solution_map.apply(res)
-        elif res.info.status_val in (1, 2, 3, 4):  # cvxpy raises on the other statuses
+        elif res.info.status_val in UNPACKED:  # cvxpy raises on the other statuses
             with warnings.catch_warnings():  # an inaccurate solve is reported by its status
                 warnings.simplefilter("ignore", UserWarning)
                 self.problem.unpack_results(res, chain, inverse)
             self.status = str(self.problem.status)
         else:
-            self.reset()  # next solve starts afresh
+            self.cold()  # no solution to warm-start from: the next solve starts from zero
+        if self._x is not None:
+            self._cold = False
         return res, total
 
 
@@ -269,7 +287,8 @@ class OSQPDriver:
 # the SQP passes its own tolerance per solve (this eps is the default for a direct solve).
 # Deterministic: a fixed adaptive-rho interval (interval 0 would time the setup and adapt rho
 # after a fraction of it, which varies run to run).
-OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, adaptive_rho_interval=25,
+# rho is OSQP's own initial value, named so that a cold restart can return to it.
+OSQP_SETTINGS = dict(eps_abs=1e-6, eps_rel=1e-6, max_iter=10000, rho=0.1, adaptive_rho_interval=25,
                      polishing=True, polish_refine_iter=3, check_termination=10, verbose=False)
 
 
@@ -288,6 +307,6 @@ def run_osqp(driver: OSQPDriver, problem: cp.Problem, eps: float | None, max_ite
             res, iterations = driver.solve(settings)
     except cp.error.SolverError as exc:  # OSQP broke down (cvxpy's error): ours, one line
         raise SolverError(f"OSQP failed inside a subproblem: {' '.join(str(exc).split())}") from None
-    ok = res.info.status_val in (1, 2, 3, 4)
+    ok = res.info.status_val in UNPACKED
     status = driver.status if ok else f"osqp:{res.info.status}"
     return res, iterations, status, res.info.status_val in SOLVED

@@ -2,11 +2,11 @@
 
 A DPP problem is canonicalised by cvxpy once; its problem data are then an affine function of
 the parameter vector p (every parameter flattened in Fortran order, then a constant 1). cvxpy
-keeps that function as sparse tensors on the compiled problem (``param_prob`` of
-``get_problem_data``): the cone form's ``[A | b]``, ``P`` and ``q``, each flattened
-column-major. ``get_problem_data`` re-applies them on every call and then reshapes, splits and
-converts the result through its reduction chain, which costs far more than the products
-themselves.
+keeps that function as sparse tensors on the compiled problem, which
+:func:`~flipkit.solvers.cvxpy_adapter.affine_program` reads from ``get_problem_data``'s
+result: the cone form's ``[A | b]``, ``P`` and ``q``, each flattened column-major.
+``get_problem_data`` re-applies them on every call and then reshapes, splits and converts the
+result through its reduction chain, which costs far more than the products themselves.
 
 :class:`ParameterMap` composes, once, those tensors with what the chain does for OSQP
 (equality rows first, inequality rows negated into ``F x ≤ g``, the upper triangle of P) into
@@ -23,14 +23,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from flipkit.errors import SolverError
+from flipkit.solvers.cvxpy_adapter import affine_program, osqp_form, problem_data, sparsity
 
-
-def osqp_form(data: dict):
-    """(P upper triangle, A, q, l, u) for OSQP from cvxpy's QP data (``A x = b``, ``F x ≤ g``)."""
-    A = sp.vstack([data["A"], data["F"]]).tocsc()
-    b, g = data["b"], data["G"]
-    l = np.concatenate([b, np.full(g.shape, -np.inf)])
-    return sp.triu(data["P"], format="csc"), A, data["q"], l, np.concatenate([b, g])
+__all__ = ["ParameterMap", "osqp_form"]
 
 
 class ParameterMap:
@@ -45,23 +40,21 @@ class ParameterMap:
     """
 
     def __init__(self, problem: cp.Problem, data: dict):
-        prog = data["param_prob"]
+        prog = affine_program(data)
         self.problem = problem
         self._columns = []  # (parameter, first column in p)
         by_id = {prm.id: prm for prm in problem.parameters()}
-        for pid, col in prog.param_id_to_col.items():
-            if pid == -1:  # the constant column
-                continue
+        for pid, col in prog.columns.items():
             prm = by_id.get(pid)
-            if prm is None or prm.sparse_idx is not None:
+            if prm is None or sparsity(prm) is not None:
                 raise SolverError("ParameterMap needs dense parameters only")
             self._columns.append((prm, col))
-        self._size = prog.total_param_size + 1
+        self._size = prog.size
         self._col = {prm.id: col for prm, col in self._columns}
         self._p = np.zeros(self._size)
         self._p[-1] = 1.0
         self._assigned: set[int] = set()
-        n, n_eq = prog.x.size, prog.cone_dims.zero
+        n, n_eq = prog.n, prog.n_eq
         m = prog.A.shape[0] // (n + 1)
         sign = np.where(np.arange(m) < n_eq, 1.0, -1.0)  # F = −A_cone on the inequality rows
         TA = sp.csr_matrix(prog.A)
@@ -134,7 +127,7 @@ class ParameterMap:
             for prm, _ in self._columns:
                 prm.value = rng.uniform(0.5, 1.5, prm.shape) if prm.shape else 1.0
             P, A, q, l, u = self.data()
-            P_ref, A_ref, q_ref, l_ref, u_ref = osqp_form(self.problem.get_problem_data(cp.OSQP)[0])
+            P_ref, A_ref, q_ref, l_ref, u_ref = osqp_form(problem_data(self.problem)[0])
             fin = np.isfinite(l_ref)
             gaps = (abs(P - P_ref).max(), abs(A - A_ref).max(),
                     np.abs(q - q_ref).max(), np.abs(l[fin] - l_ref[fin]).max(initial=0),

@@ -18,11 +18,10 @@ from types import SimpleNamespace
 
 import cvxpy as cp
 import numpy as np
-from cvxpy.reductions.solvers.qp_solvers.osqp_qpif import OSQP as CvxpyOSQP
 
 from flipkit.errors import SolverError
-
-SOLVED = (1, 2)  # OSQP's status values of a solution: solved, solved inaccurate
+from flipkit.solvers.cvxpy_adapter import status_name, store_dual, store_value
+from flipkit.solvers.osqp_status import SOLVED, OSQPStatus, PolishStatus
 
 
 class SolutionMap:
@@ -39,9 +38,11 @@ class SolutionMap:
     def __init__(self, problem: cp.Problem, chain, inverse, n: int, m: int):
         codes_x = np.arange(1.0, n + 1.0)  # distinct exact codes: entry k of x is k + 1,
         codes_y = np.arange(n + 1.0, n + m + 1.0)  # entry k of y is n + k + 1
-        info = SimpleNamespace(status_val=1, status="solved", obj_val=0.0, run_time=0.0,
-                               iter=0, setup_time=0.0, solve_time=0.0, polish_time=0.0,
-                               status_polish=0, obj_val_polish=0.0)
+        info = SimpleNamespace(status_val=int(OSQPStatus.OSQP_SOLVED), status="solved",
+                               obj_val=0.0, run_time=0.0, iter=0, setup_time=0.0,
+                               solve_time=0.0, polish_time=0.0,
+                               status_polish=int(PolishStatus.OSQP_POLISH_NOT_PERFORMED),
+                               obj_val_polish=0.0)
         probe = SimpleNamespace(x=codes_x, y=codes_y, info=info, prim_inf_cert=None,
                                 dual_inf_cert=None)
         with warnings.catch_warnings():
@@ -64,15 +65,15 @@ class SolutionMap:
         return index.astype(np.int64)
 
     def apply(self, res) -> str:
-        """Store a solved OSQP result's (status 1 or 2) values on the variables and duals, as
+        """Store a solved OSQP result's (:data:`~flipkit.solvers.osqp_status.SOLVED`) values on the variables and duals, as
         ``unpack_results`` would; return cvxpy's name of the status."""
         if res.info.status_val not in SOLVED:
             raise SolverError(f"no solution to map: OSQP status {res.info.status!r}")
         for var, index in self.variables:
-            var.save_value(res.x[index])
+            store_value(var, res.x[index])
         for con, index, sign in self.duals:
-            con.save_dual_value(sign * res.y[index])
-        return CvxpyOSQP.STATUS_MAP[res.info.status_val]
+            store_dual(con, sign * res.y[index])
+        return status_name(res.info.status_val)
 
 
-__all__ = ["SOLVED", "SolutionMap"]
+__all__ = ["SolutionMap"]

@@ -7,19 +7,22 @@ a second solve in a sweep worker, a notebook, another process — its threads wa
 other, and a condensed QP update takes over ten times as long as with one thread.
 :func:`single_threaded_blas` limits every BLAS library loaded in the process to one thread
 for the duration of a ``with`` block and restores the previous setting after it, through
-threadpoolctl (a controller built once, so entering the block is cheap).
+threadpoolctl. Building a controller scans the loaded libraries, so a caller that enters the
+block often keeps its own controller and passes it in
+(:class:`~flipkit.solvers.sqp_solver.SQPSolver` does).
 """
 
 from __future__ import annotations
 
 from threadpoolctl import ThreadpoolController
 
-_CONTROLLER: ThreadpoolController | None = None
 
+def single_threaded_blas(controller: ThreadpoolController | None = None):
+    """Context manager: BLAS limited to one thread inside the block.
 
-def single_threaded_blas():
-    """Context manager: BLAS limited to one thread inside the block."""
-    global _CONTROLLER
-    if _CONTROLLER is None:  # after numpy and scipy are loaded (they are, by the solvers)
-        _CONTROLLER = ThreadpoolController()
-    return _CONTROLLER.limit(limits=1, user_api="blas")
+    Args:
+        controller: The threadpoolctl controller to limit through, built after numpy and
+            scipy are loaded; default a new one.
+    """
+    return (ThreadpoolController() if controller is None else controller).limit(
+        limits=1, user_api="blas")

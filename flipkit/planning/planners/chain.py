@@ -22,6 +22,7 @@ from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoice
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.segment import Segment
 from flipkit.planning.plans.verify import verify_plan
+from flipkit.planning.planners.workspaces import thread_workspace
 from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
 
@@ -40,7 +41,9 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     :data:`FALLBACK_IPOPT`'s budget (60 s, 1000 iterations); the segment's ``solver.name`` in
     the plan file records which one produced it and the wall time counts both.
 
-    ``sqp_kwargs`` go to :func:`~flipkit.solvers.sqp.solve_sqp` (e.g. ``workspace``).
+    ``sqp_kwargs`` go to :func:`~flipkit.solvers.sqp.solve_sqp` (e.g. ``options``); without
+    a ``workspace`` among them the SQP solves in this thread's
+    (:func:`~flipkit.planning.planners.workspaces.thread_workspace`).
 
     Returns the result whatever its status (``result.success`` tells); the worst constraint
     group of a failure is ``nlp.worst_group(result.x)``.
@@ -50,9 +53,11 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     """
     # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
     # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
-    from flipkit.solvers import ipopt, sqp
+    from flipkit.solvers import compiled, ipopt, sqp
 
     if solver == "sqp":
+        if sqp_kwargs.get("workspace") is None:
+            sqp_kwargs["workspace"] = thread_workspace(compiled.SQPWorkspace)
         try:
             return sqp.solve_sqp(nlp, x0, raise_on_failure=False, **sqp_kwargs)
         except SolverError:  # OSQP or a factorisation broke down inside a subproblem
@@ -177,11 +182,11 @@ class Planner:
         solver: One of :data:`SOLVERS`.
         options: Transcription options.
         workspace: The SQP's compiled subproblems
-            (:class:`~flipkit.solvers.compiled.SQPWorkspace`) this planner solves in; ``None``
-            shares the process's default, so that planners made one after another (every
-            ``plan_flip`` call) compile each subproblem structure once. A planner given its
-            own workspace keeps its warm starts and compiled problems to itself, e.g. one per
-            thread of a cell that plans while it executes.
+            (:class:`~flipkit.solvers.compiled.SQPWorkspace`) this planner solves in, passed
+            down to every segment's solve; ``None``: the solving thread's
+            (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), so that
+            planners made one after another in a thread (every ``plan_flip`` call) compile
+            each subproblem structure once.
 
     Raises:
         InvalidChoiceError: Unknown solver.
@@ -255,6 +260,7 @@ class Planner:
         def build(options):
             return transcribe(spec, self.models, q, qd, options=options, task=task)
 
+        # without one of its own, solve_segment solves in the thread's
         own = {} if self.workspace is None else {"workspace": self.workspace}
         if not stretch:
             nlp = build(self.options)
