@@ -275,6 +275,18 @@ def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypa
         clear_cook(unflipped, CELL)
 
 
+def b1_unflipped(fps: dict, b2_footprint=None):
+    """:func:`fake_timeline` with b1 not flipped yet (it lies where it was dropped) and b2's
+    flip given ``b2_footprint`` (default: its blade over b1); ``fps`` takes the footprints."""
+    t, f = fake_timeline()
+    t.motions = [m for m in t.motions if m.burger != "b1"]
+    if b2_footprint is not None:
+        f[t.motions[0].plan] = b2_footprint
+    fps.clear()
+    fps.update(f)
+    return t
+
+
 def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monkeypatch):
     """b2's flip segment (its toss, which follows its landing spot) passes over b1 while b1
     still lies where it was dropped: the cook lands b2 elsewhere and plans again; a toss that
@@ -285,13 +297,8 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
 
     def schedule(lands, headings, moves=True):
         calls.append(dict(lands))
-        t, f = fake_timeline()
-        t.motions = [m for m in t.motions if m.burger != "b1"]  # b1 not flipped yet
         toss = (0.64, -0.33) if "b2" not in lands or not moves else (0.80, -0.10)
-        f[t.motions[0].plan] = blade_at(*toss, t=1.0, seg="flip")
-        fps.clear()
-        fps.update(f)
-        return t
+        return b1_unflipped(fps, blade_at(*toss, t=1.0, seg="flip"))
 
     fps = {}
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
@@ -318,14 +325,8 @@ def test_a_scoop_that_meets_a_dropped_burger_is_turned_away_from_it(monkeypatch)
     seen = []
 
     def schedule(lands, headings):
-        seen.append(dict(headings))
-        t, f = fake_timeline()
-        t.motions = [m for m in t.motions if m.burger != "b1"]  # b1 not flipped yet
-        if "b2" in headings:  # turned: its blade passes beside b1
-            f[t.motions[0].plan] = blade_at(0.80, -0.10, t=1.0)
-        fps.clear()
-        fps.update(f)
-        return t
+        seen.append(dict(headings))  # turned, b2's blade passes beside b1
+        return b1_unflipped(fps, blade_at(0.80, -0.10, t=1.0) if "b2" in headings else None)
 
     fps = {}
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)

@@ -34,6 +34,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.fileio import check_output, check_output_dir
 from flipkit.planning.kitchen.cook import read_cook_csv
+from flipkit.planning.kitchen.random_cook import random_order
 from flipkit.planning.kitchen.stream import check_stream
 from flipkit.planning.kitchen.table import DWELL_S, check_dwell
 from flipkit.planning.kitchen.windows import parse_windows
@@ -65,7 +66,7 @@ def register(subparsers) -> None:
     p.add_argument("burgers", metavar="BURGERS.csv", nargs="?",
                    help="cook order: header burger,t_drop,x,y (in any order, no other "
                         "column: id, drop time s in [0, 86400], grill position m); lines "
-                        "starting with # skipped; omitted with --stream")
+                        "starting with # skipped; omitted with --stream or --random")
     p.add_argument("--json", required=True, metavar="TIMELINE.json",
                    help="timeline output (.json; not the cook order)")
     p.add_argument("--figure", metavar="PATH", help="Gantt chart (.pdf, .png or .svg)")
@@ -101,11 +102,14 @@ def register(subparsers) -> None:
     p.add_argument("--stream", type=float, metavar="RATE",
                    help="instead of BURGERS.csv, a stream of drops: RATE burgers per hour, "
                         "evenly spaced from t = 0, each at a random free place on the grill")
+    p.add_argument("--random", type=int, metavar="N",
+                   help="instead of BURGERS.csv, N burgers (1 to 12) dropped 4-5 s apart at "
+                        "random places on the grill, at least a diameter apart (--seed)")
     p.add_argument("--minutes", type=float, metavar="M",
                    help="the stream's length, min (with --stream)")
     p.add_argument("--seed", type=int, default=0, metavar="N",
-                   help="seed of the stream's places and of CP-SAT, in [0, 2**31-1] "
-                        "(default 0)")
+                   help="seed of the stream's or --random's places and of CP-SAT, in "
+                        "[0, 2**31-1] (default 0)")
     p.add_argument("--plan", action="store_true",
                    help="with --stream: plan every motion (minutes for hundreds) instead of "
                         "scheduling on the durations of six representative plans")
@@ -134,9 +138,11 @@ def run(args: argparse.Namespace) -> int:
     """Check the options and the outputs, read the cook order (``args.order``), then plan,
     write and report (:mod:`flipkit.cli.commands.schedule`). Everything here runs before the
     planners, MuJoCo and matplotlib are imported, so a refusal takes a fraction of a second."""
-    if (args.burgers is None) == (args.stream is None):
-        raise ConfigError("give a cook order BURGERS.csv or --stream RATE"
-                          + (", not both" if args.burgers else ""))
+    given = [what for what, value in (("BURGERS.csv", args.burgers), ("--stream", args.stream),
+                                      ("--random", args.random)) if value is not None]
+    if len(given) != 1:
+        raise ConfigError("give one of a cook order BURGERS.csv, --stream RATE or --random N"
+                          + (f", not {' and '.join(given)}" if given else ""))
     if args.stream is not None:
         if args.minutes is None:
             raise ConfigError("--stream RATE needs --minutes M")
@@ -150,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
     elif args.minutes is not None or args.plan:
         raise ConfigError("--minutes and --plan go with --stream")
     if args.simulate and args.stream is not None:
-        raise ConfigError("--simulate runs a cook order (BURGERS.csv), not a stream")
+        raise ConfigError("--simulate runs a cook order (BURGERS.csv or --random), not a stream")
     if (args.film or args.sense or args.mode != "position") and not args.simulate:
         raise ConfigError("--film, --mode and --sense go with --simulate")
     inputs = [args.burgers] if args.burgers else []
@@ -177,9 +183,11 @@ def run(args: argparse.Namespace) -> int:
     check_float("--time-limit", args.time_limit, 0.0, MAX_TIME_LIMIT_S, "s")
     check_int("--seed", args.seed, 0, 2**31 - 1)
     args.order = read_cook_csv(args.burgers, CellConfig()) if args.burgers else None
+    if args.random is not None:
+        args.order = random_order(args.random, args.seed, CellConfig())
     if args.plans is None:  # TIMELINE_plans/ beside the timeline
         args.plans = str(Path(args.json).with_name(Path(args.json).stem + "_plans"))
-    if args.burgers or args.plan:
+    if args.order is not None or args.plan:
         check_output_dir(args.plans, "--plans", inputs=inputs + [args.json, args.figure,
                                                                   args.film])
     return deferred("schedule")(args)

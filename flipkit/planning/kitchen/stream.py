@@ -59,6 +59,22 @@ def n_drops(rate_per_h: float, minutes: float) -> int:
     return int(math.floor(rate_per_h * minutes / 60.0 - 1e-9)) + 1 if minutes > 0 else 0
 
 
+def free_place(rng, area, others, diameter: float):
+    """A uniformly random (x, y) (m, rounded to 0.1 mm) in ``area`` ((x0, x1), (y0, y1)) at
+    least ``diameter`` + :data:`CLEARANCE` from each of ``others``: the first of
+    :data:`PLACE_TRIES` draws of ``rng`` that is, or ``None``."""
+    (x0, x1), (y0, y1) = area
+    xy = rng.uniform((x0, y0), (x1, y1), size=(PLACE_TRIES, 2))
+    if len(others):
+        gaps = np.linalg.norm(xy[:, None, :] - np.asarray(others, float)[None], axis=2)
+        free = gaps.min(axis=1) >= diameter + CLEARANCE
+    else:
+        free = np.ones(len(xy), bool)
+    if not free.any():
+        return None
+    return tuple(round(float(v), 4) for v in xy[np.argmax(free)])
+
+
 def stream_order(rate_per_h: float, minutes: float, seed: int = 0,
                  cell: CellConfig | None = None, windows: Windows = Windows()
                  ) -> list[CookBurger]:
@@ -84,23 +100,16 @@ def stream_order(rate_per_h: float, minutes: float, seed: int = 0,
     for k in range(n_drops(rate_per_h, minutes)):
         t = round(k * gap, 6)
         on_grill = [b for b in on_grill if b[2] > t]
-        xy = rng.uniform((g.x_range[0], g.y_range[0]), (g.x_range[1], g.y_range[1]),
-                         size=(PLACE_TRIES, 2))
-        if on_grill:
-            others = np.array([b[:2] for b in on_grill])
-            free = (np.linalg.norm(xy[:, None, :] - others[None], axis=2).min(axis=1)
-                    >= d + CLEARANCE)
-        else:
-            free = np.ones(len(xy), bool)
-        if not free.any():
+        place = free_place(rng, (g.x_range, g.y_range), [b[:2] for b in on_grill], d)
+        if place is None:
             raise StreamError(f"the grill is full at t = {t:g} s: {len(on_grill)} burgers "
                               f"on it and no free place for another in {PLACE_TRIES} tries; "
                               f"lower the rate ({rate_per_h:g} per hour)")
-        x, y = (round(float(v), 4) for v in xy[np.argmax(free)])
+        x, y = place
         on_grill.append((x, y, t + hold))
         out.append(CookBurger(f"s{k + 1:04d}", t, x, y))
     return out
 
 
 __all__ = ["MAX_MINUTES", "MAX_RATE_PER_H", "PLACE_TRIES", "StreamError", "check_stream",
-           "n_drops", "stream_order"]
+           "free_place", "n_drops", "stream_order"]

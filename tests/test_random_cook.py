@@ -1,0 +1,80 @@
+"""Cooks as a camera sees them: flipkit schedule --random N --seed S
+(flipkit.planning.kitchen.random_cook)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from flipkit.cli import main
+from flipkit.config import CellConfig
+from flipkit.errors import ConfigError
+from flipkit.planning.kitchen.cook import check_cook
+from flipkit.planning.kitchen.random_cook import MAX_RANDOM, random_order
+
+CELL = CellConfig()
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_random_burgers_lie_apart_on_the_grill_and_drop_4_to_5_s_apart(seed):
+    order = random_order(5, seed, CELL)
+    assert [b.burger for b in order] == ["r1", "r2", "r3", "r4", "r5"]
+    gaps = np.diff([b.t_drop for b in order])
+    assert order[0].t_drop == 0.0 and np.all((gaps >= 4.0 - 1e-3) & (gaps <= 5.0 + 1e-3))
+    g, d = CELL.grill, CELL.burger.diameter
+    for b in order:  # the whole burger on the grill
+        assert g.x_range[0] + d / 2 <= b.x <= g.x_range[1] - d / 2
+        assert g.y_range[0] + d / 2 <= b.y <= g.y_range[1] - d / 2
+    xy = np.array([(b.x, b.y) for b in order])
+    dist = np.linalg.norm(xy[:, None] - xy[None], axis=2) + np.eye(len(xy))
+    assert dist.min() >= d
+    assert check_cook(order, CELL) == order  # a valid cook order, in drop order
+
+
+def test_same_seed_same_cook_other_seed_other_places():
+    assert random_order(5, 7, CELL) == random_order(5, 7, CELL)
+    a, b = random_order(5, 7, CELL), random_order(5, 8, CELL)
+    assert [(u.x, u.y) for u in a] != [(v.x, v.y) for v in b]
+
+
+def test_the_places_are_spread_over_the_grill():
+    """Over many seeds the places cover the grill's width, not lanes: every 10 cm band of y
+    inside the burgers' range holds some."""
+    ys = [b.y for s in range(40) for b in random_order(5, s, CELL)]
+    lo, hi = CELL.grill.y_range[0] + 0.05, CELL.grill.y_range[1] - 0.05
+    bands = np.histogram(ys, bins=np.arange(lo, hi, 0.1))[0]
+    assert bands.min() > 0
+
+
+@pytest.mark.parametrize("n", [0, MAX_RANDOM + 1, 2.5, True])
+def test_a_count_out_of_range_is_refused(n):
+    with pytest.raises(ConfigError, match=r"--random N must be a whole number"):
+        random_order(n, 0, CELL)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--random", "13"], "in [1, 12]"),
+    (["--random", "3", "--stream", "60", "--minutes", "1"], "not --stream and --random"),
+    (["flipkit/data/cook_five.csv", "--random", "3"], "not BURGERS.csv and --random"),
+])
+def test_the_cli_refuses_in_one_line(tmp_path, capsys, args, message):
+    out = tmp_path / "t.json"
+    code = main(["schedule", *args, "--json", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0]
+    assert not out.exists()
+
+
+def test_a_random_cook_is_scheduled(tmp_path, capsys):
+    """Two random burgers, flips only, planned and scheduled end to end: the timeline holds
+    the random order's places."""
+    out = tmp_path / "t.json"
+    code = main(["schedule", "--random", "2", "--seed", "4", "--flip-only", "--workers", "1",
+                 "--no-progress", "--json", str(out)])
+    assert code == 0, capsys.readouterr().err
+    doc = json.loads(out.read_text())
+    places = {tuple(b["position"]) for b in doc["burgers"]}
+    assert places == {(b.x, b.y) for b in random_order(2, 4, CELL)}
+    assert doc["status"] == "solved"
+    assert all(m["status"] == "solved" and math.isfinite(m["start"]) for m in doc["motions"])
