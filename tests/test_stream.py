@@ -178,8 +178,8 @@ def test_cli_stream_with_plan_plans_every_motion(tmp_path, fake_planners):
 @pytest.mark.parametrize("argv, message", [
     (["--stream", "100"], "needs --minutes"),
     (["--minutes", "3", str(EXAMPLE_ORDER)], "go with --stream"),
-    (["--stream", "100", "--minutes", "3", str(EXAMPLE_ORDER)], "not both"),
-    ([], "BURGERS.csv or --stream"),
+    (["--stream", "100", "--minutes", "3", str(EXAMPLE_ORDER)], "not BURGERS.csv and --stream"),
+    ([], "BURGERS.csv, --stream RATE or --random N"),
     (["--stream", "100", "--minutes", "3", "--figure", "g.png"], "--plan"),
     (["--stream", "100", "--minutes", "3", "--flip-only"], "--plan"),
     (["--stream", "1e5", "--minutes", "3"], "RATE"),
