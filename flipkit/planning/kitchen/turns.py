@@ -3,7 +3,7 @@
 :func:`~flipkit.planning.kitchen.clearance.clear_cook` asks :class:`Turns` for a flip's next
 heading when its go to burger, scoop, pickup or toss meets a burger still lying where it was
 dropped (or when its plan fails at the heading it has). The candidates are the default
-heading turned by each of :data:`~flipkit.planning.kitchen.clearance.HEADING_STEPS`, away from
+heading turned by each of :data:`HEADING_STEPS`, away from
 the burger met first (the blade then sweeps farther from it), then toward it, each within
 ±:data:`~flipkit.config.task.HEADING_LIMIT` of the world's +x.
 """
@@ -20,6 +20,11 @@ from flipkit.config.task import HEADING_LIMIT
 from flipkit.errors import FlipkitError
 
 
+# 15° moves a scoop's blade corners 2-4 cm sideways over its 15-20 cm; 30° keeps every burger
+# on the grill within HEADING_LIMIT of +x for at least one side.
+HEADING_STEPS = (math.radians(15.0), math.radians(30.0))  # rad, from the default heading
+
+
 class CookConflictError(FlipkitError):
     """A motion of the cook would meet another burger and no landing spot avoids it."""
 
@@ -32,7 +37,7 @@ class Turns:
         steps: Turns (rad) from the default heading, tried in order on each side.
     """
 
-    def __init__(self, cell: CellConfig, steps=(math.radians(15.0), math.radians(30.0))):
+    def __init__(self, cell: CellConfig, steps=HEADING_STEPS):
         self.cell, self.steps = cell, tuple(float(s) for s in steps)
         self.headings: dict[str, float] = {}
         self.tried: dict[str, list[float]] = {}
@@ -81,4 +86,4 @@ class Turns:
         return left[0]
 
 
-__all__ = ["CookConflictError", "Turns"]
+__all__ = ["HEADING_STEPS", "CookConflictError", "Turns"]
