@@ -64,10 +64,13 @@ def scoop_scenarios(segment, location, models,
 
     The friction model of :mod:`flipkit.model.scoop` with the cell's nominal patty and grill
     gives the place (x, y) (m, blade frame). How much of the patty's overhang the tip carries
-    depends on how high the blade's top face rides above the grill, between flush with it and
-    the blade's thickness (:func:`~flipkit.model.scoop.overhang_share`), which the cell does not
-    know: the predicted place is the midpoint of the two ends' outcomes. The scenarios bound
-    its spread over that and what else the cell does not know
+    depends on how high the blade's top face rides above the grill
+    (:func:`~flipkit.model.scoop.overhang_share`). The predicted place is for the blade resting
+    on the grill, its top face the blade's thickness above it: a steel grill does not yield,
+    and the scoop commands no part of the blade below the surface but the tip, by the blade's
+    own flex, so the tip rides on the grill. A top face flush with the grill (the blade sunk
+    into it) is the other end, kept as uncertainty. The scenarios bound the spread over that
+    and what else the cell does not know
     (:class:`~flipkit.config.ScoopUncertainty`): both ends of the overhang, combined with the
     burger-blade friction at both ends of its range and the burger put ± k σ along the scoop
     (the extremes of x), and ± k σ sideways (y, which the scoop does not change).
@@ -84,7 +87,7 @@ def scoop_scenarios(segment, location, models,
     b = cell.burger
     ends = (0.0, overhang_share(cell.physics.burger_modulus, b.thickness, b.density,
                                 cell.physics.blade_thickness))
-    nominal = np.mean([path.outcome(mu_blade=mu, overhang=e, **kw) for e in ends], axis=0)
+    nominal = path.outcome(mu_blade=mu, overhang=ends[1], **kw)
     xs = [path.outcome(mu_blade=mu * f, shift=(s, 0.0), overhang=e, **kw)[0]
           for e in ends for f in uncertainty.mu_scale for s in (-d, d)]
     half = cell.spatula.half_extent

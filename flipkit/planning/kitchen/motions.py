@@ -163,9 +163,8 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
 def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
                   ) -> MotionPlanner:
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
-    job's table spot, placing the burger as if it lay at the blade centre (``plan_serve``'s
-    default: planned for the scoop model's predicted place, serves rested farther from their
-    spots in simulation), coming in above the other
+    job's table spot, placing the burger where the scoop model says the scoop leaves it on the
+    blade (``plan_serve``'s default), coming in above the other
     burgers as the flip does; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to
     burger, scoop and pickup."""
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:

@@ -31,7 +31,7 @@ from flipkit.planning.plans.plan_file import Plan
 
 
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
-               solver: str = "auto", on_blade=(0.0, 0.0),
+               solver: str = "auto", on_blade=None,
                options: SegmentOptions = SegmentOptions(), atlas=None,
                approach_height=None, heading=None) -> Plan:
     """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
@@ -47,8 +47,8 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
         solver: ``"auto"`` (default: the SQP, then IPOPT where it fails), ``"sqp"`` or
             ``"ipopt"``.
         on_blade: Where the burger's centre will sit on the blade (x, y) (m, blade frame)
-            during the carry and place; default the blade centre (:func:`replan_serve`
-            re-plans for a sensed one). ``None``: where the scoop model
+            during the carry and place, if known (:func:`replan_serve` re-plans for a
+            sensed one). ``None`` (default): where the scoop model
             (:func:`~flipkit.behaviors.pick.scoop_scenarios`) says the planned scoop leaves
             it, as the flip does.
         options: Transcription options (``N``, ``cone``, ``mu_safety``, ``epsilon``).
