@@ -180,11 +180,34 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
         assert res["failure"]["reason"] == "missed_spot" and res["failure"]["amount"] > 0.2
 
 
-def test_no_atlas_needs_locations(plan_file, tmp_path, capsys):
-    code = main(["validate", "--plan", str(plan_file), "--trials", "1", "--no-atlas",
+@pytest.mark.parametrize("flag", [("--no-atlas",), ("--heading", "10")])
+def test_planning_flags_need_locations(plan_file, tmp_path, capsys, flag):
+    code = main(["validate", "--plan", str(plan_file), "--trials", "1", *flag,
                  "--no-progress", "--json", str(tmp_path / "o.json")])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and "--no-atlas needs --locations" in err and len(err.splitlines()) == 1
+    assert code == 2 and f"{flag[0]} needs --locations" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("value", ["75", "-61", "nan", "x"])
+def test_a_heading_out_of_range_is_refused_before_planning(tmp_path, capsys, value):
+    code = main(["validate", "--locations", "table1", "--heading", value, "--trials", "1",
+                 "--no-progress", "--json", str(tmp_path / "o.json")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "--heading" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o.json").exists()
+
+
+def test_a_location_is_planned_at_the_heading_asked(tmp_path):
+    """``--heading``: the plan scoops along it, and its file is kept apart from the default's."""
+    import math
+    from flipkit.experiments.trials import plan_location
+    from flipkit.planning.plans.plan_file import Plan
+
+    job = {"location": [0.69, -0.16, 0.072], "solver": "sqp", "plans_dir": str(tmp_path),
+           "heading": math.radians(-30.0)}
+    turned = plan_location(job)
+    assert turned["status"] == "solved" and turned["path"].endswith("_sqp-heading-30.0.json")
+    assert Plan.load(turned["path"]).burger["heading"] == pytest.approx(math.radians(-30.0))
 
 
 def test_a_location_is_planned_from_the_atlas_or_from_cold_starts(tmp_path):

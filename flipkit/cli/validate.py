@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 
+from flipkit.cli.plan_inputs import heading
 from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_WORKERS, add_sweep_arguments,
                                 check_float, check_int, deferred, precheck_plan)
 from flipkit.config.checks import whole
@@ -53,6 +54,10 @@ def register(subparsers) -> None:
                              "atlas; the two reach different local optima of the same NLPs, "
                              "and comparing them shows how much a result owes to the one "
                              "found")
+    parser.add_argument("--heading", default=None, metavar="DEG",
+                        help="with --locations: plan every location with this scoop heading "
+                             "(degrees from the world's +x, within +-60; default: each "
+                             "location's own, radial from the base; docs/heading.md)")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
@@ -128,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
             check_output_dir(directory, flag, inputs=inputs)
     if args.plan is not None:
         precheck_plan(args.plan)
-        if args.no_atlas:
-            raise ConfigError("--no-atlas needs --locations: a plan file is already planned")
+        for flag, given in (("--no-atlas", args.no_atlas), ("--heading", args.heading)):
+            if given:
+                raise ConfigError(f"{flag} needs --locations: a plan file is already planned")
+    args.heading = heading(args.heading)
     return deferred("validate")(args)

@@ -15,6 +15,7 @@ scoop, pickup and flip. A stage counts only if the previous ones succeeded, as i
 
 from __future__ import annotations
 
+import math
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
@@ -222,6 +223,7 @@ def plan_location(job: dict) -> dict:
             ``"cell": {dotted name: value}`` (keys of :data:`flipkit.config.PHYSICAL_RANGES`):
             plan for the default cell with those values, from cold starts (the package's
             atlas serves the default cell only); ``"atlas": False``: from cold starts.
+            ``"heading"``: the scoop heading (rad; default the location's own).
 
     Returns:
         ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
@@ -231,10 +233,13 @@ def plan_location(job: dict) -> dict:
         cell = with_parameter(cell, name, value)
     atlas = default_atlas() if not job.get("cell") and job.get("atlas", True) else None
     try:
-        plan = plan_flip(job["location"], solver=job["solver"], cell=cell, atlas=atlas)
+        plan = plan_flip(job["location"], solver=job["solver"], cell=cell, atlas=atlas,
+                         heading=job.get("heading"))
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": None, "path": None}
     made_by = job["solver"] if job.get("atlas", True) else f"{job['solver']}-cold"
+    if "heading" in job:
+        made_by += f"-heading{math.degrees(job['heading']):+.1f}"
     path = plan.to_json(Path(job["plans_dir"]) / plan_filename(job["location"], made_by))
     return {"status": plan.status, "reason": plan.failure, "time_s": float(plan.wall_time_s),
             "path": str(path)}
@@ -344,13 +349,16 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
 
 def validate_locations(locations, trials: int, solver: str = "auto", seed: int = 0, *,
                        executor=None, cache_dir=None, plans_dir=None, progress: bool = True,
-                       atlas: bool = True, **kwargs) -> dict:
+                       atlas: bool = True, heading: float | None = None, **kwargs) -> dict:
     """Plan every location (on the sweep, cached), then :func:`validate` the plans.
 
     Args:
         locations: Burger locations (m). solver: ``"sqp"`` or ``"ipopt"``.
         atlas: Warm-start from the package's atlas where it serves (as ``flipkit plan flip``
             does); ``False``: from cold starts.
+        heading: The scoop heading (rad) of every plan
+            (:func:`~flipkit.behaviors.targets.check_heading`); ``None``: each location's
+            default (radial from the base).
         plans_dir: Where to keep the plan files; default ``cache_dir/plans``, or a temporary
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
@@ -359,6 +367,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         raise InvalidChoiceError("solver", solver, SOLVERS)
     check_trials(trials)
     check_seed(seed)  # before any planning
+    turned = {} if heading is None else {"heading": float(tg.check_heading(heading))}
     if isinstance(locations, (str, bytes, dict)) or not hasattr(locations, "__iter__"):
         raise ConfigError(f"locations: expected a sequence of burger locations (x, y, z) (m), "
                           f"got {type(locations).__name__}")
@@ -372,7 +381,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         where = Path(plans_dir or (Path(cache_dir) / "plans" if cache_dir else tmp)).resolve()
         where.mkdir(parents=True, exist_ok=True)
         cold = {} if atlas else {"atlas": False}  # the key only when set: cache keys keep
-        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold}
+        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold, **turned}
                 for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
                           desc="plans", label_fn=location_label)
