@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import statistics
@@ -52,6 +53,7 @@ from flipkit.baseline import EE_METHODS, run_baseline
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.targets import default_heading
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.experiments.speed import (PAPER_EE_OPT_S, PAPER_FIVE_BURGERS_S,
@@ -255,9 +257,11 @@ def _timed_flip(location, cell: CellConfig, kw: dict) -> dict:
 
 
 def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
-               ipopt: bool = True, baseline: bool = False, cook: bool = False) -> dict:
-    """Full pickup-and-flip at the first ``n_locations`` Table I locations with the SQP from
-    cold starts, the SQP warm-started from ``atlas`` (if given) and IPOPT (if ``ipopt``),
+               ipopt: bool = True, baseline: bool = False, cook: bool = False,
+               turn: float = 0.0, cold: bool = True) -> dict:
+    """Full pickup-and-flip at the first ``n_locations`` Table I locations, each scooped along
+    its default heading turned by ``turn`` (rad), with the SQP from
+    cold starts (if ``cold``), the SQP warm-started from ``atlas`` (if given) and IPOPT (if ``ipopt``),
     then a batch of the first ``n_batch`` with the SQP, cold and from ``atlas``, the EE + IK
     baseline's times at the same locations (if ``baseline``) and the package's cook order
     scheduled with and without prefetching (if ``cook``); print; return the rows."""
@@ -268,7 +272,7 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
         structures.append(nlp)
         x = nlp.layout.nodes(nlp.x0)
         q, qd = x[-1, 0], x[-1, 1]
-    methods = {"sqp": {"solver": "sqp"}}
+    methods = {"sqp": {"solver": "sqp"}} if cold or atlas is None else {}
     if atlas is not None:
         methods["sqp_atlas"] = {"solver": "sqp", "atlas": atlas}
     if ipopt:
@@ -277,18 +281,20 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     print(f"warm-up: one SQP iteration on each of the 5 segment structures (cvxpy compile): "
           f"{warm_up(structures):.1f} s, not counted below")
     if atlas is not None:
-        print(f"atlas: {len(atlas)} locations on a {atlas.meta['grid'][0]} x "
-              f"{atlas.meta['grid'][1]} grid")
+        print(f"atlas: {len(atlas)} entries, a {atlas.meta['grid'][0]} x "
+              f"{atlas.meta['grid'][1]} grid at {len(atlas.meta.get('turns', [0.0]))} headings")
     print(f"{'loc':<4}{'p^b (m)':<25}{'method':<11}{'solve s':>8}{'wall s':>8}{'cpu s':>7}"
           f"{'it':>6}{'status':>8}{'T s':>6}{'dJ vs SQP':>11} | paper budget", flush=True)
     rows = []
     for k, loc in enumerate(locs, 1):
-        r = {"location": loc, **{n: _timed_flip(loc, cell, kw) for n, kw in methods.items()}}
+        turned = {"heading": default_heading(cell, loc) + turn} if turn else {}
+        r = {"location": loc, **turned,
+             **{n: _timed_flip(loc, cell, {**kw, **turned}) for n, kw in methods.items()}}
         rows.append(r)
         where = "(" + ", ".join(f"{v:.3f}" for v in loc) + ")"
         label = f"{k:<4}{where:<25}"
         for n in methods:
-            d, s = r[n], r["sqp"]
+            d, s = r[n], r[next(iter(methods))]
             both = d["status"] == s["status"] == "solved"
             d["rel_objective_diff_vs_sqp"] = ((d["objective"] - s["objective"])
                                               / abs(s["objective"]) if both else float("nan"))
@@ -311,7 +317,7 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     print("solve s = solver time of the five segments, wall s = the whole plan_flip call (IK, "
           "build, solve, verify), cpu s = its process CPU time, T = executed duration of the "
           "plan (s), dJ = (ΣJ − ΣJ_SQP)/ΣJ_SQP over the five segments")
-    out = {"machine": machine(), "rows": rows, "median": med}
+    out = {"machine": machine(), "turn_rad": turn, "rows": rows, "median": med}
     if n_batch:  # cold, then from the atlas (``flipkit plan batch``'s default)
         out["batch"] = _bench_batch(cell, n_batch, None)
         if atlas is not None:
@@ -448,13 +454,21 @@ def main(argv=None) -> int:
                              "the package's, when it serves the default options)")
     parser.add_argument("--no-atlas", action="store_true", help="flip: no atlas column")
     parser.add_argument("--no-ipopt", action="store_true", help="flip: no IPOPT column")
+    parser.add_argument("--no-cold", action="store_true",
+                        help="flip: no column of SQP plans from cold starts (with an atlas)")
     parser.add_argument("--baseline", action="store_true",
                         help="flip: also time the EE + IK baseline at the same locations")
     parser.add_argument("--cook", action="store_true",
                         help="flip: also schedule the package's cook order, serial and "
                              "prefetched, and compare the planning clocks")
+    parser.add_argument("--turn", type=float, default=0.0, metavar="DEG",
+                        help="flip: scoop each location along its default heading turned by "
+                             "DEG degrees (within the heading limit; the batch and cook rows "
+                             "keep the default headings)")
     parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
     args = parser.parse_args(argv)
+    if not (math.isfinite(args.turn) and abs(args.turn) <= 60.0):
+        parser.error("--turn must be a finite number of degrees in [-60, 60]")
     if not 1 <= args.locations <= len(TABLE1_LOCATIONS) or not 0 <= args.batch <= 5:
         parser.error(f"--locations must be 1..{len(TABLE1_LOCATIONS)} and --batch 0..5")
     warnings.filterwarnings("ignore", message="Solution may be inaccurate")
@@ -471,7 +485,8 @@ def main(argv=None) -> int:
             atlas = (Atlas.load(args.atlas, cell, SegmentOptions()) if args.atlas
                      else default_atlas(cell))
         result = bench_flip(cell, args.locations, args.batch, atlas, not args.no_ipopt,
-                            args.baseline, args.cook)
+                            args.baseline, args.cook, math.radians(args.turn),
+                            not args.no_cold)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(plain_json(result), fh, indent=1)

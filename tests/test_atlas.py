@@ -21,15 +21,17 @@ LOC = TABLE1_LOCATIONS[6]
 @pytest.fixture(scope="module")
 def entry():
     """The chain solved at Table I location 7, as an atlas builder's worker returns it."""
-    out = solve_entry((LOC, CellConfig(), SegmentOptions()))
+    out = solve_entry((LOC, tg.default_heading(CellConfig(), LOC), CellConfig(),
+                       SegmentOptions(), None))
     assert out["status"] == "solved"
     return out
 
 
-def _atlas(entry, locations=None, shift=None):
-    """An atlas of ``entry``'s solution at ``locations`` (default its own), the k-th copy
-    with joint angles moved by shift[k] (rad)."""
+def _atlas(entry, locations=None, shift=None, headings=None):
+    """An atlas of ``entry``'s solution at ``locations`` (default its own) and ``headings``
+    (default the entry's), the k-th copy with joint angles moved by shift[k] (rad)."""
     locations = [entry["location"]] if locations is None else locations
+    headings = [entry["heading"]] * len(locations) if headings is None else headings
     shift = [0.0] * len(locations) if shift is None else shift
     sols = {}
     for name in FLIP_NAMES:
@@ -41,14 +43,15 @@ def _atlas(entry, locations=None, shift=None):
             rows.append(y)
         sols[name] = np.array(rows)
     meta = {"options_hash": options_hash(CellConfig(), SegmentOptions()), "grid": [1, 1],
-            "failed": []}
-    return Atlas(locations, sols, entry["structure"], meta)
+            "failed": [], "flange": CellConfig().spatula.handle}
+    return Atlas(locations, headings, sols, entry["structure"], meta)
 
 
 def test_file_round_trip(entry, tmp_path):
     atlas = _atlas(entry)
     back = Atlas.load(atlas.save(tmp_path / "a.npz"), CellConfig(), SegmentOptions())
     assert len(back) == 1 and back.meta["grid"] == [1, 1]
+    np.testing.assert_array_equal(back.headings, atlas.headings)
     for name in FLIP_NAMES:  # stored as float32: a guess needs no more
         np.testing.assert_allclose(back.solutions[name], atlas.solutions[name], rtol=1e-6,
                                    atol=1e-6)
@@ -69,6 +72,11 @@ def test_stale_or_broken_atlas_is_refused(entry, tmp_path):
     bad.write_bytes(b"not an npz")
     with pytest.raises(AtlasError, match="cannot read atlas"):
         Atlas.load(bad)
+    with np.load(path) as data:  # an atlas from before scoop headings
+        old = {k: data[k] for k in data.files if k != "headings"}
+    np.savez_compressed(tmp_path / "old.npz", **old)
+    with pytest.raises(AtlasError, match="holds no scoop headings.*flipkit atlas build"):
+        Atlas.load(tmp_path / "old.npz")
 
 
 def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
@@ -88,15 +96,32 @@ def test_guess_interpolates_near_entries_and_skips_other_branches(entry):
     a, b, c = (0.70, -0.10, LOC[2]), (0.74, -0.10, LOC[2]), (0.72, -0.14, LOC[2])
     atlas = _atlas(entry, [a, b, c], shift=[0.0, 0.2, 3 * BRANCH_TOL])
     x = atlas.solutions["flip"]
-    np.testing.assert_array_equal(atlas.guess("flip", a, nlp), x[0])  # at an entry: itself
-    mid = atlas.guess("flip", (0.71, -0.10), nlp)  # 1 cm from a, 3 cm from b; c left out
+    psi = entry["heading"]
+    np.testing.assert_array_equal(atlas.guess("flip", a, nlp, psi), x[0])  # at an entry: itself
+    mid = atlas.guess("flip", (0.71, -0.10), nlp, psi)  # 1 cm from a, 3 cm from b; c left out
     w = np.array([1 / 0.01**2, 1 / 0.03**2])
     np.testing.assert_allclose(mid, (w[0] * x[0] + w[1] * x[1]) / w.sum(), rtol=1e-12)
     # an entry solved with its duration bound stretched (T beyond this NLP's bound) seeds
     # nothing, not even at its own location: b alone is left
     L = nlp.layout
     atlas.solutions["flip"][0, L.T_index] = 1.5 * nlp.x_ub[L.T_index]
-    np.testing.assert_allclose(atlas.guess("flip", a, nlp), atlas.solutions["flip"][1], rtol=1e-12)
+    np.testing.assert_allclose(atlas.guess("flip", a, nlp, psi), atlas.solutions["flip"][1],
+                               rtol=1e-12)
+
+
+def test_a_turned_heading_counts_as_the_flange_move_it_makes(entry):
+    """Entry distance: √(|Δxy|² + (handle · Δψ)²), Δψ wrapped; an entry at the same place but
+    a heading turned 30° is farther than one 3 cm away at the same heading, and the guess
+    weighs them so."""
+    from flipkit.planning.planners.atlas import entry_distance
+
+    h = CellConfig().spatula.handle
+    locs = np.array([[0.70, -0.10, 0.07], [0.73, -0.10, 0.07], [0.70, -0.10, 0.07]])
+    psis = np.array([0.5, 0.0, np.radians(-359.0)])
+    d = entry_distance(locs, psis, (0.70, -0.10, 0.07), 0.0, h)
+    np.testing.assert_allclose(d, [h * 0.5, 0.03, h * np.radians(1.0)], rtol=1e-12)
+    atlas = _atlas(entry, [tuple(v) for v in locs[:2]], headings=list(psis[:2]))
+    np.testing.assert_allclose(atlas.distance(locs[0], 0.5), [0.0, np.hypot(0.03, h * 0.5)])
 
 
 def test_warm_started_plan_is_solved_and_verified(entry):
@@ -158,7 +183,7 @@ def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch)
     for name in ("go_to_burger", "scoop", "pickup"):
         np.testing.assert_array_equal(seeded[name], atlas.solutions[name][0])
     assert all(seeded[name] is None for name in ("carry", "place", "return_home"))
-    stale = Atlas(atlas.locations, atlas.solutions, atlas.structure,
+    stale = Atlas(atlas.locations, atlas.headings, atlas.solutions, atlas.structure,
                   {**atlas.meta, "options_hash": "0" * 64})
     with pytest.raises(AtlasError, match="stale atlas"):
         plan_serve(LOC, (0.45, 0.70), atlas=stale)

@@ -180,7 +180,7 @@ def test_flip_is_judged_against_the_plans_landing_target(flip_plan, tmp_path):
         assert res["failure"]["reason"] == "missed_spot" and res["failure"]["amount"] > 0.2
 
 
-@pytest.mark.parametrize("flag", [("--no-atlas",), ("--heading", "10")])
+@pytest.mark.parametrize("flag", [("--no-atlas",), ("--heading", "10"), ("--turn", "15")])
 def test_planning_flags_need_locations(plan_file, tmp_path, capsys, flag):
     code = main(["validate", "--plan", str(plan_file), "--trials", "1", *flag,
                  "--no-progress", "--json", str(tmp_path / "o.json")])
@@ -188,13 +188,22 @@ def test_planning_flags_need_locations(plan_file, tmp_path, capsys, flag):
     assert code == 2 and f"{flag[0]} needs --locations" in err and len(err.splitlines()) == 1
 
 
-@pytest.mark.parametrize("value", ["75", "-61", "nan", "x"])
-def test_a_heading_out_of_range_is_refused_before_planning(tmp_path, capsys, value):
-    code = main(["validate", "--locations", "table1", "--heading", value, "--trials", "1",
+@pytest.mark.parametrize("flag,value", [("--heading", "75"), ("--heading", "-61"),
+                                        ("--heading", "nan"), ("--heading", "x"),
+                                        ("--turn", "121"), ("--turn", "inf")])
+def test_a_heading_out_of_range_is_refused_before_planning(tmp_path, capsys, flag, value):
+    code = main(["validate", "--locations", "table1", flag, value, "--trials", "1",
                  "--no-progress", "--json", str(tmp_path / "o.json")])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and "--heading" in err and len(err.splitlines()) == 1
+    assert code == 2 and flag in err and len(err.splitlines()) == 1
     assert not (tmp_path / "o.json").exists()
+
+
+def test_heading_and_turn_exclude_each_other(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["validate", "--locations", "table1", "--heading", "10", "--turn", "10",
+              "--trials", "1", "--json", str(tmp_path / "o.json")])
+    assert stop.value.code == 2 and "not allowed with" in capsys.readouterr().err
 
 
 def test_a_location_is_planned_at_the_heading_asked(tmp_path):

@@ -1,20 +1,26 @@
 """``flipkit atlas``: build or describe the warm-start atlas of ``plan flip``.
 
-    flipkit atlas build [--grid NX NY] [--scheduler ADDRESS] [--workers K] [--out FILE]
+    flipkit atlas build [--grid NX NY] [--turns DEG ...] [--scheduler ADDRESS] [--workers K]
+                        [--out FILE]
     flipkit atlas info [FILE]
 
-``build`` solves pickup-and-flip cold on an NX × NY grid over the grill (local worker
-processes, or a Dask cluster with ``--scheduler``) and writes one compressed file (default:
-the package's own, ``flipkit/data/atlas.npz``, which ``plan flip`` uses). NX and NY lie in
-[1, 50], the output ends in ``.npz`` and its directory is writable (checked before solving).
-Exit 0 written; 2 bad input or no location solved.
+``build`` solves pickup-and-flip cold on an NX × NY grid over the grill at each location's
+default scoop heading, then at that heading turned by each of the turns, seeded from the
+first (local worker processes, or a Dask cluster with ``--scheduler``), and writes one
+compressed file (default: the package's own, ``flipkit/data/atlas.npz``, which ``plan flip``
+uses). NX and NY lie in [1, 50], the turns in [-60, 60] degrees, the output ends in ``.npz``
+and its directory is writable (checked before solving). Exit 0 written; 2 bad input or no
+location solved.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 
 from flipkit.cli.common import MAX_GRID, MAX_WORKERS, check_int, deferred
+from flipkit.cli.plan_inputs import numbers
+from flipkit.errors import ConfigError
 from flipkit.fileio import check_output
 from flipkit.planning.planners.inputs import check_atlas_file
 
@@ -27,6 +33,10 @@ def register(subparsers) -> None:
     b = sub.add_parser("build", help="solve the grid and write the atlas")
     b.add_argument("--grid", nargs=2, type=int, metavar=("NX", "NY"), default=None,
                    help="grid over the grill area, each in [1, 50] (default 5 7)")
+    b.add_argument("--turns", nargs="*", default=None, metavar="DEG",
+                   help="turns of each location's default scoop heading to solve at too, "
+                        "degrees in [-60, 60] (default -30 -15 15 30, the turns a cook tries; "
+                        "none: the default headings alone)")
     b.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler (default: local "
                                                           "worker processes)")
     b.add_argument("--workers", type=int, metavar="K", help="local worker processes, in "
@@ -45,6 +55,12 @@ def run_build(args: argparse.Namespace) -> int:
     (:mod:`flipkit.cli.commands.atlas`)."""
     for n in args.grid or ():
         check_int("--grid", n, 1, MAX_GRID)
+    if args.turns is not None:
+        turns = numbers("--turns", args.turns, len(args.turns)) if args.turns else []
+        if any(abs(t) > 60.0 for t in turns):
+            raise ConfigError(f"--turns: each turn must lie in [-60, 60] degrees, got "
+                              f"{', '.join(f'{t:g}' for t in turns)}")
+        args.turns = [math.radians(t) for t in turns]
     if args.workers is not None:
         check_int("--workers", args.workers, 1, MAX_WORKERS)
     if args.out is not None:  # the package's own atlas is checked where it is known

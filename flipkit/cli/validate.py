@@ -12,8 +12,10 @@ every attempt (one line; the finished items stay in the cache).
 from __future__ import annotations
 
 import argparse
+import math
 
-from flipkit.cli.plan_inputs import heading
+from flipkit.cli.plan_inputs import heading, numbers
+from flipkit.config.task import HEADING_LIMIT
 from flipkit.cli.common import (LOCATION_SET_CHOICES, MAX_WORKERS, add_sweep_arguments,
                                 check_float, check_int, deferred, precheck_plan)
 from flipkit.config.checks import whole
@@ -54,10 +56,15 @@ def register(subparsers) -> None:
                              "atlas; the two reach different local optima of the same NLPs, "
                              "and comparing them shows how much a result owes to the one "
                              "found")
-    parser.add_argument("--heading", default=None, metavar="DEG",
-                        help="with --locations: plan every location with this scoop heading "
-                             "(degrees from the world's +x, within +-60; default: each "
-                             "location's own, radial from the base; docs/heading.md)")
+    turn = parser.add_mutually_exclusive_group()
+    turn.add_argument("--heading", default=None, metavar="DEG",
+                      help="with --locations: plan every location with this scoop heading "
+                           "(degrees from the world's +x, within +-60; default: each "
+                           "location's own, radial from the base; docs/heading.md)")
+    turn.add_argument("--turn", default=None, metavar="DEG",
+                      help="with --locations: plan every location with its own scoop heading "
+                           "turned by DEG degrees (the result within +-60 of +x), as a cook "
+                           "turns a scoop")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",
@@ -133,8 +140,14 @@ def run(args: argparse.Namespace) -> int:
             check_output_dir(directory, flag, inputs=inputs)
     if args.plan is not None:
         precheck_plan(args.plan)
-        for flag, given in (("--no-atlas", args.no_atlas), ("--heading", args.heading)):
-            if given:
+        for flag, given in (("--no-atlas", args.no_atlas), ("--heading", args.heading),
+                            ("--turn", args.turn)):
+            if given is not None and given is not False:
                 raise ConfigError(f"{flag} needs --locations: a plan file is already planned")
     args.heading = heading(args.heading)
+    if args.turn is not None:
+        args.turn = math.radians(numbers("--turn", args.turn)[0])
+        if abs(args.turn) > 2 * HEADING_LIMIT:
+            raise ConfigError(f"--turn: {math.degrees(args.turn):g} deg turns every default "
+                              "heading past +-60 deg of +x")
     return deferred("validate")(args)

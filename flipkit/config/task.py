@@ -44,6 +44,10 @@ APPROACH_LOW = 0.005  # m
 # flip's end set (eq. 26) keeps the blade's x axis pointing away from the arm, and the grill's
 # area is seen from the base within −40° to +15°. Ours.
 HEADING_LIMIT = 1.0471975511965976  # rad (60°)
+# rad, turns of the default scoop heading that a cook tries and the atlas holds: 15° moves a
+# scoop's blade corners 2-4 cm sideways over its 15-20 cm; 30° keeps every burger on the
+# grill within HEADING_LIMIT of +x for at least one side.
+HEADING_STEPS = (0.2617993877991494, 0.5235987755982988)  # (15°, 30°)
 SCOOP_LATERAL_BAND = 0.01  # m, |p_y − p^b_y| during the scoop: slide straight under it
 SCOOP_ANGLE_BAND = 0.05  # rad, |o_x|, |o_z| during the scoop: no yaw or roll that pushes it
 

@@ -26,6 +26,7 @@ from flipkit.behaviors import targets as tg
 from flipkit.simulation.judges import (FLIP_CONTACT_FRACTION, LANDING_TOL, SCOOP_OVERLAP,
                                       judge_flip, judge_pickup, judge_scoop, landing_target)
 from flipkit.config import CellConfig, known_physics, with_parameter
+from flipkit.config.task import HEADING_LIMIT
 from flipkit.errors import ConfigError, FlipkitError, InvalidChoiceError, UnreachableError
 from flipkit.experiments.contingent import attach, replanner, summary as contingency_summary
 from flipkit.experiments.compare_ik import location_label, plan_filename
@@ -349,7 +350,8 @@ def validate_plan_file(path, trials: int, seed: int = 0, **kwargs) -> dict:
 
 def validate_locations(locations, trials: int, solver: str = "auto", seed: int = 0, *,
                        executor=None, cache_dir=None, plans_dir=None, progress: bool = True,
-                       atlas: bool = True, heading: float | None = None, **kwargs) -> dict:
+                       atlas: bool = True, heading: float | None = None,
+                       turn: float | None = None, **kwargs) -> dict:
     """Plan every location (on the sweep, cached), then :func:`validate` the plans.
 
     Args:
@@ -359,6 +361,9 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         heading: The scoop heading (rad) of every plan
             (:func:`~flipkit.behaviors.targets.check_heading`); ``None``: each location's
             default (radial from the base).
+        turn: Instead of ``heading``: each location's default heading turned by ``turn``
+            (rad); a location whose turned heading lies beyond the limit is refused at its
+            planning (its trials fail at stage ``plan``, the reason named).
         plans_dir: Where to keep the plan files; default ``cache_dir/plans``, or a temporary
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
@@ -367,7 +372,12 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         raise InvalidChoiceError("solver", solver, SOLVERS)
     check_trials(trials)
     check_seed(seed)  # before any planning
+    if heading is not None and turn is not None:
+        raise ConfigError("give a heading or a turn of the default heading, not both")
     turned = {} if heading is None else {"heading": float(tg.check_heading(heading))}
+    if turn is not None and not (np.isfinite(turn) and abs(turn) <= 2 * HEADING_LIMIT):
+        raise ConfigError(f"turn must be finite and within +-{2 * HEADING_LIMIT:.3f} rad, "
+                          f"got {turn!r}")
     if isinstance(locations, (str, bytes, dict)) or not hasattr(locations, "__iter__"):
         raise ConfigError(f"locations: expected a sequence of burger locations (x, y, z) (m), "
                           f"got {type(locations).__name__}")
@@ -381,7 +391,9 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         where = Path(plans_dir or (Path(cache_dir) / "plans" if cache_dir else tmp)).resolve()
         where.mkdir(parents=True, exist_ok=True)
         cold = {} if atlas else {"atlas": False}  # the key only when set: cache keys keep
-        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold, **turned}
+        jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold, **turned,
+                 **({} if turn is None else
+                    {"heading": tg.default_heading(cell, loc) + float(turn)})}
                 for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
                           desc="plans", label_fn=location_label)

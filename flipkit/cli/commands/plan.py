@@ -86,7 +86,7 @@ def run_flip(args: argparse.Namespace) -> int:
                      options=options, atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
     if atlas is not None:
-        print(f"  warm start: atlas of {len(atlas)} locations")
+        print(f"  warm start: atlas of {len(atlas)} entries")
     return _report(plan, args.json)
 
 
@@ -111,7 +111,7 @@ def run_serve(args: argparse.Namespace) -> int:
                       atlas=atlas, heading=args.heading)
     plan.to_json(args.json)
     if atlas is not None:
-        print(f"  warm start: atlas of {len(atlas)} locations (go to burger, scoop, pickup)")
+        print(f"  warm start: atlas of {len(atlas)} entries (go to burger, scoop, pickup)")
     return _report(plan, args.json)
 
 

@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
             out = validate_locations(LOCATION_SETS[args.locations], args.trials, args.solver,
                                      args.seed, executor=executor, cache_dir=cache,
                                      plans_dir=args.plans, atlas=not args.no_atlas,
-                                     heading=args.heading, **common)
+                                     heading=args.heading, turn=args.turn, **common)
         write_json(args.json, out)
     print(format_table(out))
     total = out["summary"]

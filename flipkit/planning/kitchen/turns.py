@@ -16,13 +16,10 @@ import numpy as np
 
 from flipkit.behaviors.targets import default_heading
 from flipkit.config import CellConfig
-from flipkit.config.task import HEADING_LIMIT
+from flipkit.config.task import HEADING_LIMIT, HEADING_STEPS
 from flipkit.errors import FlipkitError
 
 
-# 15° moves a scoop's blade corners 2-4 cm sideways over its 15-20 cm; 30° keeps every burger
-# on the grill within HEADING_LIMIT of +x for at least one side.
-HEADING_STEPS = (math.radians(15.0), math.radians(30.0))  # rad, from the default heading
 
 
 class CookConflictError(FlipkitError):

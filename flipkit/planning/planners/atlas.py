@@ -1,9 +1,11 @@
 """Warm-start atlas: pickup-and-flip solutions over a grid on the grill, as initial guesses.
 
-An atlas holds, for each grid location where the chain was solved, every segment's solution
-vector Z (go to burger … turn back). :meth:`Atlas.guess` returns the initial guess of a
-segment at a new location: the inverse-distance-weighted mean (weights 1/d²) of the
-entries among the ``K_NEAREST`` nearest whose joint angles lie within ``BRANCH_TOL`` of
+An atlas holds, for each grid location and scoop heading where the chain was solved, every
+segment's solution vector Z (go to burger … turn back). :meth:`Atlas.guess` returns the
+initial guess of a segment at a new location and heading: the inverse-distance-weighted mean
+(weights 1/d²) of the entries among the ``K_NEAREST`` nearest (:func:`entry_distance`: the
+burger's move and the heading's turn, as far as it moves the tool flange) whose joint angles
+lie within ``BRANCH_TOL`` of
 the nearest entry's (entries on another IK branch or wrist turn are left out, and so are
 entries whose duration lies outside the NLP's bounds: solved with the bound stretched); an
 entry at the location itself is returned as it is. The guess only seeds the solver: the start state
@@ -50,10 +52,10 @@ SEEDED = FLIP_NAMES  # the atlas holds every segment of the pickup-and-flip
 # "shift": q(t) = q_atlas(t) + (q_start − q_atlas(0)) (the flip's free end moves with its
 # start); "blend": the offset fades out by a smoothstep (the turn back ends at q_home).
 ANCHORED = {s.name: s.atlas_anchor for s in PICKUP_AND_FLIP.steps if s.atlas_anchor}
-# The atlas's plans take each location's default scoop heading (radial from the base,
-# flipkit.behaviors.targets.default_heading); the hash names the rule, so an atlas built
-# with another one is refused as stale.
-HEADING_RULE = "radial"
+# The atlas's headings are each location's default scoop heading (radial from the base,
+# flipkit.behaviors.targets.default_heading) turned by each of its ``turns``; the hash names
+# the rule, so an atlas built with another one is refused as stale.
+HEADING_RULE = "radial+turns"
 K_NEAREST = 4
 BRANCH_TOL = 0.5  # rad: entries whose joint path departs more from the nearest one's are left out
 DEFAULT_NAME = "atlas.npz"
@@ -87,24 +89,47 @@ def default_atlas(cell: CellConfig | None = None, options: SegmentOptions = Segm
         return None
 
 
+def entry_distance(locations, headings, location, heading, flange: float) -> np.ndarray:
+    """Distance (m) of atlas entries (``locations`` (K, 3) m, ``headings`` (K,) rad) from a
+    burger at ``location`` scooped along ``heading`` (rad): √(|Δxy|² + (flange · Δψ)²), Δψ
+    wrapped to (−π, π]. Turning the heading by Δψ about the burger moves the tool flange,
+    ``flange`` (m, the spatula's handle) from the blade centre, by flange · Δψ: a turn counts
+    as the move of the joints' end that it makes."""
+    dxy = np.linalg.norm(np.asarray(locations, float)[:, :2] - np.asarray(location, float)[:2],
+                         axis=1)
+    dpsi = np.angle(np.exp(1j * (np.asarray(headings, float) - float(heading))))
+    return np.hypot(dxy, flange * dpsi)
+
+
 class Atlas:
-    """Solved chains by location.
+    """Solved chains by location and scoop heading.
 
     Args:
         locations: (K, 3) burger locations p^b (m).
+        headings: (K,) scoop headings ψ (rad) the entries were solved at.
         solutions: Segment name -> (K, n) solution vectors (unscaled).
         structure: Segment name -> NLP structure key at build time.
         meta: JSON-able record: ``options_hash``, ``options``, ``cell``, ``grid``,
-            ``failed`` locations, ``flipkit`` version and commit.
+            ``turns`` (rad, from each location's default heading), ``flange`` (m, the
+            spatula's handle, :func:`entry_distance`), ``failed`` entries, ``flipkit``
+            version and commit.
 
     Raises:
         AtlasError: Inconsistent shapes or missing segments.
     """
 
-    def __init__(self, locations, solutions: dict, structure: dict, meta: dict):
+    def __init__(self, locations, headings, solutions: dict, structure: dict, meta: dict):
         self.locations = np.asarray(locations, float).reshape(-1, 3)
+        self.headings = np.asarray(headings, float).reshape(-1)
         self.solutions = {k: np.asarray(v, float) for k, v in solutions.items()}
         self.structure, self.meta = dict(structure), dict(meta)
+        if self.headings.shape != (len(self.locations),) or not np.all(
+                np.isfinite(self.headings)):
+            raise AtlasError(f"atlas: {self.headings.size} headings for "
+                             f"{len(self.locations)} locations; each entry needs a finite one")
+        flange = self.meta.get("flange")
+        if not (isinstance(flange, (int, float)) and np.isfinite(flange) and flange > 0):
+            raise AtlasError(f"atlas: meta 'flange' must be a positive length (m), got {flange!r}")
         for name in FLIP_NAMES:
             if name not in self.solutions or name not in self.structure:
                 raise AtlasError(f"atlas has no {name!r} solutions; segments: "
@@ -126,7 +151,8 @@ class Atlas:
         arrays = {f"x_{k}": v.astype(np.float32) for k, v in self.solutions.items()}
         header = {"format": FORMAT, "structure": self.structure, **self.meta}
         return replace_with(path, lambda tmp: np.savez_compressed(
-            tmp, locations=self.locations, header=np.array(json.dumps(header)), **arrays))
+            tmp, locations=self.locations, headings=self.headings,
+            header=np.array(json.dumps(header)), **arrays))
 
     @classmethod
     def load(cls, path, cell: CellConfig | None = None,
@@ -141,6 +167,10 @@ class Atlas:
             with np.load(Path(path), allow_pickle=False) as data:
                 header = strict_loads(str(data["header"]))
                 locations = data["locations"]
+                if "headings" not in data.files:
+                    raise AtlasError(f"stale atlas {path}: it holds no scoop headings; rebuild "
+                                     "it with `flipkit atlas build`")
+                headings = data["headings"]
                 solutions = {k[2:]: data[k] for k in data.files if k.startswith("x_")}
         except (OSError, ValueError, KeyError, RecursionError) as exc:
             reason = ("an array holds Python objects, which are never loaded"
@@ -152,7 +182,7 @@ class Atlas:
         if header.get("format") != FORMAT:
             raise AtlasError(f"{path}: not a {FORMAT} file (format {header.get('format')!r})")
         structure = header.pop("structure", {})
-        atlas = cls(locations, solutions, structure, header)
+        atlas = cls(locations, headings, solutions, structure, header)
         if cell is not None and options is not None:
             want = options_hash(cell, options)
             if header.get("options_hash") != want:
@@ -162,8 +192,14 @@ class Atlas:
         return atlas
 
     # ----------------------------------------------------------------- lookup
-    def stretched(self, name: str, location, nlp) -> bool:
-        """Whether most of the atlas's ``K_NEAREST`` entries nearest to ``location`` solved
+    def distance(self, location, heading: float) -> np.ndarray:
+        """Each entry's :func:`entry_distance` (m) from ``location`` and ``heading``."""
+        return entry_distance(self.locations, self.headings, location, heading,
+                              self.meta["flange"])
+
+    def stretched(self, name: str, location, nlp, heading: float) -> bool:
+        """Whether most of the atlas's ``K_NEAREST`` entries nearest to ``location`` and
+        ``heading`` (rad) solved
         segment ``name`` with its duration bound stretched (their T above ``nlp``'s upper
         bound): the planner then tries the stretched bound first. Where the neighbourhood
         needs the stretch, the warm SQP within the bound, seeded from the few entries that
@@ -173,16 +209,18 @@ class Atlas:
         X = self.solutions.get(name)
         if X is None or self.structure.get(name) != nlp.structure_key:
             return False
-        d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
+        d = self.distance(location, heading)
         near = np.argsort(d, kind="stable")[:K_NEAREST]
         i = nlp.layout.T_index
         return bool(2 * np.count_nonzero(X[near, i] > nlp.x_ub[i] + 1e-6) > len(near))
 
-    def guess(self, name: str, location, nlp, start=None) -> np.ndarray:
-        """Initial guess of segment ``name`` of the chain at ``location`` for ``nlp``.
+    def guess(self, name: str, location, nlp, heading: float, start=None) -> np.ndarray:
+        """Initial guess of segment ``name`` of the chain at ``location`` and ``heading`` for
+        ``nlp``.
 
         Args:
             name, location, nlp: The segment, the burger's location p^b (m) and its NLP.
+            heading: The scoop heading ψ (rad).
             start: Optional (q, q̇) the segment starts from (rad, rad/s); for the segments of
                 :data:`ANCHORED`, the guess is then anchored there (:func:`anchored_guess`).
 
@@ -194,7 +232,7 @@ class Atlas:
             raise AtlasError(f"stale atlas: the {name!r} segment's NLP has changed since the "
                              "atlas was built; rebuild it with `flipkit atlas build`")
         X = self.solutions[name]
-        d = np.linalg.norm(self.locations[:, :2] - np.asarray(location, float)[:2], axis=1)
+        d = self.distance(location, heading)
         # An entry whose duration lies outside this NLP's bounds was solved with the bound
         # stretched (the planner's retry, ×1.5): clipped to the bound it violates every
         # defect row, so it seeds nothing (an SQP started there declares the segment
@@ -230,24 +268,27 @@ def check_atlas(atlas, cell: CellConfig, options: SegmentOptions) -> None:
 
 class Seeding:
     """A :meth:`~flipkit.planning.planners.chain.Planner.chain` ``guess`` from an atlas for
-    the burger at ``location``: called as ``guess(name, nlp, q, qd)``, the atlas's
-    interpolated solution for the segments it holds (:data:`SEEDED`), else ``None``;
-    :meth:`stretched` tells the planner to try the stretched bound first."""
+    the burger at ``location`` scooped along ``heading`` (rad): called as
+    ``guess(name, nlp, q, qd)``, the atlas's interpolated solution for the segments it holds
+    (:data:`SEEDED`), else ``None``; :meth:`stretched` tells the planner to try the
+    stretched bound first."""
 
-    def __init__(self, atlas: Atlas, location):
-        self.atlas, self.location = atlas, location
+    def __init__(self, atlas: Atlas, location, heading: float):
+        self.atlas, self.location, self.heading = atlas, location, float(heading)
 
     def __call__(self, name: str, nlp, q, qd):
-        return self.atlas.guess(name, self.location, nlp, (q, qd)) if name in SEEDED else None
+        if name not in SEEDED:
+            return None
+        return self.atlas.guess(name, self.location, nlp, self.heading, (q, qd))
 
     def stretched(self, name: str, nlp) -> bool:
-        return name in SEEDED and self.atlas.stretched(name, self.location, nlp)
+        return name in SEEDED and self.atlas.stretched(name, self.location, nlp, self.heading)
 
 
-def seeding(atlas, location):
-    """A :class:`Seeding` from ``atlas`` for the burger at ``location``; ``None`` without an
-    atlas."""
-    return None if atlas is None else Seeding(atlas, location)
+def seeding(atlas, location, heading: float):
+    """A :class:`Seeding` from ``atlas`` for the burger at ``location`` scooped along
+    ``heading`` (rad); ``None`` without an atlas."""
+    return None if atlas is None else Seeding(atlas, location, heading)
 
 
 def anchored_guess(nlp, x, q_start, qd_start, how: str) -> np.ndarray:

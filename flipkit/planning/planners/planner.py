@@ -157,7 +157,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
     task = Task(location=pb, land=spot, on_blade=on_blade,
                 approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("flip", task, q, qd,
-                         guess=seeding(atlas, pb), t0=t0)
+                         guess=seeding(atlas, pb, psi), t0=t0)
 
 
 def covers(landing: dict, on_blade) -> bool:

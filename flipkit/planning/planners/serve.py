@@ -90,7 +90,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
     task = Task(location=pb, spot=spot, on_blade=on_blade,
                 approach_height=check_approach_height(approach_height), heading=psi)
     return planner.chain("serve", task, q, qd,
-                         guess=seeding(atlas, pb), t0=t0)
+                         guess=seeding(atlas, pb, psi), t0=t0)
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
