@@ -53,7 +53,7 @@ from flipkit.baseline import EE_METHODS, run_baseline
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
-from flipkit.behaviors.targets import default_heading
+from flipkit.behaviors.targets import turned_heading
 from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.experiments.speed import (PAPER_EE_OPT_S, PAPER_FIVE_BURGERS_S,
@@ -287,7 +287,7 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
           f"{'it':>6}{'status':>8}{'T s':>6}{'dJ vs SQP':>11} | paper budget", flush=True)
     rows = []
     for k, loc in enumerate(locs, 1):
-        turned = {"heading": default_heading(cell, loc) + turn} if turn else {}
+        turned = {"heading": turned_heading(cell, loc, turn)} if turn else {}
         r = {"location": loc, **turned,
              **{n: _timed_flip(loc, cell, {**kw, **turned}) for n, kw in methods.items()}}
         rows.append(r)
@@ -463,8 +463,8 @@ def main(argv=None) -> int:
                              "prefetched, and compare the planning clocks")
     parser.add_argument("--turn", type=float, default=0.0, metavar="DEG",
                         help="flip: scoop each location along its default heading turned by "
-                             "DEG degrees (within the heading limit; the batch and cook rows "
-                             "keep the default headings)")
+                             "DEG degrees, stopping at the heading limit (+-60 deg of +x); the "
+                             "batch and cook rows keep the default headings")
     parser.add_argument("--json", metavar="OUT", help="also write the results as JSON")
     args = parser.parse_args(argv)
     if not (math.isfinite(args.turn) and abs(args.turn) <= 60.0):

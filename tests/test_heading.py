@@ -133,3 +133,18 @@ def test_a_tampered_heading_fails_verify(corner_plan, tmp_path):
     assert not report.ok
     failed = {name for name, g in report.groups.items() if not g.ok}
     assert {"endpoints", "behavior_path"} & failed
+
+
+def test_a_turned_heading_stops_at_the_limit():
+    """``turned_heading``: the default heading plus the turn, held within ±HEADING_LIMIT."""
+    import math
+
+    from flipkit.behaviors.targets import default_heading, turned_heading
+    from flipkit.config import CellConfig
+    from flipkit.config.task import HEADING_LIMIT
+
+    cell, near = CellConfig(), (0.75, -0.45, 0.072)
+    psi = default_heading(cell, near)
+    assert turned_heading(cell, near, math.radians(10)) == pytest.approx(psi + math.radians(10))
+    assert turned_heading(cell, near, -math.radians(45)) == pytest.approx(-HEADING_LIMIT)
+    assert turned_heading(cell, near, math.radians(120)) == pytest.approx(HEADING_LIMIT)

@@ -85,6 +85,13 @@ def default_heading(cell: CellConfig, pb) -> float:
     return float(math.atan2(pb[1] - base[1], pb[0] - base[0]))
 
 
+def turned_heading(cell: CellConfig, pb, turn: float) -> float:
+    """The default heading at ``pb`` turned by ``turn`` (rad), held within
+    ±:data:`~flipkit.config.task.HEADING_LIMIT` of +x (a turn past it stops at it)."""
+    psi = default_heading(cell, pb) + float(turn)
+    return float(min(max(psi, -HEADING_LIMIT), HEADING_LIMIT))
+
+
 def check_heading(heading) -> float:
     """A scoop heading (rad) as a float, or :class:`UnreachableError`: finite and within
     ±:data:`~flipkit.config.task.HEADING_LIMIT` of the paper's +x (the flip's end set,

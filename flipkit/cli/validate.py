@@ -63,8 +63,8 @@ def register(subparsers) -> None:
                            "location's own, radial from the base; docs/heading.md)")
     turn.add_argument("--turn", default=None, metavar="DEG",
                       help="with --locations: plan every location with its own scoop heading "
-                           "turned by DEG degrees (the result within +-60 of +x), as a cook "
-                           "turns a scoop")
+                           "turned by DEG degrees, as a cook turns a scoop, stopping at +-60 "
+                           "deg of +x")
     parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                         help="PD controller rate (Hz) in [10, 100000] (default 1000)")
     parser.add_argument("--mode", choices=("feedforward", "position"), default="feedforward",

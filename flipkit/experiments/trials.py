@@ -362,8 +362,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
             (:func:`~flipkit.behaviors.targets.check_heading`); ``None``: each location's
             default (radial from the base).
         turn: Instead of ``heading``: each location's default heading turned by ``turn``
-            (rad); a location whose turned heading lies beyond the limit is refused at its
-            planning (its trials fail at stage ``plan``, the reason named).
+            (rad), stopping at the heading limit (:func:`~flipkit.behaviors.targets.turned_heading`).
         plans_dir: Where to keep the plan files; default ``cache_dir/plans``, or a temporary
             directory without a cache.
         trials, seed, executor, cache_dir, progress, kwargs: As :func:`validate`.
@@ -393,7 +392,7 @@ def validate_locations(locations, trials: int, solver: str = "auto", seed: int =
         cold = {} if atlas else {"atlas": False}  # the key only when set: cache keys keep
         jobs = [{"location": loc, "solver": solver, "plans_dir": str(where), **cold, **turned,
                  **({} if turn is None else
-                    {"heading": tg.default_heading(cell, loc) + float(turn)})}
+                    {"heading": tg.turned_heading(cell, loc, turn)})}
                 for loc in locs]
         infos = run_sweep(plan_location, jobs, executor, cache_dir, progress=progress,
                           desc="plans", label_fn=location_label)
