@@ -210,7 +210,9 @@ def test_a_stream_over_the_arms_speed_is_refused_with_nothing_written(plan, tmp_
 # ------------------------------------------------------------------ ROS 2
 def test_ros2_yaml_is_the_resampled_trajectory(plan, robot, tmp_path):
     path = tmp_path / "flip.yaml"
-    assert write_ros2(plan, path, 126.0) == 265  # 227 on the grid, 37 nodes off it, the end
+    # 227 on the grid, 15 of them within a quarter period of a node (left out), 37 nodes off
+    # the grid, the end
+    assert write_ros2(plan, path, 126.0) == 227 - 15 + 37 + 1
     doc = yaml.safe_load(path.read_text())
     assert list(doc) == ["header", "joint_names", "points"]
     assert doc["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}
@@ -302,3 +304,24 @@ def test_the_command_lines_constants_are_the_librarys():
     assert cli_export.RATE_RANGE == export.RATE_RANGE
     assert cli_export.STREAM_RATES == export.STREAM_RATES
     assert cli_export.SERVO_RATES == export_urscript.SERVO_RATES
+
+
+def test_a_node_a_few_nanoseconds_off_the_grid_takes_the_grid_samples_place(plan):
+    """A segment whose duration falls 2 ns short of the grid puts every later node 2 ns off
+    it: the grid sample there gives way to the node, so no two samples are closer than a
+    quarter period (written to the ns they would be one time stamp, and a spline through them
+    asks for unbounded acceleration); every node stays among the samples."""
+    from dataclasses import replace
+
+    seg = plan.segments[0]
+    T = 0.9 - 2e-9
+    short = replace(plan, segments=[replace(seg, T=T, t=seg.t[0] + (seg.t - seg.t[0]) * T / seg.T)])
+    t, q, qd = export.resample(short, 500.0)
+    assert np.diff(t).min() >= export.MIN_GAP / 500.0 - 1e-15
+    nodes = short.segments[0].t - short.segments[0].t[0]
+    assert np.abs(t[:, None] - nodes[None, :]).min(axis=0).max() == 0.0
+    assert t[-1] == T
+    on_grid = np.isclose(nodes * 500.0, np.round(nodes * 500.0), rtol=0, atol=1e-5)
+    assert on_grid.sum() >= 5  # nodes just off the grid: the case at stake
+    near = np.abs(t[:, None] - nodes[None, on_grid]) < 1e-6
+    assert np.all(near.sum(axis=0) == 1)  # one sample there, the node's own

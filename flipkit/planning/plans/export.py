@@ -17,7 +17,8 @@ bounds. Segments are
 concatenated on a global clock; a sample on a segment boundary is taken from the later
 segment (both agree on a continuous plan). Samples are at t_j = j / rate, j = 0 ..
 ⌊T_total · rate⌋, at every node of the plan and at T_total, so that a stream ends where the
-plan does, at rest. With the nodes among the samples, the cubic spline a controller lays
+plan does, at rest; a t_j within :data:`MIN_GAP` of a period from a node is left out (the
+node stands for it), so no two samples share a written time stamp. With the nodes among the samples, the cubic spline a controller lays
 through the samples' (q, q̇) is the plan's own interpolant, which verify bounded: on the
 rate's grid alone, a spline across a node where the plan's q̈ steps (a segment join) asks
 for more acceleration than the plan does. :func:`evaluate` gives the same interpolant (and u,
@@ -49,6 +50,7 @@ STREAM_RATES = {"csv": (100.0, 1000.0), "ros2": (100.0, 1000.0)}
 own run between 125 and 500 Hz); URScript's are its servo periods
 (:data:`flipkit.planning.plans.export_urscript.SERVO_RATES`)."""
 _EPS = 1e-9  # s, slack on the last sample time (floating-point T_total · rate)
+MIN_GAP = 0.25  # periods: the least spacing of a grid sample from a plan node (resample)
 
 
 def _check_rate(rate) -> float:
@@ -92,8 +94,13 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     starts = np.concatenate([[0.0], np.cumsum([s.T for s in plan.segments])[:-1]])
     knots = np.concatenate([start + seg.t - seg.t[0] for start, seg in zip(starts,
                                                                            plan.segments)])
-    t = np.unique(np.concatenate([t, np.minimum(knots, total), [total]]))
-    t = t[np.concatenate([[True], np.diff(t) > _EPS])]  # a knot on the grid counts once
+    knots = np.unique(np.concatenate([np.minimum(knots, total), [total]]))
+    knots = knots[np.concatenate([[True], np.diff(knots) > _EPS])]  # a join counts once
+    # A grid time within MIN_GAP periods of a node gives way to the node: two samples a few
+    # nanoseconds apart (a node just off the grid) are one time stamp once written, and a
+    # spline through them asks for unbounded acceleration.
+    near = np.abs(t[:, None] - knots[None, :]).min(axis=1) < MIN_GAP / rate
+    t = np.union1d(t[~near], knots)
     q, qd, _ = evaluate(plan, t)
     return t, q, qd
 
