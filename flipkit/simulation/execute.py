@@ -27,7 +27,6 @@ draw; the plan's feed-forward ignores it. After the plan the last desired state 
 
 from __future__ import annotations
 
-import hashlib
 
 import time
 from dataclasses import dataclass, replace
@@ -308,7 +307,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
 
 def _errors(robot, t, q, q_des, bounds) -> dict:
     """Per-segment spatula position error against the plan (m)."""
-    diff = _positions(robot, q) - _desired_positions(robot, q_des)
+    diff = _positions(robot, q) - _positions(robot, q_des)
     e = np.linalg.norm(diff, axis=1)
     out = {}
     for name, (t0, t1) in bounds.items():
@@ -323,24 +322,6 @@ def _errors(robot, t, q, q_des, bounds) -> dict:
 def _positions(robot, q) -> np.ndarray:
     """Blade-centre positions (m) at each row of q."""
     return np.array([robot.placement(a).translation for a in q])
-
-
-_DESIRED: dict = {}  # digest of a desired path -> its positions: every trial of a plan has it
-
-
-def _desired_positions(robot, q_des) -> np.ndarray:
-    """:func:`_positions` of a desired path, kept for the trials of the same plan (keyed by
-    the path's bytes and the arm's kinematics: joint placements and the spatula's)."""
-    q_des = np.ascontiguousarray(q_des, dtype=float)
-    kinematics = np.concatenate([robot.spatula_in_joint.homogeneous.ravel()] + [
-        placement.homogeneous.ravel() for placement in robot.model.jointPlacements])
-    key = (hashlib.sha1(q_des.tobytes()).hexdigest(), q_des.shape,
-           hashlib.sha1(kinematics.tobytes()).hexdigest())
-    if key not in _DESIRED:
-        if len(_DESIRED) >= 16:
-            _DESIRED.pop(next(iter(_DESIRED)))
-        _DESIRED[key] = _positions(robot, q_des)
-    return _DESIRED[key]
 
 
 __all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "SENSE_LEAD", "NO_DRAW", "Execution", "execute_plan"]
