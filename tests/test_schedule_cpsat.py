@@ -227,7 +227,7 @@ def test_flip_only_and_the_timeline_record():
 @pytest.fixture
 def fake_planners(monkeypatch):
     monkeypatch.setattr(motions, "default_planners",
-                        lambda kinds, cell=None, solver="auto", atlas=None:
+                        lambda kinds, cell=None, solver="auto", atlas=None, caches=None:
                         {k: v for k, v in planners().items() if k in kinds})
 
 
