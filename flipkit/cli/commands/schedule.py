@@ -26,6 +26,7 @@ from flipkit.fileio import replace_with
 from flipkit.planning.kitchen import motions
 from flipkit.planning.kitchen.clearance import CookConflictError, clear_cook, cook_meetings
 from flipkit.planning.kitchen.cook import check_cook, table_spots
+from flipkit.planning.kitchen.cpsat_process import Child
 from flipkit.planning.kitchen.durations import plan_model, representative_order
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
@@ -66,9 +67,10 @@ def run(args: argparse.Namespace) -> int:
     timeline_path, plans = Path(args.json), Path(args.plans)  # --plans checked there too
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     pool = make_executor(workers=workers) if workers > 1 else contextlib.nullcontext()
-    with pool as executor:  # its workers end with the run, however it ends
+    # the workers, and the CP-SAT child that answers every schedule of the run, end with it
+    with pool as executor, Child() as child:
         if stream and not args.plan:
-            return _modelled_stream(args, cell, atlas, executor, timeline_path, caches)
+            return _modelled_stream(args, cell, atlas, executor, timeline_path, caches, child)
         order = check_cook(burgers, cell)
         spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
         planners = _planners(order, kinds, cell, args, atlas, spots, executor, caches)
@@ -81,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
                 def cpsat(lands, headings):
                     return schedule_cook_cpsat(burgers, planners, cell.robot.q_home, **common,
                                                lands=lands, headings=headings,
-                                               time_limit_s=args.time_limit, seed=args.seed)
+                                               time_limit_s=args.time_limit, seed=args.seed,
+                                               child=child)
 
                 timeline, lands, headings = clear_cook(cpsat, cell)
             else:
@@ -196,14 +199,14 @@ def _report_simulation(sim, args: argparse.Namespace) -> int:
     return 0
 
 
-def _modelled_stream(args, cell, atlas, executor, timeline_path: Path, caches) -> int:
+def _modelled_stream(args, cell, atlas, executor, timeline_path: Path, caches, child) -> int:
     """A stream scheduled on the durations of representative plans: report and JSON."""
     rep, rep_spots = representative_order(cell)
     model = plan_model(_planners(rep, ("flip", "serve"), cell, args, atlas, rep_spots,
                                  executor, caches), cell.robot.q_home, cell)
     timeline, report = run_stream(args.stream, args.minutes, model, policy=args.policy,
                                   windows=args.windows, dwell_s=args.dwell, seed=args.seed,
-                                  cell=cell, time_limit_s=args.time_limit)
+                                  cell=cell, time_limit_s=args.time_limit, child=child)
     doc = timeline.to_dict()
     doc["stream"], doc["motion_model"] = report.to_dict(), model.to_dict()
     write_json(timeline_path, doc)
