@@ -9,9 +9,9 @@ Two end-effector optimisations (``ee``):
   (:mod:`.ee_scp`, sequential convex programming over the rpy Bezier; the duration by a
   golden-section search within collocation's bounds the specs' ``duration``),
   with collocation's task-space endpoint constraints, friction cone and flip landing.
-* ``fixed``: the earlier single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep
-  profile to a fixed flip end orientation, the durations :data:`BASELINE_T` (s) — the upper
-  bounds collocation had before its chain was shortened from 4.0 s to 3.4 s.
+* ``fixed``: a single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep profile to a
+  fixed flip end orientation, the durations fixed at :data:`BASELINE_T` (s), longer than
+  collocation's upper bounds.
 
 Each subbehaviour's end-effector problem starts at the previous one's end state (position,
 velocity, orientation, orientation rate); the IK continues from the previous IK

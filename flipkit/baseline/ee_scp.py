@@ -20,27 +20,28 @@ arm's space limits (joint-space quantities the task-space method cannot see).
 Method. p(s) and the rpy angles o(s) are Bezier polynomials of degree 7 in s = t/T; their
 control points C, D (m, rad) are the decision variables. The constraints are imposed at
 :data:`SAMPLES` evenly spaced s (the velocity, acceleration and pitch bounds on the control
-points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints,
-boxes, pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised about the
-previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
-differences of :data:`flipkit.model.flight.LANDING`, 25 points in one call) and relaxed by one elastic slack
-σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
+points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints, boxes,
+pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised
+about the previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
+differences of :data:`flipkit.model.flight.LANDING`, 25 points in one call) and relaxed by one
+elastic slack σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
 (subbehaviour, samples), written once with Parameters (DPP) and kept in a
 :class:`~flipkit.baseline.problems.CompiledProblems`; the duration enters only through
-Parameters (bounds scaled by T, T²; cost weights), so a duration search recompiles nothing,
-and nor does a sweep over burger locations that passes the same ``problems``. A step is taken when the merit — cost plus
-penalty × the exact violation — falls by at least a tenth of what the subproblem predicts;
-the box trust region (Δ rad on D, 0.3 Δ m on C) halves when it falls by less than a quarter
-and doubles when by more than three quarters at its edge. The cost
-is ∫ |p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT`
-(m²/rad²): a radian of blade rotation weighs as much as a translation by the arm's reach,
-≈ 1 m, both being about a radian of joint motion. (With w_o = (l/2)², a blade-tip
-displacement, rotations were so cheap that the go-to-burger pitched back and forward again
-to keep the tip off the grill, driving wrist 1 far past its speed limit.) The duration is chosen by a search of the converged cost over the bounds
-(infeasible durations cost +∞), each solve warm-started from the best so far: the upper bound
-and a probe just below it, and a golden-section search only when the probe costs less
-(:data:`PROBE_FRACTION`). At each duration the SCP returns the best feasible point it met, and stops
-once that has not improved by OBJ_TOL for :data:`STALE_ITERATIONS` iterations.
+Parameters (bounds scaled by T, T²; cost weights), so a duration search recompiles nothing, and
+nor does a sweep over burger locations that passes the same ``problems``. A step is taken when
+the merit — cost plus penalty × the exact violation — falls by at least a tenth of what the
+subproblem predicts; the box trust region (Δ rad on D, 0.3 Δ m on C) halves when it falls by
+less than a quarter and doubles when by more than three quarters at its edge. The cost is ∫
+|p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT` (m²/rad²): a
+radian of blade rotation weighs as much as a translation by the arm's reach, ≈ 1 m, both being
+about a radian of joint motion. (A weight as small as (l/2)², a blade-tip displacement, makes
+rotations so cheap that the go to burger pitches back and forward again to keep the tip off the
+grill, driving wrist 1 past its speed limit; docs/history.md.) The duration is chosen by a
+search of the converged cost over the bounds (infeasible durations cost +∞), each solve
+warm-started from the best so far: the upper bound and a probe just below it, and a
+golden-section search only when the probe costs less (:data:`PROBE_FRACTION`). At each duration
+the SCP returns the best feasible point it met, and stops once that has not improved by OBJ_TOL
+for :data:`STALE_ITERATIONS` iterations.
 """
 
 from __future__ import annotations
@@ -120,9 +121,8 @@ class ScpSegment:
         self.tip = hg - SCOOP_PRESS
         self.cone_frac = {"pickup": 1.0, "flip": max(RELEASE_FRACTION, tg.FLIP_CONE_FRACTION)}
         self.release = int(np.ceil(RELEASE_FRACTION * (n - 1) - 1e-9))
-        # The nominal μ × MU_SAFETY, not collocation's MU_PLAN: with the 0.16 cone the SCP
-        # finds no feasible chain at the tests' location (scp_violation 0.6), so the baseline
-        # keeps the cone it was compared with.
+        # The nominal μ × MU_SAFETY, not collocation's narrower MU_PLAN: the baseline keeps
+        # the cone it was compared with, within which the SCP finds feasible chains.
         self.mu = cell.burger.mu * MU_SAFETY
         self.g = np.asarray(cell.gravity, float)
         self._mapped: dict = {}  # k -> LANDING mapped over k release states

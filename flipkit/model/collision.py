@@ -35,9 +35,9 @@ from flipkit.errors import ConfigError
 from flipkit.model.robot import LWA, Robot, skew
 
 BLADE, HANDLE = "blade", "handle"
-# GJK's stopping tolerance (m). coal's default, 1e-6, left distances up to 2e-7 m off (seen:
-# blade to table at 0.95 m), enough to spoil finite differences and the SQP's line search;
-# 1e-9 costs ~1.5× per query.
+# GJK's stopping tolerance (m). coal's default, 1e-6, leaves distances off by more than the
+# finite differences of the gradient tests and the SQP's line search can tell from a change
+# of the configuration; 1e-9 makes a query somewhat dearer (docs/history.md).
 GJK_TOLERANCE = 1e-9
 
 

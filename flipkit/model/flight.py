@@ -14,8 +14,8 @@ for the default patty). In torque-free motion its angular momentum L = I_t ω + 
 (ω·n) n is constant and so is ω·n (Euler's equations of a symmetric body), so ω = L/I_t −
 (κ − 1)(ω·n) n and ṅ = ω × n = (L/I_t) × n: the axis n turns about the fixed direction of L
 at the constant rate |L|/I_t, not about ω. ω is along a principal axis only when the blade
-does not turn about its own normal at release; a flip's ω·n of about 0.5 rad/s over 6 rad/s
-turns the landed face 2-7° from where a rotation about ω would put it.
+does not turn about its own normal at release; a flip's small turn about the normal still
+turns the landed face by degrees from where a rotation about ω would put it.
 
 Release state at the blade pose (p, R), velocity v and angular velocity ω (world frame), the
 burger's centre over the blade point b = (b_x, b_y, 0) (the blade centre unless the burger
@@ -31,12 +31,12 @@ Flight, with τ the time since release and g = |gravity| along −z:
 
 Everything is one CasADi SX graph (exact first derivatives by algorithmic differentiation):
 :func:`landing_function` gives the landing point, tilt and time of flight,
-:func:`clearance_function` the signed clearance of the flying burger from the blade plane at
-a later blade pose. Both build a new function; :data:`LANDING` and :data:`FLIGHT_CLEARANCE`
-are the ones built when this module loads (a few milliseconds), which every caller shares:
-a CasADi function is immutable once built, and calling it allocates its own work memory. Rotation inputs are perturbed by a small world rotation δ,
-R(δ) = (I + [δ]×) R, so that a derivative with respect to δ at δ = 0 chains with pinocchio's
-angular Jacobian (dR = [J_ω dq]× R).
+:func:`clearance_function` the signed clearance of the flying burger from the blade plane at a
+later blade pose. Both build a new function; :data:`LANDING` and :data:`FLIGHT_CLEARANCE` are
+the ones built when this module loads (a few milliseconds), which every caller shares: a CasADi
+function is immutable once built, and calling it allocates its own work memory. Rotation inputs
+are perturbed by a small world rotation δ, R(δ) = (I + [δ]×) R, so that a derivative with
+respect to δ at δ = 0 chains with pinocchio's angular Jacobian (dR = [J_ω dq]× R).
 """
 
 from __future__ import annotations

@@ -60,8 +60,8 @@ SETTLED_MOTION = 2e-4  # m
 SETTLED_TURN = 2e-3  # (unitless)
 # The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
 # scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
-# burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
-# μ × 0.81, sensed after the scoop; the place depends on where it lies then).
+# burger can still shift on the blade in the pickup and carry, and the place depends on
+# where it lies then).
 SENSE_AFTER = {b.name: b.step(b.sensed).name for b in BEHAVIORS.values() if b.sensed}
 # How long before that segment ends the camera sees the burger (s). A serve's re-plan starts
 # where the planned carry ends, so it runs while the carry finishes, as in a cook

@@ -36,8 +36,8 @@ from flipkit.planning.kitchen.cpsat import (BurgerJob, CpSatSchedule, MotionTime
 from flipkit.planning.kitchen.windows import WindowBreak, Windows
 
 # The child's wall-time bound only detects a hung child. Its work is bounded in CP-SAT's
-# deterministic time (about seconds on one idle core), and the same work takes several times
-# longer on a loaded machine: at load 4-5 on two cores a 10 s limit overran 70 s of wall time.
+# deterministic time (close to seconds on one idle core), and the same work takes several
+# times longer in wall time on a loaded machine (docs/history.md).
 CHILD_WALL_FACTOR = 30.0  # wall s allowed per deterministic s of the limit
 CHILD_MARGIN_S = 60.0  # s beyond that (start-up, building the model)
 

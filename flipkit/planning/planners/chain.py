@@ -26,10 +26,10 @@ from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
 
 
-# The IPOPT fallback of ``auto``: the budget is above the slowest fallback that has succeeded
-# on the planner's segments, and bounds a hopeless one. An explicit ``ipopt`` keeps
-# IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
-# (flipkit.model.goal_check), so the fallback no longer spends its budget on them.
+# The IPOPT fallback of ``auto``: the budget is above the slowest fallback that succeeds on
+# the planner's segments (docs/history.md), and bounds a hopeless one. An explicit ``ipopt``
+# keeps IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
+# (flipkit.model.goal_check), so the fallback does not spend its budget on them.
 FALLBACK_IPOPT = {"max_wall_time": 60.0, "max_iter": 1000}
 
 
@@ -52,8 +52,8 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, *, caches: PlannerCaches | 
     Raises:
         InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
     """
-    # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
-    # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
+    # The solvers load cvxpy and CasADi, slow to import: imported on the first solve, so that
+    # input checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
     from flipkit.solvers import compiled, ipopt, sqp
 
     if solver == "sqp":

@@ -1,16 +1,15 @@
 """Contingency flips: the re-plans that sense-plan-act is likely to need, made ahead.
 
 After the scoop the cell measures where the burger lies on the blade and re-plans the flip
-(:func:`~flipkit.planning.planners.planner.replan_flip`). A robust plan lands every place
-within its scenarios' promise, and then the re-plan returns it at once. A place outside
-costs an SQP solve of flip and turn back (about 0.5 s on the 2-core machine) while the arm
-holds. Such places lie beyond the scenario set: in the tails of the placement and sensing
-errors, and where the scoop's unmodelled drift takes the burger, further along the blade or
-to its side (``docs/robust-flips.md`` §4). :class:`Contingencies` solves the flips for four
-such places before they are needed, which a cell can do while the arm goes to the burger
-and scoops (1.1 s). At the measurement it hands out the one that keeps its promise for the
-measured place (its scenarios' hull holds the place, or its own release and flight land it
-within its promise): a check of milliseconds instead of a solve.
+(:func:`~flipkit.planning.planners.planner.replan_flip`). A robust plan lands every place within
+its scenarios' promise, and then the re-plan returns it at once. A place outside costs an SQP
+solve of flip and turn back while the arm holds. Such places lie beyond the scenario set: in the
+tails of the placement and sensing errors, and where the scoop's unmodelled drift takes the
+burger, further along the blade or to its side (``docs/robust-flips.md`` §4).
+:class:`Contingencies` solves the flips for four such places before they are needed, which a
+cell can do while the arm goes to the burger and scoops. At the measurement it hands out the one
+that keeps its promise for the measured place (its scenarios' hull holds the place, or its own
+release and flight land it within its promise): a check of milliseconds instead of a solve.
 
 Every contingency is a re-plan as :func:`replan_flip` makes it (go to burger, scoop and
 pickup kept), solved and verified. Like every re-plan it is robust to the camera's error: it
@@ -18,7 +17,7 @@ lands the places 1 cm around its own, so it covers a patch of the blade, not a p
 that none of them covers is solved as before.
 
 A contingency may not be ready when the camera looks: the preparation starts with the plan,
-and its solves can outlast the 1.1 s of motion before the sense. The object records when
+and its solves can outlast the motion before the sense. The object records when
 each one became ready (``ready_s``, from the start of the preparation). Given ``sense_s``,
 the time of the sense on that clock, handing out a contingency that was not ready by then
 waits the rest of its solve, as a cell would wait for a solve under way. A plan that is

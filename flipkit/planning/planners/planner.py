@@ -97,7 +97,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
                 raise ConfigError(f"start configuration puts the blade {gap * 1e3:.1f} mm from "
                                   "the start position; give one of them")
     o = planner.options
-    try:  # every IK branch against the NLP's joint bounds and the cell, before any NLP (~1 ms)
+    try:  # every IK branch against the NLP's joint bounds and the cell, cheaper than any NLP
         check_goal(robot, planner.models.shapes, cell, p_goal, (0.0, 0.0, yaw), q_start=q0,
                    singularity_margin=o.singularity_margin, clearance=o.arm_clearance)
     except UnreachableError as exc:
@@ -228,8 +228,8 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     ``on_blade`` on the blade after the scoop (sense, plan, act).
 
     The scoop ends at rest with the blade flat on the grill and the burger on it, so the cell
-    can measure where the burger lies on the blade (a scoop drags it forward, by 2–7 cm in
-    simulation) and wait there while this runs. Go to burger, scoop and pickup are kept (the
+    can measure where the burger lies on the blade (a scoop drags it forward by centimetres)
+    and wait there while this runs. Go to burger, scoop and pickup are kept (the
     pickup's constraints do not depend on where the burger lies); the flip is solved again
     with the release state of a burger at ``on_blade``, to the plan's landing target, then the
     turn back from its end, each SQP started from the plan's own solution of that segment (the

@@ -102,10 +102,10 @@ def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
     :func:`~flipkit.planning.planners.planner.replan_flip`): the re-plan starts where the
     planned carry ends, at rest with the blade flat above the table, so it can run while the
     carry finishes (a cook's serves, :mod:`flipkit.simulation.cook_blade`) or while the arm
-    waits there (``flipkit validate``'s serve trials). Go to burger, scoop, pickup and carry are kept; the place is moved so that the
-    burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a
-    burger that shifted on the blade during the pickup and carry was placed 5.5 cm off in
-    MuJoCo.)
+    waits there (``flipkit validate``'s serve trials). Go to burger, scoop, pickup and carry
+    are kept; the place is moved so that the burger where it really lies comes to rest on the
+    spot. The burger is sensed at the carry's end, not after the scoop, because it can still
+    shift on the blade during the pickup and carry.
 
     Args:
         plan: A solved serve plan. on_blade: (x, y) of the burger's centre in the blade frame

@@ -55,7 +55,7 @@ class CellGeometry:
         Args:
             q: Configuration (rad).
             floor: Pairs whose bounding sphere lies at least ``floor`` (m) from the box are
-                not measured: they get that lower bound (≥ ``floor``) instead of their
+                not queried: they get that lower bound (≥ ``floor``) instead of their
                 distance. A check of d ≥ floor reads the same either way; the default
                 measures every pair.
         """
