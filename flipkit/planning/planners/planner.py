@@ -323,7 +323,7 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
     kw = {"cell": cell, "solver": solver, "options": options, "atlas": atlas}
     ahead = None if executor is None else _deal(executor, [
         (pb, q_start if k == 0 else home) for k, pb in enumerate(checked)], kw)
-    kw["caches"] = planner.caches  # the burgers planned here
+    kw = {**kw, "caches": planner.caches}  # the burgers planned here (the workers' kw stays)
     q, qd, plans = q_start, None, []
     bar = tqdm(checked, desc="burgers", unit="burger", disable=not progress)
     for k, pb in enumerate(bar, 1):
