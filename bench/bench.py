@@ -49,9 +49,8 @@ import numpy as np
 
 from bench.bench_replan import bench_replan, load_result, run_validation
 from bench.iteration_notes import iteration_notes
-from flipkit.baseline import EE_METHODS, run_baseline
+from flipkit.baseline import EE_METHODS, CompiledProblems, run_baseline
 from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
-from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.targets import turned_heading
 from flipkit.behaviors.transcribe import transcribe
@@ -66,6 +65,7 @@ from flipkit.planning.kitchen.motions import default_planners
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
 from flipkit.planning.kitchen.schedule import schedule_cook
 from flipkit.planning.planners.atlas import Atlas, default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.chain import solve_segment
 from flipkit.planning.planners.planner import plan_batch, plan_flip
 from flipkit.solvers.exact import ExactOptions, ExactSolver
@@ -146,13 +146,14 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
         jit: Compile FATROP's and exact IPOPT's functions to C (CasADi JIT).
     """
     names = NLP_SOLVERS if full else tuple(TRANSLATE_SOLVERS)
-    nlps = translate_nlps(cell, SegmentOptions(arm_clearance=full))
+    caches = PlannerCaches()  # the SQP's workspace, compiled by the warm-up
+    nlps = translate_nlps(cell, SegmentOptions(arm_clearance=full), caches)
     print(machine())
     print(f"problem: translate NLP {'with' if full else 'without'} the arm's clearance rows"
           f"{'' if full else ' (no symbolic form: left out for every solver)'}; "
           f"{nlps[0].n} variables, {nlps[0].m} rows")
     print(f"warm-up: one SQP iteration on the translate structure (cvxpy compile): "
-          f"{warm_up(nlps[:1]):.1f} s, not counted below")
+          f"{warm_up(nlps[:1], caches):.1f} s, not counted below")
     build = {}
     if not full:
         exact, build, first = _exact_solvers(nlps, jit)
@@ -172,7 +173,7 @@ def bench_translate(cell: CellConfig, full: bool = False, jit: bool = False) -> 
                 solver, graph = exact[(name, k)]
                 res, profile = solver.solve(graph=graph), solver.last_profile
             else:
-                res = solve_segment(nlp, name)
+                res = solve_segment(nlp, name, caches=caches)
             r[name] = {"time_s": res.wall_time_s, "cpu_s": time.process_time() - cpu,
                        "iterations": res.iterations,
                        "objective": res.objective, "status": str(res.status),
@@ -265,21 +266,23 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
     then a batch of the first ``n_batch`` with the SQP, cold and from ``atlas``, the EE + IK
     baseline's times at the same locations (if ``baseline``) and the package's cook order
     scheduled with and without prefetching (if ``cook``); print; return the rows."""
-    models, locs = models_for(cell), TABLE1_LOCATIONS[:n_locations]
+    caches = PlannerCaches()  # every plan of the benchmark, compiled once by the warm-up
+    models, locs = caches.models(cell), TABLE1_LOCATIONS[:n_locations]
     q, qd, structures = models.bare.q_home, None, []
     for name in FLIP_NAMES:  # one NLP per structure, along the initial guesses
-        nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
+        nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1],
+                         patterns=caches.patterns)
         structures.append(nlp)
         x = nlp.layout.nodes(nlp.x0)
         q, qd = x[-1, 0], x[-1, 1]
-    methods = {"sqp": {"solver": "sqp"}} if cold or atlas is None else {}
+    methods = {"sqp": {"solver": "sqp", "caches": caches}} if cold or atlas is None else {}
     if atlas is not None:
-        methods["sqp_atlas"] = {"solver": "sqp", "atlas": atlas}
+        methods["sqp_atlas"] = {"solver": "sqp", "atlas": atlas, "caches": caches}
     if ipopt:
-        methods["ipopt"] = {"solver": "ipopt"}
+        methods["ipopt"] = {"solver": "ipopt", "caches": caches}
     print(machine())
     print(f"warm-up: one SQP iteration on each of the 5 segment structures (cvxpy compile): "
-          f"{warm_up(structures):.1f} s, not counted below")
+          f"{warm_up(structures, caches):.1f} s, not counted below")
     if atlas is not None:
         print(f"atlas: {len(atlas)} entries, a {atlas.meta['grid'][0]} x "
               f"{atlas.meta['grid'][1]} grid at {len(atlas.meta.get('turns', [0.0]))} headings")
@@ -319,13 +322,13 @@ def bench_flip(cell: CellConfig, n_locations: int, n_batch: int, atlas=None,
           "plan (s), dJ = (ΣJ − ΣJ_SQP)/ΣJ_SQP over the five segments")
     out = {"machine": machine(), "turn_rad": turn, "rows": rows, "median": med}
     if n_batch:  # cold, then from the atlas (``flipkit plan batch``'s default)
-        out["batch"] = _bench_batch(cell, n_batch, None)
+        out["batch"] = _bench_batch(cell, n_batch, None, caches)
         if atlas is not None:
-            out["batch_atlas"] = _bench_batch(cell, n_batch, atlas)
+            out["batch_atlas"] = _bench_batch(cell, n_batch, atlas, caches)
     if baseline:
         out["baseline"] = _bench_baseline(cell, locs)
     if cook:
-        out["cook"] = _bench_cook(cell, atlas)
+        out["cook"] = _bench_cook(cell, atlas, caches)
     return out
 
 
@@ -336,7 +339,8 @@ def _bench_baseline(cell: CellConfig, locations) -> dict:
     print(f"{'EE + IK baseline':<29}{'EE s med':>9}{'EE s max':>9}{'IK s med':>9}"
           f"{'IK s max':>9}{'solved':>8} | paper budget", flush=True)
     for ee in EE_METHODS:
-        results = [run_baseline(loc, cell, ee=ee) for loc in locations]
+        problems = CompiledProblems()  # compiled by the first location, reused by the others
+        results = [run_baseline(loc, cell, ee=ee, problems=problems) for loc in locations]
         ee_s = [s.ee_time_s for r in results for s in r.segments]
         ik_s = [s.ik_time_s for r in results for s in r.segments]
         solved = sum(r.status == "solved" for r in results)
@@ -350,13 +354,14 @@ def _bench_baseline(cell: CellConfig, locations) -> dict:
     return out
 
 
-def _bench_cook(cell: CellConfig, atlas) -> dict:
+def _bench_cook(cell: CellConfig, atlas, caches: PlannerCaches) -> dict:
     """The package's cook order (flips and serves, SQP) scheduled with its motions planned one
-    after another and ahead on one worker process per CPU; print; return the record."""
+    after another (with ``caches``) and ahead on one worker process per CPU (each motion's
+    task compiling its own subproblems); print; return the record."""
     burgers, kinds = read_cook_csv(EXAMPLE_ORDER, cell), ("flip", "serve")
     q_home = cell.robot.q_home
-    runs = {"serial": schedule_cook(burgers, default_planners(kinds, cell, "sqp", atlas), q_home,
-                                    kinds=kinds, cell=cell)}
+    runs = {"serial": schedule_cook(burgers, default_planners(kinds, cell, "sqp", atlas, caches),
+                                    q_home, kinds=kinds, cell=cell)}
     workers = os.cpu_count() or 1
     executor = make_executor(workers=workers)
     try:
@@ -378,18 +383,19 @@ def _bench_cook(cell: CellConfig, atlas) -> dict:
     return {"workers": workers, **out}
 
 
-def _bench_batch(cell: CellConfig, n_batch: int, atlas) -> dict:
+def _bench_batch(cell: CellConfig, n_batch: int, atlas, caches: PlannerCaches) -> dict:
     """The first ``n_batch`` Table I burgers with :func:`plan_batch` (SQP, from ``atlas`` or
-    cold), one after the other and on a warm pool of one worker process per CPU; print a
-    line; return its record."""
+    cold), one after the other (with ``caches``, compiled) and on a started pool of one
+    worker process per CPU (each worker's task compiles its own subproblems, counted); print
+    a line; return its record."""
     kw = {"cell": cell, "solver": "sqp", "progress": False, "atlas": atlas}
     t0 = time.perf_counter()
-    plans = plan_batch(TABLE1_LOCATIONS[:n_batch], **kw)
+    plans = plan_batch(TABLE1_LOCATIONS[:n_batch], caches=caches, **kw)
     wall = time.perf_counter() - t0
     batch = [_flip_row(p) for p in plans]
     workers = os.cpu_count() or 1
     executor = make_executor(workers=workers)
-    try:  # a warm pool, as a running cell keeps it: imports and cvxpy compiles done
+    try:  # a started pool, as a running cell keeps it: the workers' imports done
         t_warm = time.perf_counter()
         list(executor.map(_warm_worker, range(workers)))
         t_warm = time.perf_counter() - t_warm
@@ -406,15 +412,15 @@ def _bench_batch(cell: CellConfig, n_batch: int, atlas) -> dict:
           f"{sum(b['solve_s'] for b in batch):.1f} s, wall {wall:.1f} s one after another; "
           f"{workers} worker processes: wall {wall_par:.1f} s "
           f"({sum(p.status == 'solved' for p in par)}/{n_batch} solved, same plans: {same}; "
-          f"pool warm-up {t_warm:.1f} s not counted) "
+          f"pool start-up {t_warm:.1f} s not counted) "
           f"(paper: {PAPER_FIVE_BURGERS_S:.0f} s for 4-5 burgers)", flush=True)
     return {"n": n_batch, "atlas": atlas is not None, "wall_s": wall, "plans": batch,
             "workers": workers, "wall_parallel_s": wall_par, "same_plans": same}
 
 
 def _warm_worker(_) -> None:
-    """Import the planner and compile the five segment structures in a pool worker."""
-    plan_flip(TABLE1_LOCATIONS[1], solver="sqp")
+    """Nothing: running it starts a pool worker and imports this module, and with it the
+    planners (the subproblems a task compiles end with the task)."""
 
 
 def plain_json(obj):

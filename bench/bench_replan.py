@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import time
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 
 import numpy as np
 
@@ -32,6 +33,7 @@ from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, FlipkitError
 from flipkit.experiments.trials import validate_locations
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.contingency import Contingencies
 from flipkit.planning.planners.planner import covers, plan_flip, replan_flip
 
@@ -70,21 +72,22 @@ def bench_replan(result: dict, contingencies: bool = False) -> dict:
     ``contingencies``, the re-plan through each plan's :class:`Contingencies`); print;
     return the rows and the summary."""
     atlas, rows, prepared = default_atlas(), [], []
+    caches = PlannerCaches()  # every plan and re-plan here, one after another, as a cell's
     print(f"{'location (m)':<24}{'sensed (mm)':>16}{'in hull':>9}{'kept':>6}{'replan s':>10}"
           f"{'status':>8}" + (f"{'with contingencies':>20}{'s':>7}" if contingencies else ""))
     for loc, places in sensed_places(result):
-        plan = plan_flip(loc, atlas=atlas)
+        plan = plan_flip(loc, atlas=atlas, caches=caches)
         if plan.status != "solved":
             print(f"{str(loc):<24} plan failed: {plan.failure}")
             continue
         landing = plan.segment("flip").landing
-        extra = Contingencies.prepare(plan) if contingencies else None
+        extra = Contingencies.prepare(plan, caches=caches) if contingencies else None
         if extra is not None:
             prepared.append({"location": loc, "time_s": extra.wall_time_s,
                              "solved": len(extra.flips), "failed": len(extra.failed)})
         for xy in places:
             try:
-                new, dt = _timed(replan_flip, plan, xy)
+                new, dt = _timed(partial(replan_flip, caches=caches), plan, xy)
             except ConfigError as exc:  # the camera saw the burger off the blade: refused
                 rows.append({"location": loc, "sensed": list(xy), "refused": str(exc)})
                 print(f"{str(loc):<24} sensed {xy} refused: {exc}", flush=True)

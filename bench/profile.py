@@ -29,6 +29,7 @@ from flipkit.config import TABLE1_LOCATIONS
 from bench.bench import machine
 from flipkit.planning.planners import planner
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.solvers import sqp
 
 # part -> (file suffix, function name) whose cumulative time it is; the parts do not nest
@@ -60,8 +61,9 @@ def profile_flip(location, segment: str = "flip", atlas=None) -> dict:
         ``{"location", "segment", "atlas", "iterations", "sqp_s", "parts_ms_per_iteration":
         {part: ms}, "solve_s_unprofiled"}``; ``parts`` sum to the SQP's time per iteration.
     """
-    planner.plan_flip(location, atlas=atlas)  # warm-up: compile every subproblem structure
-    plain = planner.plan_flip(location, atlas=atlas)
+    caches = PlannerCaches()  # every plan below, compiled by the warm-up
+    planner.plan_flip(location, atlas=atlas, caches=caches)  # warm-up: compile every structure
+    plain = planner.plan_flip(location, atlas=atlas, caches=caches)
     plain_s = next(s.solver.wall_time_s for s in plain.segments if s.name == segment)
     profiler, calls = cProfile.Profile(), []
     original = sqp.solve_sqp
@@ -79,7 +81,7 @@ def profile_flip(location, segment: str = "flip", atlas=None) -> dict:
 
     sqp.solve_sqp = traced
     try:
-        planner.plan_flip(location, atlas=atlas)
+        planner.plan_flip(location, atlas=atlas, caches=caches)
     finally:
         sqp.solve_sqp = original
     stats = pstats.Stats(profiler)

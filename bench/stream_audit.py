@@ -19,6 +19,7 @@ from flipkit.config import MORE_LOCATIONS, TABLE1_LOCATIONS
 from flipkit.errors import FlipkitError
 from flipkit.experiments.speed import TRANSLATE_KEY_POINTS
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip, plan_translate
 from flipkit.planning.planners.serve import plan_serve
 from flipkit.planning.plans.export import write_csv
@@ -37,16 +38,16 @@ STREAMS = (("urscript", 125.0, "raw"), ("urscript", 500.0, "raw"), ("ros2", 500.
 
 def plans():
     """(name, plan) of every plan of the audit, in order."""
-    atlas = default_atlas()
+    atlas, caches = default_atlas(), PlannerCaches()
     for k, loc in enumerate(TABLE1_LOCATIONS, 1):
-        yield f"table1_{k}", plan_flip(loc, atlas=atlas)
+        yield f"table1_{k}", plan_flip(loc, atlas=atlas, caches=caches)
     for k, loc in enumerate(MORE_LOCATIONS, 1):
-        yield f"more_{k}", plan_flip(loc, atlas=atlas)
+        yield f"more_{k}", plan_flip(loc, atlas=atlas, caches=caches)
     for k, (burger, spot) in enumerate(SERVE_PAIRS, 1):
-        yield f"serve_{k}", plan_serve(burger, spot)
+        yield f"serve_{k}", plan_serve(burger, spot, caches=caches)
     pts = TRANSLATE_KEY_POINTS
     for k, (a, b) in enumerate(zip(pts, pts[1:] + pts[:1]), 1):
-        yield f"translate_{k}", plan_translate(a, b)
+        yield f"translate_{k}", plan_translate(a, b, caches=caches)
 
 
 def audit_plan(name: str, plan, where: Path) -> list[dict]:

@@ -172,9 +172,9 @@ def test_a_serve_is_seeded_for_its_first_three_segments_only(entry, monkeypatch)
 
     seeded, solve = {}, chain.solve_segment
 
-    def spy(nlp, solver, x0=None):
+    def spy(nlp, solver, x0=None, **kw):
         seeded.setdefault(nlp.name, None if x0 is None else np.array(x0))
-        return solve(nlp, solver, x0) if x0 is not None else solve(nlp, solver)
+        return solve(nlp, solver, x0, **kw) if x0 is not None else solve(nlp, solver, **kw)
 
     monkeypatch.setattr(chain, "solve_segment", spy)
     atlas = _atlas(entry)

@@ -14,7 +14,7 @@ import pytest
 
 from flipkit.behaviors import library
 from flipkit.behaviors.guesses import end_pose_guess
-from flipkit.behaviors.models import models_for
+from flipkit.behaviors.models import Models
 from flipkit.behaviors.spec import Behavior, Subbehavior, Task
 from flipkit.behaviors.transcribe import blade_floor, flat_pose, transcribe
 from flipkit.config import CellConfig
@@ -25,7 +25,7 @@ from flipkit.planning.plans.verify import verify_plan
 from flipkit.transcription.constraints import KinematicBlock
 
 CELL = CellConfig()
-CELL_ROBOT = models_for(CELL).loaded
+CELL_ROBOT = Models(CELL).loaded
 
 
 def _spec(**kw):
@@ -81,7 +81,7 @@ def test_the_flip_and_carry_hold_the_burger_and_the_turn_back_ends_at_home():
                                            ("scoop", "scoop needs the burger location"),
                                            ("translate", "translate needs a goal pose")])
 def test_transcribing_without_the_task_it_needs_is_one_line(name, message):
-    models = models_for(CELL)
+    models = Models(CELL)
     with pytest.raises(ConfigError, match=message):
         transcribe(name, models, models.bare.q_home)
 
@@ -100,7 +100,7 @@ def test_floors_follow_the_spec():
 def test_the_scoop_predicts_the_burger_place_for_the_flip_only_when_unknown():
     after = library.SUBBEHAVIORS["scoop"].after_solve
     known = Task(location=(0.7, 0.0, 0.073), on_blade=(0.01, 0.0))
-    assert after(None, known, models_for(CELL), None) is known
+    assert after(None, known, Models(CELL), None) is known
 
 
 # A new subbehaviour, declared as one spec: lift the carried burger, flat, to a goal pose.
@@ -204,30 +204,29 @@ def test_the_plan_format_names_every_registered_subbehaviour():
     assert sorted(names) == sorted(library.SUBBEHAVIORS)
 
 
-def test_a_planner_with_its_own_workspace_plans_the_same():
-    """The SQP's workspace is the planner's when given one: its compiled subproblems are
-    used, with the same plan; without one, planners in a thread share the thread's."""
-    from flipkit.planning.planners.workspaces import thread_workspace
+def test_planners_reuse_the_caches_they_are_given_and_plan_the_same():
+    """A planner solves in its caches' SQP workspace: planners given the same caches share
+    its compiled subproblems and models, a planner given none compiles its own, and the
+    plans are the same either way."""
+    from flipkit.planning.planners.caches import PlannerCaches
     from flipkit.solvers.compiled import SQPWorkspace
 
     goal = Task(goal=flat_pose((0.70, 0.05, 0.30)))
-    shared = Planner(CELL, solver="sqp")
-    robot = shared.models.loaded
+    caches = PlannerCaches()
+    first = Planner(CELL, solver="sqp", caches=caches)
+    robot = first.models.loaded
     q0 = solve_pose(robot, (0.62, -0.10, 0.25), (0.0, 0.0, 0.0), robot.q_home)
     qd0 = np.zeros(robot.nq)
-    a = shared.chain("translate", goal, q0, qd0)
-    own = SQPWorkspace()
-    b = Planner(CELL, solver="sqp", workspace=own).chain("translate", goal, q0, qd0)
-    assert a.status == b.status == "solved"
-    np.testing.assert_allclose(a.segments[0].q, b.segments[0].q, atol=1e-9)
-    mine = thread_workspace(SQPWorkspace)
-    assert own is not mine and own._built  # its own compiled subproblems
-    nlp_key = next(iter(own._built))[0]
-    assert any(key[0] == nlp_key for key in mine._built)  # the shared planner's: the thread's
-    other = []
-    import threading
-
-    t = threading.Thread(target=lambda: other.append(thread_workspace(SQPWorkspace)))
-    t.start()
-    t.join()
-    assert other[0] is not mine and thread_workspace(SQPWorkspace) is mine
+    a = first.chain("translate", goal, q0, qd0)
+    workspace = caches.workspace(SQPWorkspace)
+    compiled = dict(workspace._built)
+    assert compiled  # the first planner compiled into the caches' workspace
+    second = Planner(CELL, solver="sqp", caches=caches)
+    b = second.chain("translate", goal, q0, qd0)
+    assert second.models is first.models and workspace._built == compiled  # nothing new
+    alone = Planner(CELL, solver="sqp")
+    c = alone.chain("translate", goal, q0, qd0)
+    assert alone.caches.workspace(SQPWorkspace) is not workspace
+    assert a.status == b.status == c.status == "solved"
+    for other in (b, c):
+        np.testing.assert_allclose(a.segments[0].q, other.segments[0].q, atol=1e-9)

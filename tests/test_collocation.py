@@ -145,21 +145,24 @@ def test_branch_bounds_keep_the_elbow_and_wrist_on_the_home_side():
         branch_bounds(q_min, q_max, home, home, 2.0)
 
 
-def test_cached_patterns_equal_freshly_filled_ones_and_are_read_only(models):
-    """Block._pattern fills a Jacobian pattern once per key and process: a segment built with
-    the cache emptied and one built from it have the same pattern, and the shared arrays
-    cannot be written through."""
-    from flipkit.transcription.constraints import base
+def test_shared_patterns_equal_freshly_filled_ones_and_are_read_only(models):
+    """Blocks given Patterns fill a Jacobian pattern once per key: a segment built without
+    them, one that fills them and one built from them have the same pattern, and the shared
+    arrays cannot be written through."""
+    from flipkit.transcription.constraints.base import Patterns
     from flipkit.transcription.constraints.kinematic import KinematicBlock
 
-    q0 = models.bare.q_home
-    base._PATTERNS.clear()
+    q0, patterns = models.bare.q_home, Patterns()
     fresh = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[0])
-    cached = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[3])
-    assert len(base._PATTERNS) > 0
-    np.testing.assert_array_equal(fresh.jac_rows, cached.jac_rows)
-    np.testing.assert_array_equal(fresh.jac_cols, cached.jac_cols)
-    rows, _ = next(iter(base._PATTERNS.values()))
+    filling = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[0],
+                         patterns=patterns)
+    assert len(patterns) > 0
+    shared = transcribe("go_to_burger", models, q0, location=TABLE1_LOCATIONS[3],
+                        patterns=patterns)
+    for nlp in (filling, shared):
+        np.testing.assert_array_equal(fresh.jac_rows, nlp.jac_rows)
+        np.testing.assert_array_equal(fresh.jac_cols, nlp.jac_cols)
+    rows, _ = next(iter(patterns._filled.values()))
     with pytest.raises(ValueError):
         rows[0] = 1
     # the key tells blocks apart: other nodes, another pattern

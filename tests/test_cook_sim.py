@@ -146,7 +146,8 @@ def test_a_burger_dropped_later_is_parked_before_its_drop(timeline):
 
 @pytest.mark.slow
 def test_cli_simulates_the_cook_and_films_it(planners, tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None: {
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None,
+                        caches=None: {
         k: v for k, v in planners.items() if k in kinds})  # the fixture's plans, not again
     path, out, film = tmp_path / "order.csv", tmp_path / "t.json", tmp_path / "cook.gif"
     path.write_text(CSV)
@@ -178,7 +179,8 @@ def _stub(monkeypatch, fail=()):
                                  failure=None if ok else "scoop: test failure")
         return plan
     stubs = {"flip": planner("flip", 3.4, 2.2), "serve": planner("serve", 5.0, 1.5)}
-    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None: {
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None,
+                        caches=None: {
         k: stubs[k] for k in kinds})
 
 

@@ -12,8 +12,8 @@ from flipkit.behaviors.options import MU_SAFETY, R_LAND, SCOOP_PRESS, SCOOP_TIP_
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline import run_baseline
 from flipkit.baseline.ee_opt import EEState, orientation_profile
-from flipkit.baseline.ee_scp import (PROBE_FRACTION, SAMPLES, ScpSegment, _problem,
-                                     plan_segment_scp, scp_at_duration, search_duration)
+from flipkit.baseline.ee_scp import (PROBE_FRACTION, SAMPLES, ScpSegment, plan_segment_scp,
+                                     scp_at_duration, scp_subproblem, search_duration)
 from flipkit.behaviors import targets as tg
 from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError, InvalidChoiceError
@@ -177,7 +177,7 @@ def test_linearisation_is_first_order_exact(chain, cell, h):
     """The subproblem's linear models of the edge heights, the cone and the landing at an
     iterate: errors fall ~4x when the step halves (second-order remainder)."""
     task = ScpSegment("flip", cell, np.array(BENIGN), chain["pickup"].end_state(), None)
-    qp = _problem(task, SAMPLES)
+    qp = scp_subproblem(task, SAMPLES)
     flip = chain["flip"]
     C, D, T = flip.coeffs, flip.o_coeffs, flip.T
     qp.set_task(task, T)

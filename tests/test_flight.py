@@ -15,7 +15,7 @@ from flipkit.config import CellConfig
 from flipkit.transcription.constraints.flight import FlightClearance, Landing
 from flipkit.errors import ConfigError, UnreachableError
 from flipkit.model.flight import TILT_MIN_DEG, predict_landing
-from flipkit.behaviors.models import models_for
+from flipkit.behaviors.models import Models
 from flipkit.planning.plans.verify import verify_plan
 from flipkit.planning.plans.verify_flight import recompute_landing
 from scipy.spatial.transform import Rotation
@@ -123,7 +123,7 @@ def test_flight_model_rejects_sideways_gravity():
 def flip_nlp():
     """A flip NLP at a pickup end state, evaluated at a moving point of its initial guess."""
     cell = CellConfig()
-    models = models_for(cell)
+    models = Models(cell)
     from flipkit.model.ik import solve_pose
     from flipkit.behaviors.targets import pickup_end
 
@@ -193,7 +193,7 @@ def test_cone_and_landing_for_a_burger_off_centre(flip_nlp):
     cell = CellConfig()
     nlp0 = flip_nlp
     q0, qd0 = nlp0.x0[nlp0.layout.iq(0)], nlp0.x0[nlp0.layout.iqd(0)]
-    nlp = transcribe("flip", models_for(cell), q0, qd0, location=(0.69, -0.16, 0.072),
+    nlp = transcribe("flip", Models(cell), q0, qd0, location=(0.69, -0.16, 0.072),
                         on_blade=(0.05, 0.01))
     cone = next(b for b in nlp.blocks if b.name == "cone")
     x = nlp.x0.copy()

@@ -24,12 +24,12 @@ CORNER = (0.64, -0.33, 0.072)  # Table I's place nearest the grill's near corner
 @pytest.fixture(scope="module")
 def flip_nlp():
     """A flip along a heading of −0.3 rad, from its pickup's end."""
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
     from flipkit.behaviors.transcribe import transcribe
     from flipkit.model.ik import solve_pose
 
     cell = CellConfig()
-    models, pb = models_for(cell), np.array([0.69, -0.16, 0.072])
+    models, pb = Models(cell), np.array([0.69, -0.16, 0.072])
     pose = tg.pickup_end(cell, pb, -0.3)
     q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
     return transcribe("flip", models, q0, np.zeros(6), location=pb, heading=-0.3)

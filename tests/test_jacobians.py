@@ -124,14 +124,14 @@ def test_states_of_a_batch_are_the_single_node_states(robot):
 
 @pytest.fixture(scope="module")
 def flip_nlp():
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
     from flipkit.behaviors.targets import pickup_end
     from flipkit.behaviors.transcribe import transcribe
     from flipkit.config import CellConfig
     from flipkit.model.ik import solve_pose
 
     cell = CellConfig()
-    models = models_for(cell)
+    models = Models(cell)
     pb = np.array([0.69, -0.16, 0.072])
     pose = pickup_end(cell, pb)
     q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)

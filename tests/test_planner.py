@@ -10,7 +10,7 @@ from flipkit.experiments.speed import TRANSLATE_KEY_POINTS
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, UnreachableError
 from flipkit.planning.plans.plan_file import Plan
-from flipkit.behaviors.models import models_for
+from flipkit.behaviors.models import Models
 from flipkit.planning.planners.chain import solve_segment
 from flipkit.planning.planners.planner import (format_summary, plan_batch, plan_flip, plan_translate,
                                       summary_table)
@@ -33,7 +33,7 @@ def test_ipopt_translate_is_solved_and_verified(ipopt_translate):
     seg = plan.segments[0]
     assert seg.solver.name == "ipopt" and seg.solver.status == "solved"
     assert seg.goal.p == pytest.approx(GRILL_B) and seg.goal.o == pytest.approx((0, 0, 0))
-    robot = models_for(CellConfig()).loaded
+    robot = Models(CellConfig()).loaded
     assert robot.position(seg.q[0]) == pytest.approx(GRILL_A, abs=1e-6)
     assert robot.position(seg.q[-1]) == pytest.approx(GRILL_B, abs=1e-6)
     assert plan.wall_time_s >= seg.solver.wall_time_s > 0
@@ -51,7 +51,7 @@ def test_sqp_translate_status_matches_verification():
 
 def _fake_solver(status):
     """A solve_segment that returns the initial guess with the given status."""
-    def fake(nlp, solver="sqp", x0=None):
+    def fake(nlp, solver="sqp", x0=None, **kw):
         x = np.clip(nlp.x0, nlp.x_lb, nlp.x_ub)
         return SolveResult(x=x, status=status, iterations=3, wall_time_s=0.01,
                            objective=nlp.objective(x), max_violation=1.0, solver=solver)
@@ -108,8 +108,15 @@ def test_solve_segment_rejects_unknown_solver():
         solve_segment(None, "snopt")
 
 
-def test_models_are_cached_per_cell():
-    assert models_for(CellConfig()) is models_for(CellConfig())
+def test_planner_caches_keep_each_cells_models():
+    """A cell's models are built once per PlannerCaches and handed to every planner given it;
+    other caches build their own."""
+    from flipkit.planning.planners.caches import PlannerCaches
+
+    caches = PlannerCaches()
+    assert caches.models(CellConfig()) is caches.models(CellConfig())
+    assert PlannerCaches().models(CellConfig()) is not caches.models(CellConfig())
+    assert chain.Planner(CellConfig(), caches=caches).models is caches.models(CellConfig())
 
 
 def test_summary_table(ipopt_translate):
@@ -144,7 +151,7 @@ def test_auto_falls_back_to_ipopt_when_the_sqp_fails(monkeypatch):
                            objective=nlp.objective(x), max_violation=1.0)
 
     monkeypatch.setattr(sqp_module, "solve_sqp", failing_sqp)
-    models = models_for(CellConfig())
+    models = Models(CellConfig())
     from flipkit.behaviors.transcribe import flat_pose, transcribe
     from flipkit.model.ik import solve_pose
 

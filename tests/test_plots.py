@@ -16,7 +16,7 @@ from flipkit.errors import ConfigError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.segment import Segment
-from flipkit.behaviors.models import models_for
+from flipkit.behaviors.models import Models
 from flipkit.figures import data
 from flipkit.figures import draw
 from flipkit.figures import runs
@@ -37,7 +37,7 @@ def _result(nlp, x=None):
 def guess_plan():
     """A flip plan made of the five initial guesses, chained as bench does (no solve)."""
     cell = CellConfig()
-    models = models_for(cell)
+    models = Models(cell)
     q, qd, segments = models.bare.q_home, None, []
     for name in FLIP_NAMES:
         nlp = transcribe(name, models, q, qd, location=TABLE1_LOCATIONS[1])
@@ -50,7 +50,7 @@ def guess_plan():
 @pytest.fixture(scope="module")
 def translate_nlp():
     cell = CellConfig()
-    models = models_for(cell)
+    models = Models(cell)
     robot = models.for_segment("translate")
     q0 = solve_pose(robot, (0.65, -0.30, 0.15), (0.0, 0.0, 0.0), robot.q_home)
     return transcribe("translate", models, q0, goal=flat_pose((0.80, -0.10, 0.15)))

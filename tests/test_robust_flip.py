@@ -168,10 +168,10 @@ def test_scenario_landing_jacobian_matches_finite_differences(seed):
     from flipkit.behaviors.transcribe import transcribe
     from flipkit.behaviors.targets import pickup_end
     from flipkit.model.ik import solve_pose
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
 
     cell = CellConfig()
-    models = models_for(cell)
+    models = Models(cell)
     pb = np.array([0.69, -0.16, 0.072])
     pose = pickup_end(cell, pb)
     q0 = solve_pose(models.loaded, pose.p, pose.o, models.loaded.q_home)
@@ -321,10 +321,10 @@ def test_validate_command_line_takes_the_command_stream(flip_plan_file, tmp_path
 def test_a_place_the_plan_already_lands_needs_no_replan(flip_plan):
     """Outside the scenarios' hull, the plan's own release and flight decide: a place it
     lands within r_scenario keeps the plan, one it misses by more is solved again."""
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
     from flipkit.planning.planners.planner import covers, landing_miss, replan_flip
 
-    models = models_for(flip_plan.cell())
+    models = Models(flip_plan.cell())
     flip = flip_plan.segment("flip")
     nominal = np.asarray(flip.landing["burger_on_blade"])
     recorded = np.hypot(*(np.asarray(flip.landing["point"][:2]) - flip.landing["target"]))
@@ -403,11 +403,11 @@ def test_the_burger_leaves_the_blade_at_the_release_node(flip_plan):
 def test_flip_nlp_carries_the_release_blocks():
     """The flip NLP has a cone per scenario and the press at r − 1; release_press=0 drops the
     press, and a task without scenarios has neither scenario cone."""
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
     from flipkit.behaviors.options import SegmentOptions
     from flipkit.behaviors.transcribe import transcribe
 
-    models = models_for(CellConfig())
+    models = Models(CellConfig())
     q, qd = models.bare.q_home, np.zeros(6)
     kw = {"location": (0.69, -0.16, 0.072), "on_blade": (0.03, 0.0)}
     scen = ((0.01, 0.0), (0.05, 0.0))

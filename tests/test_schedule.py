@@ -326,7 +326,8 @@ def test_gantt_draws_every_motion_and_burger(tmp_path):
 
 def test_cli_writes_the_timeline_and_exits_1_on_a_failed_plan(tmp_path, capsys, monkeypatch):
     fixed = Fixed(fail=[("flip", "b2")])
-    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None: {
+    monkeypatch.setattr(motions, "default_planners", lambda kinds, cell, solver, atlas=None,
+                        caches=None: {
         k: v for k, v in fixed.planners().items() if k in kinds})
     path = tmp_path / "order.csv"
     path.write_text("burger,t_drop,x,y\nb1,0,0.64,-0.33\nb2,5,0.69,-0.16\nb3,10,0.75,0.0\n")

@@ -227,7 +227,7 @@ def test_flip_only_and_the_timeline_record():
 @pytest.fixture
 def fake_planners(monkeypatch):
     monkeypatch.setattr(motions, "default_planners",
-                        lambda kinds, cell=None, solver="auto", atlas=None:
+                        lambda kinds, cell=None, solver="auto", atlas=None, caches=None:
                         {k: v for k, v in planners().items() if k in kinds})
 
 
@@ -309,14 +309,20 @@ def test_a_hung_child_is_reported_after_the_scaled_wall_bound(monkeypatch):
 
 
 def test_one_child_answers_every_schedule_and_a_dead_one_is_replaced():
-    from flipkit.planning.kitchen import cpsat_process
+    """A Child given to many schedules answers them all from one process, is replaced when it
+    dies, and stops at the end of its with block; a schedule given none stops its own."""
+    from flipkit.planning.kitchen.cpsat_process import Child
 
     job = BurgerJob("b1", 0.0, MotionTimes(3.0, 1.0), MotionTimes(5.0, 2.0))
-    first = solve_schedule([job])
-    pid = cpsat_process.CHILD._proc.pid
-    again = solve_schedule([job])
-    assert cpsat_process.CHILD._proc.pid == pid and again.starts == first.starts
-    cpsat_process.CHILD._proc.kill()
-    cpsat_process.CHILD._proc.wait()
-    assert solve_schedule([job]).starts == first.starts  # a new child, the same answer
-    assert cpsat_process.CHILD._proc.pid != pid
+    with Child() as child:
+        first = solve_schedule([job], child=child)
+        proc = child._proc
+        again = solve_schedule([job], child=child)
+        assert child._proc is proc and again.starts == first.starts
+        proc.kill()
+        proc.wait()
+        assert solve_schedule([job], child=child).starts == first.starts  # a new child
+        assert child._proc is not proc
+        last = child._proc
+    assert child._proc is None and last.poll() is not None
+    assert solve_schedule([job]).starts == first.starts  # a child of its own, stopped

@@ -144,7 +144,7 @@ def test_stream_report_below_and_at_a_resonant_rate():
 @pytest.fixture
 def fake_planners(monkeypatch):
     monkeypatch.setattr(motions, "default_planners",
-                        lambda kinds, cell=None, solver="auto", atlas=None:
+                        lambda kinds, cell=None, solver="auto", atlas=None, caches=None:
                         {k: v for k, v in MODEL.planners().items() if k in kinds})
 
 

@@ -79,7 +79,7 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     """The whole chain at a far-grill location with the SQP alone: every segment solved by
     the SQP, the turn back within 40 iterations and within its (possibly stretched) bound,
     and the plan verified; the flip ends where coasting keeps the margin."""
-    from flipkit.behaviors.models import models_for
+    from flipkit.behaviors.models import Models
     from flipkit.planning.planners.planner import plan_flip
     from flipkit.config import CellConfig
 
@@ -92,7 +92,7 @@ def test_sqp_turns_back_from_a_far_grill_flip():
     assert tb.solver.name == "sqp" and tb.solver.iterations <= 40
     assert tb.T <= T_STRETCH * SUBBEHAVIORS["turn_back"].duration[1] + 1e-9
     flip = plan.segments[names.index("flip")]
-    shapes = models_for(CellConfig()).shapes
+    shapes = Models(CellConfig()).shapes
     pairs = np.array([(k, b) for k in range(len(shapes.names))
                       for b in range(len(shapes.box_names))])
     tau = SUBBEHAVIORS["turn_back"].duration[1] / (len(flip.t) - 1)

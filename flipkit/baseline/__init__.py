@@ -9,9 +9,9 @@ Two end-effector optimisations (``ee``):
   (:mod:`.ee_scp`, sequential convex programming over the rpy Bezier; the duration by a
   golden-section search within collocation's bounds the specs' ``duration``),
   with collocation's task-space endpoint constraints, friction cone and flip landing.
-* ``fixed``: the earlier single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep
-  profile to a fixed flip end orientation, the durations :data:`BASELINE_T` (s) — the upper
-  bounds collocation had before its chain was shortened from 4.0 s to 3.4 s.
+* ``fixed``: a single QP (:mod:`.ee_opt`): the orientation a fixed smoothstep profile to a
+  fixed flip end orientation, the durations fixed at :data:`BASELINE_T` (s), longer than
+  collocation's upper bounds.
 
 Each subbehaviour's end-effector problem starts at the previous one's end state (position,
 velocity, orientation, orientation rate); the IK continues from the previous IK
@@ -38,6 +38,7 @@ from flipkit.baseline.classify import (CLASSES, REASONS, BaselineResult, Segment
                                       Thresholds, classify_plan, classify_segment)
 from flipkit.baseline.ee_opt import EEState, EETrajectory, plan_segment
 from flipkit.baseline.ee_scp import plan_segment_scp
+from flipkit.baseline.problems import CompiledProblems
 
 BASELINE_T = {"go_to_burger": 0.8, "scoop": 0.6, "pickup": 0.4, "flip": 0.6, "turn_back": 1.6}
 from flipkit.baseline.ik_track import IKTrack, PlacoTracker  # noqa: E402
@@ -51,7 +52,7 @@ EE_METHODS = ("scp", "fixed")
 def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: float = 200.0,
                  *, iterations: int = 3, velocity_limits: bool = True,
                  thresholds: Thresholds = Thresholds(), ik: str = "placo",
-                 ee: str = "scp") -> BaselineResult:
+                 ee: str = "scp", problems: CompiledProblems | None = None) -> BaselineResult:
     """Plan pickup-and-flip at ``location`` with the end-effector-space + IK baseline.
 
     Args:
@@ -66,6 +67,9 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
             ``analytic`` (the UR10's closed form, the branch continuous with the start;
             :mod:`.analytic_track`).
         ee: End-effector optimisation, one of :data:`EE_METHODS` (see the module docstring).
+        problems: The end-effector problems compiled so far, solved in and added to (default:
+            new ones, for this call alone); a sweep over locations passes one to compile
+            each problem once.
 
     Returns:
         The per-subbehaviour verdicts (with EE and IK wall times), trajectories and tracks.
@@ -95,13 +99,16 @@ def run_baseline(location, cell: CellConfig | None = None, q_start=None, rate: f
     tracker = (AnalyticTracker(robot) if ik == "analytic" else
                PlacoTracker(robot, iterations=iterations, velocity_limits=velocity_limits))
     result = BaselineResult(tuple(float(x) for x in pb), [])
+    problems = CompiledProblems() if problems is None else problems
     for name in FLIP_NAMES:
         tic = time.perf_counter()
         try:
             if ee == "scp":
-                traj = plan_segment_scp(name, cell, pb, start, home=home, rate=rate)
+                traj = plan_segment_scp(name, cell, pb, start, home=home, rate=rate,
+                                        problems=problems)
             else:
-                traj = plan_segment(name, cell, pb, start, BASELINE_T[name], home=home, rate=rate)
+                traj = plan_segment(name, cell, pb, start, BASELINE_T[name], home=home, rate=rate,
+                                    problems=problems)
         except NoSolutionFound as exc:
             result.segments.append(SegmentVerdict(
                 name, "failed", "ee_infeasible", detail=f"end-effector QP: {exc.status}",
@@ -138,4 +145,5 @@ def _restart(robot, traj: EETrajectory, q_track: np.ndarray) -> np.ndarray:
 
 __all__ = ["run_baseline", "BaselineResult", "SegmentVerdict", "Thresholds", "REASONS",
            "classify_segment", "EEState", "EETrajectory", "plan_segment", "IKTrack",
-           "PlacoTracker", "AnalyticTracker", "IK_METHODS", "EE_METHODS", "plan_segment_scp", "CLASSES", "classify_plan"]
+           "PlacoTracker", "AnalyticTracker", "IK_METHODS", "EE_METHODS", "plan_segment_scp",
+           "CLASSES", "classify_plan", "CompiledProblems"]

@@ -79,7 +79,7 @@ class Thresholds:
         sigma_min: Smallest singular value of the 6×6 spatula Jacobian (linear part in m/rad,
             angular in rad/rad) below which a sample counts as singular. Our choice: 0.01, a
             hundredth of the arm's typical values (0.1–1), where the IK's joint rates are
-            ~100× the spatula's.
+            about a hundred times the spatula's.
     """
 
     position: float = 1e-3

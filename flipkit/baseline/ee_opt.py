@@ -10,8 +10,9 @@ cone (eq. 5), the blade-edge heights p_z + (R r)_z, the scoop tip height (eq. 24
 ∫ |jerk|² + λ |a|² dt. On the scoop the pitch follows o_y = asin σ(s) with σ a quintic, so the
 tip equality p_z = h + (l/2) σ(s) has a polynomial solution and holds exactly.
 
-Problems are cached per (subbehaviour, samples, duration, degree) with the location-dependent
-data as cvxpy Parameters, so a sweep over burger locations compiles each QP once.
+A QP is stated once per (subbehaviour, samples, duration, degree) with the location-dependent
+data as cvxpy Parameters; given a :class:`~flipkit.baseline.problems.CompiledProblems`, a sweep
+over burger locations compiles each QP once.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
+from flipkit.baseline.problems import CompiledProblems
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
 from flipkit.model.bezier import Bezier
@@ -154,9 +156,6 @@ class _SegmentQP:
         return self.problem.status, self.C.value, self.problem.value
 
 
-_CACHE: dict = {}  # (name, samples, T, degree, cone samples) -> _SegmentQP; a few per rate
-
-
 def sample_times(T: float, rate: float) -> np.ndarray:
     """Evenly spaced times on [0, T] (s), spacing ≤ 1/rate, both ends included."""
     n = max(int(np.ceil(T * rate - 1e-9)), 1)
@@ -165,7 +164,8 @@ def sample_times(T: float, rate: float) -> np.ndarray:
 
 def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float,
                  home: tg.Pose | None = None, rate: float = 200.0,
-                 degree: int = DEGREE) -> EETrajectory:
+                 degree: int = DEGREE, problems: CompiledProblems | None = None
+                 ) -> EETrajectory:
     """Optimise the spatula trajectory of subbehaviour ``name``.
 
     Args:
@@ -177,6 +177,8 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
         home: Home spatula pose (``turn_back`` only).
         rate: Sample rate of the output and of the constraints (Hz).
         degree: Bezier degree of p(t) (≥ 5).
+        problems: The compiled QPs to solve in and add to (default: new ones, for this
+            call alone).
 
     Raises:
         NoSolutionFound: The QP is infeasible.
@@ -206,10 +208,9 @@ def plan_segment(name: str, cell: CellConfig, location, start: EEState, T: float
     frac = {"pickup": 1.0, "flip": tg.FLIP_CONE_FRACTION}.get(name, 0.0)
     cone = t <= frac * T + 1e-12 if frac else np.zeros(len(t), bool)
     tic = time.perf_counter()
-    key = (name, len(t), round(float(T), 12), int(degree), int(cone.sum()))
-    if key not in _CACHE:
-        _CACHE[key] = _SegmentQP(name, t, T, int(degree), np.flatnonzero(cone))
-    qp = _CACHE[key]
+    key = ("fixed", name, len(t), round(float(T), 12), int(degree), int(cone.sum()))
+    problems = CompiledProblems() if problems is None else problems
+    qp = problems.get(key, lambda: _SegmentQP(name, t, T, int(degree), np.flatnonzero(cone)))
 
     sp, lim, hg = cell.spatula, cell.limits, cell.grill.height
     edges = np.array([[sp.length / 2, 0, 0], [-sp.length / 2, 0, 0],

@@ -20,31 +20,32 @@ arm's space limits (joint-space quantities the task-space method cannot see).
 Method. p(s) and the rpy angles o(s) are Bezier polynomials of degree 7 in s = t/T; their
 control points C, D (m, rad) are the decision variables. The constraints are imposed at
 :data:`SAMPLES` evenly spaced s (the velocity, acceleration and pitch bounds on the control
-points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints,
-boxes, pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised about the
-previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
-differences of :func:`flipkit.model.flight.landing_function`, 25 points in one call) and relaxed by one elastic slack
-σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
-(subbehaviour, samples), written once with Parameters (DPP) and cached; the duration enters
-only through Parameters (bounds scaled by T, T²; cost weights), so a duration search and a
-sweep over burger locations recompile nothing. A step is taken when the merit — cost plus
-penalty × the exact violation — falls by at least a tenth of what the subproblem predicts;
-the box trust region (Δ rad on D, 0.3 Δ m on C) halves when it falls by less than a quarter
-and doubles when by more than three quarters at its edge. The cost
-is ∫ |p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT`
-(m²/rad²): a radian of blade rotation weighs as much as a translation by the arm's reach,
-≈ 1 m, both being about a radian of joint motion. (With w_o = (l/2)², a blade-tip
-displacement, rotations were so cheap that the go-to-burger pitched back and forward again
-to keep the tip off the grill, driving wrist 1 far past its speed limit.) The duration is chosen by a search of the converged cost over the bounds
-(infeasible durations cost +∞), each solve warm-started from the best so far: the upper bound
-and a probe just below it, and a golden-section search only when the probe costs less
-(:data:`PROBE_FRACTION`). At each duration the SCP returns the best feasible point it met, and stops
-once that has not improved by OBJ_TOL for :data:`STALE_ITERATIONS` iterations.
+points instead, so they hold along the whole curve). Those linear in (C, D) — endpoints, boxes,
+pitch, bands — are exact; the others (cone, edge heights, tip, axes, landing) are linearised
+about the previous iterate (R(o) ≈ R(oᵏ) + Σ_j ∂R/∂o_j (o_j − o_jᵏ); the landing by central
+differences of :data:`flipkit.model.flight.LANDING`, 25 points in one call) and relaxed by one
+elastic slack σ ≥ 0 with an exact ℓ∞ penalty. Each convex subproblem is one cvxpy problem per
+(subbehaviour, samples), written once with Parameters (DPP) and kept in a
+:class:`~flipkit.baseline.problems.CompiledProblems`; the duration enters only through
+Parameters (bounds scaled by T, T²; cost weights), so a duration search recompiles nothing, and
+nor does a sweep over burger locations that passes the same ``problems``. A step is taken when
+the merit — cost plus penalty × the exact violation — falls by at least a tenth of what the
+subproblem predicts; the box trust region (Δ rad on D, 0.3 Δ m on C) halves when it falls by
+less than a quarter and doubles when by more than three quarters at its edge. The cost is ∫
+|p⃛|² + λ|p̈|² + w_o (|o⃛|² + λ|ö|²) dt with w_o = :data:`ORIENTATION_WEIGHT` (m²/rad²): a
+radian of blade rotation weighs as much as a translation by the arm's reach, ≈ 1 m, both being
+about a radian of joint motion. (A weight as small as (l/2)², a blade-tip displacement, makes
+rotations so cheap that the go to burger pitches back and forward again to keep the tip off the
+grill, driving wrist 1 past its speed limit; docs/history.md.) The duration is chosen by a
+search of the converged cost over the bounds (infeasible durations cost +∞), each solve
+warm-started from the best so far: the upper bound and a probe just below it, and a
+golden-section search only when the probe costs less (:data:`PROBE_FRACTION`). At each duration
+the SCP returns the best feasible point it met, and stops once that has not improved by OBJ_TOL
+for :data:`STALE_ITERATIONS` iterations.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 
@@ -55,6 +56,7 @@ from flipkit.behaviors.library import FLIP_NAMES, SUBBEHAVIORS
 from flipkit.behaviors.options import MU_SAFETY, RELEASE_FRACTION, R_LAND, SCOOP_PRESS, SCOOP_TIP_BAND
 from flipkit.behaviors.transcribe import blade_floor
 from flipkit.baseline.ee_opt import EEState, EETrajectory, sample_times
+from flipkit.baseline.problems import CompiledProblems
 from flipkit.baseline.scp_problem import (ACC_WEIGHT, COST_SCALE, ORIENTATION_WEIGHT, REST,
                                           SCPProblem)
 from flipkit.behaviors import targets as tg
@@ -62,7 +64,7 @@ from flipkit.behaviors.guesses import flip_guess_pose
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError, NoSolutionFound
 from flipkit.model.bezier import Bezier
-from flipkit.model.flight import TILT_MIN_DEG, landing_function, landing_parameters
+from flipkit.model.flight import LANDING, TILT_MIN_DEG, landing_parameters
 from flipkit.model.orientation import rpy_matrix, rpy_rate_matrix
 
 DEGREE = 7
@@ -119,11 +121,18 @@ class ScpSegment:
         self.tip = hg - SCOOP_PRESS
         self.cone_frac = {"pickup": 1.0, "flip": max(RELEASE_FRACTION, tg.FLIP_CONE_FRACTION)}
         self.release = int(np.ceil(RELEASE_FRACTION * (n - 1) - 1e-9))
-        # The nominal μ × MU_SAFETY, not collocation's MU_PLAN: with the 0.16 cone the SCP
-        # finds no feasible chain at the tests' location (scp_violation 0.6), so the baseline
-        # keeps the cone it was compared with.
+        # The nominal μ × MU_SAFETY, not collocation's narrower MU_PLAN: the baseline keeps
+        # the cone it was compared with, within which the SCP finds feasible chains.
         self.mu = cell.burger.mu * MU_SAFETY
         self.g = np.asarray(cell.gravity, float)
+        self._mapped: dict = {}  # k -> LANDING mapped over k release states
+
+    def _landing_map(self, k: int):
+        """:data:`~flipkit.model.flight.LANDING` mapped over ``k`` release states, built on
+        first use by this segment (its solves ask for a few sizes, many times each)."""
+        if k not in self._mapped:
+            self._mapped[k] = LANDING.map(k)
+        return self._mapped[k]
 
     def cone_idx(self, n: int) -> np.ndarray:
         frac = self.cone_frac.get(self.name, 0.0)
@@ -135,7 +144,7 @@ class ScpSegment:
 
     def _landings(self, Z: np.ndarray) -> np.ndarray:
         """:meth:`landing` of each row of Z (k, 12), in one call of the mapped CasADi
-        function (:func:`flipkit.model.flight.landing_function`); (3, k)."""
+        function (:meth:`_landing_map`); (3, k)."""
         x = np.zeros((12, len(Z)))
         Rs = np.empty((3, 3 * len(Z)))
         for k, z in enumerate(Z):
@@ -145,7 +154,7 @@ class ScpSegment:
         bg = self.cell.burger
         par = landing_parameters(bg.thickness, self.cell.grill.height, self.g,
                                  diameter=bg.diameter)
-        y = np.asarray(_mapped_landing(len(Z))(x, Rs, par)[0])  # (5, k)
+        y = np.asarray(self._landing_map(len(Z))(x, Rs, par)[0])  # (5, k)
         return np.vstack([y[3], y[4], np.clip(y[1], -1.0, 1.0)])
 
     def landing_jacobian(self, z: np.ndarray, h: float = 1e-6) -> tuple:
@@ -153,11 +162,6 @@ class ScpSegment:
         E = h * np.eye(12)
         Y = self._landings(np.vstack([z, z + E, z - E]))
         return Y[:, 0], (Y[:, 1:13] - Y[:, 13:]) / (2 * h)
-
-
-@functools.lru_cache(maxsize=None)
-def _mapped_landing(k: int):
-    return landing_function().map(k)
 
 
 def violations(task: ScpSegment, B: list, C: np.ndarray, D: np.ndarray, T: float) -> dict:
@@ -202,14 +206,30 @@ def _objective(B, C, D, T, w_o) -> float:
     return COST_SCALE * (jerk(C) + ACC_WEIGHT * acc(C) + w_o * (jerk(D) + ACC_WEIGHT * acc(D)))
 
 
-_CACHE: dict = {}  # (name, samples, cone samples) -> SCPProblem
+def scp_subproblem(task: ScpSegment, n: int = SAMPLES,
+                problems: CompiledProblems | None = None) -> SCPProblem:
+    """The SCP subproblem of ``task`` on ``n`` samples, from ``problems`` (built there on
+    first use; default: a new one)."""
+    key = ("scp", task.name, n, len(task.cone_idx(n)))
+    problems = CompiledProblems() if problems is None else problems
+    return problems.get(key, lambda: SCPProblem(task.name, n, DEGREE, task.cone_idx(n),
+                                                task.release))
 
 
-def _problem(task: ScpSegment, n: int) -> SCPProblem:
-    key = (task.name, n, len(task.cone_idx(n)))
-    if key not in _CACHE:
-        _CACHE[key] = SCPProblem(task.name, n, DEGREE, task.cone_idx(n), task.release)
-    return _CACHE[key]
+def compile_subproblems(cell: CellConfig, location, problems: CompiledProblems) -> float:
+    """Compile every subbehaviour's SCP subproblem at ``location`` into ``problems`` (cvxpy's
+    one-off canonicalisation, on placeholder Parameter values that every solve sets anew),
+    so that what a run with ``problems`` then times is the SCP, not the compile. Returns the
+    time spent (s)."""
+    t0, pb = time.perf_counter(), tg.check_location(cell, location)
+    rest = EEState((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    for name in FLIP_NAMES:
+        task = ScpSegment(name, cell, pb, rest, tg.Pose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+        problem = scp_subproblem(task, SAMPLES, problems).problem
+        for par in problem.parameters():
+            par.value = np.zeros(par.shape)
+        problem.get_problem_data(cp.CLARABEL)
+    return time.perf_counter() - t0
 
 
 def _meet_ends(task: ScpSegment, C0: np.ndarray, D0: np.ndarray, T: float) -> tuple:
@@ -226,14 +246,15 @@ def _meet_ends(task: ScpSegment, C0: np.ndarray, D0: np.ndarray, T: float) -> tu
 
 
 def scp_at_duration(task: ScpSegment, T: float, C0: np.ndarray, D0: np.ndarray,
-                    trust: float = TRUST0) -> dict:
-    """The SCP at a fixed duration T (s) from the iterate (C0, D0), trust region ``trust`` (rad).
+                    trust: float = TRUST0, *, problem: SCPProblem | None = None) -> dict:
+    """The SCP at a fixed duration T (s) from the iterate (C0, D0), trust region ``trust`` (rad),
+    its subproblems solved in ``problem`` (default :func:`scp_subproblem` of ``task``).
 
     Returns:
         ``{"C", "D", "objective", "violation", "iterations", "qp_solves"}``; ``objective`` is
         +∞ when the final violation exceeds :data:`FEAS_TOL`.
     """
-    qp = _problem(task, SAMPLES)
+    qp = scp_subproblem(task) if problem is None else problem
     B, w_o, W = qp.B, ORIENTATION_WEIGHT, qp.PENALTY
     C, D = _meet_ends(task, C0, D0, T)
     viol = violation(task, B, C, D, T)
@@ -319,7 +340,8 @@ def search_duration(f, lo: float, hi: float) -> None:
 
 def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
                      home: tg.Pose | None = None, rate: float = 500.0,
-                     T_bounds: tuple | None = None) -> EETrajectory:
+                     T_bounds: tuple | None = None,
+                     problems: CompiledProblems | None = None) -> EETrajectory:
     """Optimise position, orientation and duration of subbehaviour ``name`` in task space.
 
     Args:
@@ -331,10 +353,12 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
         home: Home spatula pose (``turn_back`` only).
         rate: Sample rate of the output (Hz).
         T_bounds: Duration bounds (s); default collocation's (the specs' ``duration``).
+        problems: The compiled subproblems to solve in and add to (default: new ones, for
+            this call alone).
 
     Returns:
-        The trajectory; ``solve_time_s`` is the whole duration search (all QP solves, their
-        first compilation included).
+        The trajectory; ``solve_time_s`` is the whole duration search (all QP solves, and
+        the subproblem's compilation when ``problems`` did not hold it yet).
 
     Raises:
         NoSolutionFound: No duration within the bounds gives a feasible SCP solution.
@@ -355,16 +379,16 @@ def plan_segment_scp(name: str, cell: CellConfig, location, start: EEState,
             raise ConfigError(f"start.{field_name} must be 3 finite numbers, got {value.tolist()}")
     tic = time.perf_counter()
     task = ScpSegment(name, cell, tg.check_location(cell, location), start, home)
-    qp = _problem(task, SAMPLES)
+    qp = scp_subproblem(task, SAMPLES, problems)
     C, D = _guess_coeffs(qp.bez, np.linspace(0, 1, SAMPLES), start, task.guess_goal)
     evals: dict = {}
 
     def f(T: float) -> float:  # warm start: the best solution so far, a smaller region
         best = min(evals.values(), key=lambda r: (r["objective"], r["merit"]), default=None)
         if best is None:
-            evals[T] = scp_at_duration(task, T, C, D)
+            evals[T] = scp_at_duration(task, T, C, D, problem=qp)
         else:
-            evals[T] = scp_at_duration(task, T, best["C"], best["D"], TRUST_WARM)
+            evals[T] = scp_at_duration(task, T, best["C"], best["D"], TRUST_WARM, problem=qp)
         return evals[T]["objective"]
 
     search_duration(f, lo, hi)
@@ -393,4 +417,5 @@ def _sampled(task: ScpSegment, bez: Bezier, sol: dict, T: float, rate: float, el
                         durations_tried=n_durations)
 
 
-__all__ = ["plan_segment_scp", "scp_at_duration", "search_duration", "violation", "ScpSegment", "DEGREE", "SAMPLES"]
+__all__ = ["DEGREE", "SAMPLES", "ScpSegment", "compile_subproblems", "plan_segment_scp",
+           "scp_at_duration", "scp_subproblem", "search_duration", "violation"]

@@ -1,9 +1,9 @@
 """The go to burger's approach: how the blade comes down to where the scoop starts.
 
-A fast go to burger (0.5 s) that came straight down to the scoop's start met the largest
-burger of the sourced range (12.7 cm) on its rim, 1.5 mm behind the scoop's start, whenever
-it lay a few millimetres toward the arm, and such a scoop failed. The approach therefore has
-three phases over the segment's nodes (constants in :mod:`flipkit.config.task`):
+A fast go to burger that comes straight down to the scoop's start can meet the largest
+burger of the sourced range on its rim, just behind the scoop's start, when it lies a few
+millimetres toward the arm, and such a scoop fails. The approach therefore has three phases
+over the segment's nodes (constants in :mod:`flipkit.config.task`):
 
 1. until the descent (the last ``APPROACH_FRACTION`` of the intervals): the blade's corners
    ``APPROACH_CLEARANCE`` above the tallest burger of the range, whatever burger lies below;

@@ -13,9 +13,9 @@ are) and three subbehaviours of its own, each a collocation segment:
   node ⌈0.7 N⌉ on the tip holds its final point (±:data:`PIVOT_BAND`) and the blade tilts
   about it, so the pitch passes the friction angle with the tip in place: the burger slides
   down the blade until its front edge meets the table, and rests there, front edge on the
-  table, back on the blade. (Without the pivot the solver's place swung the blade low and
-  back, tilted it early and came forward again: a burger that slid off early was pushed
-  7 cm past its spot in MuJoCo.)
+  table, back on the blade. (Without the pivot the solver's place may swing the blade low
+  and back, tilt it early and come forward again, pushing a burger that slid off early past
+  its spot.)
 * ``return_home``: first the withdrawal — for nodes 1..:data:`WITHDRAW_NODES` the blade keeps
   its attitude (±:data:`WITHDRAW_ANGLE_BAND`) and slides back in its own plane
   (±:data:`WITHDRAW_BAND` off it) by at least :data:`WITHDRAW_DISTANCE` (a blade length less
@@ -41,9 +41,8 @@ it, x_eff − (l/2)(1 − cos θ) ahead of the blade centre along the heading an
 A burger that slid s = x_eff − x_b down the blade arrives moving: with the energy
 m g (sin θ − μ cos θ) s it gained spent against the table's friction μ_t m g, it runs out
 s (sin θ − μ cos θ)/μ_t further (μ the burger's nominal friction on the blade, μ_t the
-table's: a steel tray like the grill, ``physics.mu_grill``). (Without this term a burger the
-scoop had left at the blade centre came to rest 3.8 cm beyond its spot in MuJoCo; with
-it, 1.4 cm of that is predicted.)
+table's: a steel tray like the grill, ``physics.mu_grill``). Without this term the rest point
+would lie short of where a sliding burger comes to rest in the simulated cell.
 The planner puts the blade so that this point is the spot; ``on_blade`` is where the burger
 sits on the blade (default the centre; sensed during the carry, :func:`flipkit.planning.planners.serve.replan_serve`).
 """

@@ -25,6 +25,7 @@ from flipkit.model.contact import make_cone
 from flipkit.model.singular import branch_bounds
 from flipkit.transcription.constraints import (BezierOutput, Dynamics, FixedValues,
                                                HermiteSimpson, KinematicBlock)
+from flipkit.transcription.constraints.base import Patterns
 from flipkit.transcription.constraints.braking import BrakingMargin
 from flipkit.transcription.constraints.clearance import ArmClearance, CoastingClearance
 from flipkit.transcription.constraints.coasting_floor import CoastingFloor
@@ -36,7 +37,7 @@ from flipkit.transcription.nlp import NLP
 
 def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, *,
                options: SegmentOptions = SegmentOptions(), task: Task | None = None,
-               **fields) -> NLP:
+               patterns: Patterns | None = None, **fields) -> NLP:
     """The NLP of one segment.
 
     Args:
@@ -46,6 +47,9 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
         options: Transcription options.
         task: What the segment is for; or its fields as keywords (``location``, ``goal``,
             ``land``, ``on_blade``, ``spot``, ``scenarios``).
+        patterns: The blocks' sparsity patterns filled so far, taken from and added to
+            (:class:`~flipkit.transcription.constraints.base.Patterns`); default: the
+            blocks fill their own.
 
     Raises:
         InvalidChoiceError: Unknown name. ConfigError: A task field the spec needs is
@@ -55,7 +59,7 @@ def transcribe(spec: Subbehavior | str, models: Models, q_start, qd_start=None, 
     task = Task(**fields) if task is None else task.with_(**fields)
     spec.check(task)
     cell, robot = models.cell, models.for_spec(spec)
-    L = Layout(robot.nq, options.N)
+    L = Layout(robot.nq, options.N, patterns=patterns)
     q_start = np.asarray(q_start, float)
     qd_start = np.zeros(robot.nq) if qd_start is None else np.asarray(qd_start, float)
     location = tg.check_location(cell, task.location) if "location" in spec.needs else None

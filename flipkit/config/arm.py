@@ -151,8 +151,8 @@ DEFAULT_PRESET = "least_restricted"
 SPEED_MARGIN = 0.90
 """Plans keep every joint within this fraction of its published speed: room for a stream
 resampled from the plan (a controller's own spline) and for the servo's corrections of what
-the arm meets (the blade's contact with the grill pushed a wrist 7.8 % past its command in
-simulation, docs/arm-profile.md), so that the arm stays under the published speed."""
+the arm meets (the blade's contact with the grill can push a wrist past its command,
+docs/arm-profile.md), so that the arm stays under the published speed."""
 
 
 def arm_profile(name: str) -> ArmProfile:

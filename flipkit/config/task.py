@@ -59,8 +59,8 @@ R_LAND = 0.005  # m
 # The landing radii accepted (plan flip --r-land, SegmentOptions, verify). The landing point
 # is predicted by the NLP's flight rows and recomputed by verify's ODE to within 0.1 mm of it
 # (verify_flight.LANDING_TOL): a disc smaller than that spread can be neither planned to nor
-# checked (at 1e-9 m IPOPT ran 93.6 s and failed; at 0.1 mm the SQP solves in 3.7 s). Above
-# 0.1 m the disc is wider than the burger's own diameter and the paper's success square.
+# checked (the solvers then fail after long solves; docs/history.md). Above 0.1 m the disc is
+# wider than the burger's own diameter and the paper's success square.
 R_LAND_RANGE = (1e-4, 0.1)  # m
 # Every scenario of the burger's place on the blade lands within R_SCENARIO: 1 cm inside the
 # paper's success square (5 cm in x and y), which holds the disc.
@@ -78,8 +78,8 @@ TILT_MIN_DEG = 175.0
 # planned for the least sticky burger the cell may meet, since it cannot measure μ: the low
 # end of the sourced burger–blade range (PHYSICAL_RANGES["burger.mu"], 0.2) times the low end
 # of the per-burger spread (ScoopUncertainty.mu_scale, × 0.8): 0.16. A cone planned at the
-# nominal μ is active, and a less sticky burger then slides off (in the sensitivity study, a
-# flip planned with μ 0.4 succeeded 0/100 with the burger's μ at 0.2).
+# nominal μ is active, and a less sticky burger then slides off (the sensitivity study's
+# flips planned at the nominal μ fail with the least sticky burger; docs/history.md).
 MU_PLAN = PHYSICAL_RANGES["burger.mu"][0] * ScoopUncertainty().mu_scale[0]
 # The scoop's cone only limits how hard the blade brakes under the burger (what any burger
 # does on the blade is the scoop model's, with its scenarios): nominal μ × MU_SAFETY.

@@ -23,7 +23,6 @@ import time
 import numpy as np
 
 from flipkit.behaviors.library import FLIP_NAMES
-from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.targets import default_heading
 from flipkit.behaviors.transcribe import transcribe
@@ -32,6 +31,7 @@ from flipkit.config.task import HEADING_LIMIT, HEADING_STEPS
 from flipkit.errors import AtlasError
 from flipkit.experiments.sweep import grill_grid, make_executor, run_sweep
 from flipkit.planning.planners.atlas import FORMAT, Atlas, options_hash
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.provenance import git_commit
 
@@ -46,22 +46,24 @@ def solve_entry(item) -> dict:
     "iterations"}``. ``item``: (location, heading (rad), cell, options, seed atlas or
     ``None``)."""
     location, heading, cell, options, seed = item
+    caches = PlannerCaches()  # the plan's and the rebuilt segments'
     plan = plan_flip(location, cell=cell, options=options, solver="sqp", heading=heading,
-                     atlas=seed)
+                     atlas=seed, caches=caches)
     out = {"location": list(location), "heading": float(heading), "status": plan.status,
            "failure": plan.failure,
            "wall_s": plan.wall_time_s, "iterations": sum(s.solver.iterations for s in plan.segments),
            "x": {}, "structure": {}}
     if plan.status != "solved":
         return out
-    models, q, qd = models_for(cell), None, None
+    models, q, qd = caches.models(cell), None, None
     for seg in plan.segments:
         q0 = seg.q[0] if q is None else q
         landing = seg.landing or {}  # a robust flip's scenario rows are part of its NLP
         nlp = transcribe(seg.name, models, q0, seg.qd[0] if qd is None else qd,
                             location=location, options=options,
                             on_blade=landing.get("burger_on_blade", (0.0, 0.0)),
-                            scenarios=[r["burger_on_blade"] for r in landing.get("scenarios", [])])
+                            scenarios=[r["burger_on_blade"] for r in landing.get("scenarios", [])],
+                            patterns=caches.patterns)
         out["structure"][seg.name] = nlp.structure_key
         out["x"][seg.name] = nlp.layout.pack(seg.q, seg.qd, seg.qdd, seg.u, seg.alpha, seg.T).tolist()
         q, qd = seg.q[-1], seg.qd[-1]

@@ -7,6 +7,11 @@ on each burger location — :func:`flipkit.planning.planners.planner.plan_flip` 
 executor, and summarises success fractions, the baseline's failure reasons and classes, and
 the median wall time per subbehaviour of each method.
 
+Each location's task compiles both methods' subproblems before it times them
+(:func:`~flipkit.experiments.speed.warm_flip`,
+:func:`~flipkit.baseline.ee_scp.compile_subproblems`), into caches of its own: the times are
+planning with compiled subproblems, as a running cell's are, whichever worker ran what before.
+
 One judge for both (:mod:`flipkit.baseline.classify`): the baseline's joint path (closed-form
 IK, the branch continuous with the start, :data:`RATE` Hz) and the collocation plan resampled at
 the same rate (cubic Hermite between nodes) face the same checks and thresholds; the
@@ -23,11 +28,14 @@ from pathlib import Path
 
 from flipkit.behaviors.library import FLIP_NAMES
 from flipkit.behaviors import targets as tg
-from flipkit.baseline import run_baseline
+from flipkit.baseline import CompiledProblems, run_baseline
 from flipkit.baseline.classify import FAILURE_CLASSES, REASONS, classify_plan
+from flipkit.baseline.ee_scp import compile_subproblems
 from flipkit.config import LOCATION_SETS, CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.experiments.speed import warm_flip
 from flipkit.experiments.sweep import run_sweep
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.plans.verify import verify_plan
 from flipkit.solvers.names import SOLVERS
@@ -56,9 +64,12 @@ def location_label(job: dict) -> str:
 
 
 def _collocation(location, solver: str, plans_dir) -> dict:
-    t0 = time.perf_counter()
+    caches, t0 = PlannerCaches(), time.perf_counter()
     try:
-        plan = plan_flip(location, solver=solver)
+        if solver != "ipopt":  # the SQP's subproblems compiled before the clock starts
+            warm_flip(caches, CellConfig(), location)
+            t0 = time.perf_counter()
+        plan = plan_flip(location, solver=solver, caches=caches)
     except FlipkitError as exc:
         return {"status": "failed", "reason": str(exc), "time_s": time.perf_counter() - t0,
                 _PRIVATE: {}}
@@ -84,7 +95,9 @@ def _judge(plan) -> dict:
 
 
 def _ee_ik(location) -> dict:
-    res = run_baseline(location, rate=RATE, ik=IK, ee=EE)
+    problems = CompiledProblems()  # compiled before the baseline's clock starts
+    compile_subproblems(CellConfig(), location, problems)
+    res = run_baseline(location, rate=RATE, ik=IK, ee=EE, problems=problems)
     failure = res.failure
     return {"status": res.status, "reason": res.reason,
             "class": failure.failure_class if failure else None,

@@ -21,6 +21,7 @@ from functools import partial
 from flipkit.errors import FlipkitError
 from flipkit.experiments.sweep import run_sweep, stable_hash
 from flipkit.experiments.trial_jobs import plan_from_text, plan_text
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.contingency import Contingencies
 from flipkit.planning.plans.verify import verify_plan
 from flipkit.simulation.execute import SENSE_AFTER
@@ -78,12 +79,14 @@ def summary(record: dict) -> dict:
     return {k: record[k] for k in ("places", "failed", "ready_s", "prepare_s", "sense_s")}
 
 
-def replanner(plan, record: dict) -> Contingencies:
-    """The re-plan of a trial of ``plan`` from its job's contingency record."""
+def replanner(plan, record: dict, caches: PlannerCaches | None = None) -> Contingencies:
+    """The re-plan of a trial of ``plan`` from its job's contingency record, solving a place
+    none covers with ``caches`` (default: new ones)."""
     flips = [(tuple(p), plan_from_text(t)) for p, t in zip(record["places"], record["texts"])]
     return Contingencies(plan, flips, [tuple(p) for p in record["failed"]],
                          float(record["prepare_s"]), [float(v) for v in record["ready_s"]],
-                         float(record["sense_s"]))
+                         float(record["sense_s"]),
+                         PlannerCaches() if caches is None else caches)
 
 
 __all__ = ["attach", "prepare", "replanner", "sense_time", "summary"]

@@ -28,6 +28,7 @@ from flipkit.config import TABLE1_LOCATIONS
 from flipkit.errors import ConfigError
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.plans.verify_flight import recompute_landing
 from flipkit.simulation.execute import execute_plan
@@ -121,9 +122,9 @@ def main(argv=None) -> int:
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--mode", nargs="+", choices=MODES, default=list(MODES))
     args = parser.parse_args(argv)
-    atlas, plans = default_atlas(), {}
+    atlas, plans, caches = default_atlas(), {}, PlannerCaches()
     for loc in dict.fromkeys(TABLE1_LOCATIONS):
-        plans[loc] = plan_flip(loc, atlas=atlas)
+        plans[loc] = plan_flip(loc, atlas=atlas, caches=caches)
     cm = lambda v: "(" + ", ".join(f"{100 * x:+.1f}" for x in v) + ")"  # noqa: E731
     print(f"{'location (m)':<24}{'mode':<13}{'on blade: plan':>15}{'sim':>15}"
           f"{'total (cm)':>15}{'place':>15}{'flight':>15}")

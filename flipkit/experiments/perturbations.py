@@ -79,7 +79,7 @@ def trial_rng(seed: int, trial: int, location) -> np.random.Generator:
     Seeded by numpy's ``SeedSequence`` of the seed, the trial and the location in µm, so
     that every trial of every location has a stream of its own: Table I's 10 × 10 trials are
     100 perturbations, not 10 repeated at each location, and runs with different seeds share
-    no draw (with ``default_rng(seed + trial)``, seed 3's trial 0 was seed 0's trial 3). Every
+    no draw (``default_rng(seed + trial)`` would make seed 3's trial 0 seed 0's trial 3). Every
     parameter setting of a run sees the same draws at a location (common random numbers).
 
     Raises:

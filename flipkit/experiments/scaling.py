@@ -22,6 +22,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError, InvalidChoiceError
 from flipkit.experiments.speed import TRANSLATE_SOLVERS, translate_nlps, warm_up
 from flipkit.experiments.sweep import run_sweep
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.chain import solve_segment
 from flipkit.solvers.exact import ExactOptions, ExactSolver
 from flipkit.solvers.names import EXACT_RESULT_NAMES
@@ -42,12 +43,13 @@ def scaling_item(item: dict) -> dict:
         "objective" (Σu²)}]``.
     """
     n, solver = int(item["N"]), str(item["solver"])
-    nlps = translate_nlps(CellConfig(), SegmentOptions(N=n, arm_clearance=False))
+    caches = PlannerCaches()  # this item's: its NLPs' models and the SQP's workspace
+    nlps = translate_nlps(CellConfig(), SegmentOptions(N=n, arm_clearance=False), caches)
     nlps = nlps[:int(item["segments"])]
     plugin = {v: k for k, v in EXACT_RESULT_NAMES.items()}.get(solver)
     setup, rows = 0.0, []
     if solver == "sqp":
-        setup = warm_up(nlps[:1])
+        setup = warm_up(nlps[:1], caches)
     built = {}  # the translates differ only in their bounds: one solver per distinct graph
     for k, nlp in enumerate(nlps):
         if plugin is not None:
@@ -58,7 +60,7 @@ def scaling_item(item: dict) -> dict:
             setup += time.perf_counter() - t0
             res = built[graph.key].solve(graph=graph)
         else:
-            res = solve_segment(nlp, solver)
+            res = solve_segment(nlp, solver, caches=caches)
         rows.append({"segment": k + 1, "status": str(res.status),
                      "time_s": float(res.wall_time_s), "iterations": int(res.iterations),
                      "objective": float(res.objective)})

@@ -16,6 +16,7 @@ and re-plans place and return home for it while the carry finishes
 from __future__ import annotations
 
 from dataclasses import asdict
+from functools import partial
 from pathlib import Path
 
 
@@ -28,7 +29,8 @@ from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
-                                            trial_key, trial_label)
+                                            trial_key, trial_label, warm_replan)
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.planning.planners.serve import replan_serve, table_spot
@@ -54,7 +56,11 @@ def run_serve_trial(job: dict) -> dict:
     draw = Perturbations(**job["perturbations"]).draw(
         trial_rng(job["seed"], job["trial"], plan.burger["location"]))
     cell = job_cell(plan.cell(), job)
-    replan = replan_serve if job.get("replan", False) else None
+    replan = None
+    if job.get("replan", False):  # its re-plans share caches, compiled before it runs
+        caches = PlannerCaches()
+        warm_replan(replan_serve, plan, (0.0, 0.0), caches)
+        replan = partial(replan_serve, caches=caches)
     mode = job.get("mode", FEEDFORWARD)
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
                       replan=replan, command=job.get("command", DEFAULT_COMMAND),

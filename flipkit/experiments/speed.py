@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import time
 
-from flipkit.behaviors.models import models_for
+from flipkit.behaviors.library import FLIP_NAMES
+from flipkit.behaviors.models import Models
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.transcribe import flat_pose, transcribe
 from flipkit.config import CellConfig
 from flipkit.model.ik import solve_pose
-from flipkit.planning.planners.workspaces import thread_workspace
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.solvers.sqp import SQPOptions, SQPWorkspace, TerminationOptions, solve_sqp
 
 # Key points of the translate experiment (paper Fig. 6: three on the grill, three on the
@@ -42,26 +43,28 @@ TRANSLATE_SOLVERS = {"sqp": "SQP", "fatrop": "FATROP", "ipopt_exact": "IPOPT exa
                      "sqpmethod": "sqpmethod", "ipopt": "IPOPT L-BFGS"}
 
 
-def translate_nlps(cell: CellConfig, options: SegmentOptions) -> list:
+def translate_nlps(cell: CellConfig, options: SegmentOptions,
+                   caches: PlannerCaches | None = None) -> list:
     """The six translate segments between :data:`TRANSLATE_KEY_POINTS`, each to the next,
-    as NLPs built with ``options`` (each start pose by IK from q_home)."""
-    models = models_for(cell)
+    as NLPs built with ``options`` (each start pose by IK from q_home), with the models and
+    patterns of ``caches`` (default: the cell's models, built for these NLPs)."""
+    models = Models(cell) if caches is None else caches.models(cell)
+    patterns = None if caches is None else caches.patterns
     robot = models.for_segment("translate")
     pts, nlps = TRANSLATE_KEY_POINTS, []
     for k, a in enumerate(pts):
         q0 = solve_pose(robot, a, (0.0, 0.0, 0.0), robot.q_home)
         nlps.append(transcribe("translate", models, q0, goal=flat_pose(pts[(k + 1) % len(pts)]),
-                                  options=options))
+                               options=options, patterns=patterns))
     return nlps
 
 
-def warm_up(nlps) -> float:
+def warm_up(nlps, caches: PlannerCaches) -> float:
     """Compile the elastic (restoration) QPs of each distinct structure (cvxpy, once per
     workspace) and run one SQP iteration on it, which compiles the condensed hard QP;
-    returns the time (s). The workspace is this thread's planning workspace
-    (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), which the planner's
-    solves here use."""
-    t0, seen, workspace = time.perf_counter(), set(), thread_workspace(SQPWorkspace)
+    returns the time (s). The workspace is ``caches``'s, which the solves and planners
+    given the same ``caches`` then use."""
+    t0, seen, workspace = time.perf_counter(), set(), caches.workspace(SQPWorkspace)
     for nlp in nlps:
         if nlp.structure_key not in seen:
             seen.add(nlp.structure_key)
@@ -70,4 +73,18 @@ def warm_up(nlps) -> float:
             solve_sqp(nlp, options=SQPOptions(termination=TerminationOptions(max_iter=1)),
                       raise_on_failure=False, workspace=workspace)
     return time.perf_counter() - t0
+
+
+def warm_flip(caches: PlannerCaches, cell: CellConfig, location) -> float:
+    """:func:`warm_up` on the five segment structures of a flip at ``location``, built along
+    their initial guesses with ``caches``'s models: what a plan made with ``caches`` then
+    times is planning, not cvxpy's one-off compile. Returns the time spent (s)."""
+    models = caches.models(cell)
+    q, qd, nlps = models.bare.q_home, None, []
+    for name in FLIP_NAMES:
+        nlp = transcribe(name, models, q, qd, location=location, patterns=caches.patterns)
+        nlps.append(nlp)
+        nodes = nlp.layout.nodes(nlp.x0)
+        q, qd = nodes[-1, 0], nodes[-1, 1]
+    return warm_up(nlps, caches)
 

@@ -1,7 +1,7 @@
 """The job of one simulated trial, shared by the flip trials (:mod:`flipkit.experiments.trials`)
 and the serve trials (:mod:`flipkit.experiments.serve_trials`): the job dicts a sweep worker
-receives, their cache key, the plan read back from its text, and the spatula tracking errors
-merged over trials."""
+receives, their cache key, the plan read back from its text, the re-plan's subproblems
+compiled before the trial runs, and the spatula tracking errors merged over trials."""
 
 from __future__ import annotations
 
@@ -14,9 +14,10 @@ import numpy as np
 
 from flipkit.config import PhysicsConfig, with_parameter
 from flipkit.config.physics import SERVO_FORMS, servo_lookahead
-from flipkit.errors import InvalidChoiceError
+from flipkit.errors import FlipkitError, InvalidChoiceError
 from flipkit.experiments.perturbations import Perturbations, check_seed
 from flipkit.experiments.sweep import stable_hash
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
 from flipkit.simulation.modes import FEEDFORWARD
@@ -63,6 +64,20 @@ def trial_jobs(plan_text: str, trials: int, seed: int, perturbations: Perturbati
     return [{"plan_text": plan_text, "trial": i, "seed": seed, "draws": DRAWS,
              "perturbations": asdict(perturbations), "rate_hz": float(rate_hz), "mode": mode,
              "replan": bool(replan), "command": command, **extra} for i in range(trials)]
+
+
+def warm_replan(replan, plan: Plan, on_blade, caches: PlannerCaches, **kw) -> None:
+    """Make one re-plan of ``plan`` with ``replan`` (``replan_flip`` or ``replan_serve``) for
+    a burger at ``on_blade`` (x, y) (m, blade frame) in ``caches``, before the trial runs and
+    untimed (``kw``: e.g. ``keep=False``, so that a flip is solved though its plan keeps its
+    promise). The trial's own re-plan in ``caches`` then takes what a running cell's would,
+    not cvxpy's one-off compile of its subproblems, and so does the arm's pause for it
+    (:func:`~flipkit.simulation.execute.execute_plan`). A re-plan that fails has compiled
+    what it reached; the trial's own says what is wrong."""
+    try:
+        replan(plan, on_blade, caches=caches, **kw)
+    except FlipkitError:
+        pass
 
 
 def job_cell(cell, job: dict):
@@ -215,4 +230,5 @@ def merge_tracking(errors: list) -> dict:
 
 
 __all__ = ["DRAWS", "HOLD_S", "PLAN_KEYS", "TRACK_RATE_HZ", "lookahead_of", "merge_tracking",
-           "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key", "trial_label"]
+           "plan_from_text", "plan_text", "servo_physics", "trial_jobs", "trial_key", "trial_label",
+           "warm_replan"]

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import tempfile
 from dataclasses import asdict
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -40,11 +41,12 @@ from flipkit.experiments.sweep import run_sweep
 from flipkit.experiments.trial_jobs import (HOLD_S, TRACK_RATE_HZ, lookahead_of, merge_tracking,
                                             job_cell, judged, safety_summary, stage_verdicts,
                                             plan_from_text, servo_physics, trial_jobs,
-                                            trial_key, trial_label)
+                                            trial_key, trial_label, warm_replan)
 from flipkit.model.robot import Robot
 from flipkit.planning.planners.atlas import default_atlas
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.servo_command import DEFAULT_COMMAND
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip, replan_flip
 from flipkit.planning.plans.verify import require_verified
 from flipkit.simulation.execute import execute_plan
@@ -140,9 +142,13 @@ def run_trial(job: dict) -> dict:
     draw = Perturbations(**job["perturbations"]).draw(
         trial_rng(job["seed"], job["trial"], plan.burger["location"]))
     cell = job_cell(plan.cell(), job)
-    replan = replan_flip if job.get("replan", False) else None
-    if replan is not None and "contingencies" in job:
-        replan = replanner(plan, job["contingencies"])
+    replan = None
+    if job.get("replan", False):  # this trial's re-plans share caches, compiled before it runs
+        caches = PlannerCaches()
+        warm_replan(replan_flip, plan, plan.step("release").landing.get(
+            "burger_on_blade", (0.0, 0.0))[:2], caches, keep=False)
+        replan = (replanner(plan, job["contingencies"], caches) if "contingencies" in job
+                  else partial(replan_flip, caches=caches))
     command = job.get("command", DEFAULT_COMMAND)
     servo = known_physics(plan.cell().physics, job.get("physics") or {})
     ex = execute_plan(plan, mode, draw, cell=cell, hold=HOLD_S, rate_hz=job["rate_hz"],
@@ -227,7 +233,9 @@ def plan_location(job: dict) -> dict:
             ``"heading"``: the scoop heading (rad; default the location's own).
 
     Returns:
-        ``{"status", "reason", "time_s" (s, planning wall time), "path" (plan file or None)}``.
+        ``{"status", "reason", "time_s" (s, planning wall time: in a task of its own, as a
+        new ``flipkit plan flip`` process, it includes compiling the SQP's subproblems),
+        "path" (plan file or None)}``.
     """
     cell = CellConfig()
     for name, value in job.get("cell", {}).items():

@@ -29,12 +29,9 @@ from scipy.interpolate import CubicHermiteSpline
 from flipkit.baseline import run_baseline
 from flipkit.baseline.classify import classify_plan
 from flipkit.baseline.ee_opt import sample_times
-from flipkit.behaviors.library import FLIP_NAMES
-from flipkit.behaviors.models import models_for
-from flipkit.behaviors.transcribe import transcribe
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
-from flipkit.experiments.speed import warm_up
+from flipkit.experiments.speed import warm_flip
 from flipkit.experiments.compare_ik import EE, IK, RATE, plan_filename
 from flipkit.experiments.perturbations import Perturbations
 from flipkit.experiments.sweep import make_executor, run_sweep
@@ -45,6 +42,7 @@ from flipkit.experiments.trials import track_plan as track_execution
 from flipkit.figures.data import PlanSeries, plan_series, spatula_positions
 from flipkit.model.robot import Robot
 from flipkit.planning.plans.plan_file import Plan
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip, plan_translate, replan_flip
 from flipkit.simulation.execute import execute_plan
 from flipkit.simulation.judges import judge_flip, judge_pickup, judge_scoop, landing_target
@@ -70,10 +68,10 @@ def chain_translates(points, *, solver: str = "ipopt", cell: CellConfig | None =
     if len(pts) < 2:
         raise ConfigError(f"need at least two key points, got {len(pts)}")
     goals = pts[1:] + (pts[:1] if closed else [])
-    plans, q = [], None
+    plans, q, caches = [], None, PlannerCaches()
     for goal in goals:
         plan = plan_translate(pts[0] if q is None else None, goal, q_start=q, cell=cell,
-                              solver=solver)
+                              solver=solver, caches=caches)
         plans.append(plan)
         q = plan.segments[-1].q[-1]
     status = "solved" if all(p.status == "solved" for p in plans) else "failed"
@@ -135,27 +133,6 @@ def nominal_trial(plan) -> dict:
 
 
 # ------------------------------------------------------------------ solve times
-_WARMED: set = set()
-
-
-def _warm_sqp(cell: CellConfig, location) -> float:
-    """One SQP iteration on each of the five segment structures, once per process: cvxpy's
-    one-off compile of each QP (~2 s per structure) is set-up, not solve time (as in
-    :mod:`flipkit.experiments.speed`). Returns the time spent (s)."""
-    if cell in _WARMED:
-        return 0.0
-    models = models_for(cell)
-    q, qd, nlps = models.bare.q_home, None, []
-    for name in FLIP_NAMES:  # the structures along the initial guesses
-        nlp = transcribe(name, models, q, qd, location=location)
-        nlps.append(nlp)
-        nodes = nlp.layout.nodes(nlp.x0)
-        q, qd = nodes[-1, 0], nodes[-1, 1]
-    spent = warm_up(nlps)
-    _WARMED.add(cell)
-    return spent
-
-
 def flip_solve_times(item) -> dict:
     """Plan pickup-and-flip at one location with one solver and report the solve times.
 
@@ -164,17 +141,18 @@ def flip_solve_times(item) -> dict:
 
     Returns:
         JSON values: ``location``, ``solver``, ``status``, ``failure``, ``wall_time_s`` (the
-        whole call), ``warm_up_s`` (SQP compile excluded from the solve times) and
+        whole call), ``warm_up_s`` (the SQP's compile before it, excluded from the solve
+        times: every item compiles its own) and
         ``segments``: ``[{name, status, wall_time_s, iterations, T}]`` (solver wall time, s;
         executed duration T, s) for the segments attempted.
     """
     location, solver = [float(v) for v in item["location"]], str(item["solver"])
-    cell = CellConfig()
+    cell, caches = CellConfig(), PlannerCaches()
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-        warm = _warm_sqp(cell, location) if solver == "sqp" else 0.0
+        warm = warm_flip(caches, cell, location) if solver == "sqp" else 0.0
         t0 = time.perf_counter()
-        plan = plan_flip(location, cell=cell, solver=solver)
+        plan = plan_flip(location, cell=cell, solver=solver, caches=caches)
         wall = time.perf_counter() - t0
     return {"location": location, "solver": solver, "status": plan.status,
             "failure": plan.failure, "wall_time_s": wall, "warm_up_s": warm,

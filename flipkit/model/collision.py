@@ -35,24 +35,12 @@ from flipkit.errors import ConfigError
 from flipkit.model.robot import LWA, Robot, skew
 
 BLADE, HANDLE = "blade", "handle"
-# GJK's stopping tolerance (m). coal's default, 1e-6, left distances up to 2e-7 m off (seen:
-# blade to table at 0.95 m), enough to spoil finite differences and the SQP's line search;
-# 1e-9 costs ~1.5× per query.
+# GJK's stopping tolerance (m). coal's default, 1e-6, leaves distances off by more than the
+# finite differences of the gradient tests and the SQP's line search can tell from a change
+# of the configuration; 1e-9 makes a query somewhat dearer (docs/history.md).
 GJK_TOLERANCE = 1e-9
 
 
-# coal (3.0.x) keeps in its Box support function a function-local
-#     static const CoalScalar inflate = (dir.array() == 0).any() ? 1 + 1e-10 : 1.;
-# (coal/narrowphase/support_functions.h): the first Box support query of the *process* decides,
-# for every later one, whether a box's negative half-sides are inflated by 1e-10 relative.
-# Which query comes first depended on the process's history — a box–box pair (the blade or
-# the ee box against a cell box, or the blade against the burger in verify_flight) puts GJK's
-# default guess (1, 0, 0) in the box's frame and inflates; a link's hull against the grill
-# does not — and distances then differ in their last digits, enough for the SQP to end at
-# another point of the solution set. :func:`pin_box_support` makes the first
-# Box query of the process one with a generic direction (no inflation, the exact box), so
-# every flipkit process computes the same distances.
-_BOX_SUPPORT_PINNED: bool | None = None
 _GENERIC_ROTATION = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
 
 
@@ -68,37 +56,50 @@ def _box_probe() -> float:
 
 
 def pin_box_support() -> bool:
-    """Make coal's first Box support query of the process one with no zero direction component
-    (see the note above), once; returns True if coal's boxes are exact in this process, False
-    (with a RuntimeWarning) if a Box query made before flipkit's (outside flipkit) left them
-    inflated — distances then differ from other processes' by ~1e-11 m."""
-    global _BOX_SUPPORT_PINNED
-    if _BOX_SUPPORT_PINNED is None:
-        # An ellipsoid first (GJK's first direction (−1, 0, 0) is its own), the box second,
-        # turned so that the direction in its frame, the rotation's first row, has no zero.
-        coal.distance(coal.Ellipsoid(0.1, 0.12, 0.14), coal.Transform3s(np.eye(3), np.zeros(3)),
-                      coal.Box(1.0, 1.0, 1.0),
-                      coal.Transform3s(_GENERIC_ROTATION, np.array([2.0, 0.3, 0.2])),
-                      coal.DistanceRequest(), coal.DistanceResult())
-        _BOX_SUPPORT_PINNED = abs(_box_probe() - 0.3) <= 1e-13
-        if not _BOX_SUPPORT_PINNED:
-            warnings.warn("coal's Box support was first used before flipkit in this process and "
-                          "inflates boxes by 1e-10: collision distances (and so plans) may differ "
-                          "from other processes' in their last digits", RuntimeWarning,
-                          stacklevel=2)
-    return _BOX_SUPPORT_PINNED
+    """Make coal's first Box support query of the process one with no zero direction
+    component, and say whether coal's boxes are exact in this process.
+
+    coal (3.0.x) keeps in its Box support function a function-local
+    ``static const CoalScalar inflate = (dir.array() == 0).any() ? 1 + 1e-10 : 1.;``
+    (``coal/narrowphase/support_functions.h``): the first Box support query of the process
+    decides, for every later one, whether a box's negative half-sides are inflated by 1e-10
+    relative. Left to chance, the process's history would decide — a box–box pair (the blade
+    or the ee box against a cell box, the blade against the burger in verify) puts GJK's
+    default guess (1, 0, 0) in the box's frame and inflates; a link's hull against the grill
+    does not — and distances would differ in their last digits, enough for the SQP to end at
+    another point of the solution set. This state is coal's, one per process, and cannot be
+    passed to anyone: loading this module calls this function (:data:`BOX_SUPPORT_EXACT`)
+    before flipkit makes any other coal query, so every flipkit process computes the same
+    distances. Calling it again changes nothing (coal's choice is made) and reports it.
+
+    Returns:
+        True if coal's boxes are exact, False if a Box query made before flipkit's (outside
+        flipkit) left them inflated: distances then differ from other processes' by ~1e-11 m.
+    """
+    # An ellipsoid first (GJK's first direction (−1, 0, 0) is its own), the box second,
+    # turned so that the direction in its frame, the rotation's first row, has no zero.
+    coal.distance(coal.Ellipsoid(0.1, 0.12, 0.14), coal.Transform3s(np.eye(3), np.zeros(3)),
+                  coal.Box(1.0, 1.0, 1.0),
+                  coal.Transform3s(_GENERIC_ROTATION, np.array([2.0, 0.3, 0.2])),
+                  coal.DistanceRequest(), coal.DistanceResult())
+    return abs(_box_probe() - 0.3) <= 1e-13
+
+
+# Whether coal's boxes are exact in this process: pinned when this module loads, before any
+# other flipkit query (pin_box_support), and fixed from then on by coal itself.
+BOX_SUPPORT_EXACT = pin_box_support()
+if not BOX_SUPPORT_EXACT:
+    warnings.warn("coal's Box support was first used before flipkit in this process and "
+                  "inflates boxes by 1e-10: collision distances (and so plans) may differ "
+                  "from other processes' in their last digits", RuntimeWarning, stacklevel=2)
 
 
 def distance_request():
-    """A coal DistanceRequest with :data:`GJK_TOLERANCE` (coal's box support pinned first,
-    :func:`pin_box_support`)."""
-    pin_box_support()
+    """A coal DistanceRequest with :data:`GJK_TOLERANCE` (coal's box support was pinned
+    when this module loaded, :func:`pin_box_support`)."""
     req = coal.DistanceRequest()
     req.gjk_tolerance = GJK_TOLERANCE
     return req
-
-
-pin_box_support()  # before any other flipkit query: loading this module pins it
 
 
 def sphere_box_bound(centers, radii, lo, hi) -> np.ndarray:
@@ -130,25 +131,40 @@ def _bounding_sphere(geometry) -> tuple[np.ndarray, float]:
     return np.array(geometry.aabb_center), float(geometry.aabb_radius)
 
 
-_MESHES: dict = {}  # (URDF, joint names) -> the loaded shapes; their geometries are read-only
+class ArmMeshes:
+    """The URDF's collision meshes of the arm, loaded once per (URDF, joints) by whoever
+    holds this and shared by every :class:`ArmShapes` built with it.
 
-
-def _mesh_shapes(robot: Robot) -> list[Shape]:
-    """The URDF's collision geometries on moving joints; meshes as their convex hulls.
-
-    Loaded once per process and URDF (loading the meshes and building their hulls is not
-    cheap, and every plan's verification builds its own geometry); each call
-    returns its own :class:`Shape` records around the shared, never modified, coal geometries.
+    Loading the meshes and building their hulls is not cheap, and a planner builds shapes
+    for its models and again for every plan's verification: a planner's owner keeps one
+    (:class:`~flipkit.planning.planners.caches.PlannerCaches`). The coal geometries are never
+    modified after loading, so the shapes that share them stay independent.
     """
-    key = (str(robot.urdf), tuple(robot.model.names))
-    if key not in _MESHES:
-        _MESHES[key] = _load_mesh_shapes(robot)
-    return [Shape(s.name, s.joint, s.placement.copy(), s.geometry, s.center.copy(), s.radius)
-            for s in _MESHES[key]]
+
+    def __init__(self):
+        self._loaded: dict[tuple, list[Shape]] = {}
+
+    def shapes(self, robot: Robot) -> list[Shape]:
+        """The URDF's collision geometries on moving joints, meshes as their convex hulls
+        (:func:`load_mesh_shapes`): new :class:`Shape` records around the shared geometries.
+
+        Raises:
+            ConfigError: The meshes cannot be loaded.
+        """
+        key = (str(robot.urdf), tuple(robot.model.names))
+        if key not in self._loaded:
+            self._loaded[key] = load_mesh_shapes(robot)
+        return [Shape(s.name, s.joint, s.placement.copy(), s.geometry, s.center.copy(), s.radius)
+                for s in self._loaded[key]]
 
 
-def _load_mesh_shapes(robot: Robot) -> list[Shape]:
-    """:func:`_mesh_shapes` without the cache."""
+def load_mesh_shapes(robot: Robot) -> list[Shape]:
+    """The URDF's collision geometries on moving joints, meshes as their convex hulls (the
+    base, fixed to the world, left out).
+
+    Raises:
+        ConfigError: The meshes cannot be loaded.
+    """
     dirs = [str(robots_dir().parent.parent)] if robots_dir() is not None else []
     try:
         gmodel = pin.buildGeomFromUrdf(robot.model, robot.urdf, pin.COLLISION, package_dirs=dirs)
@@ -169,17 +185,20 @@ def _load_mesh_shapes(robot: Robot) -> list[Shape]:
 
 
 class ArmShapes:
-    """The arm's shapes (:func:`_mesh_shapes`, handle, blade) and the cell's boxes.
+    """The arm's shapes (the URDF's link meshes, handle, blade) and the cell's boxes.
 
     Args:
         robot: The arm with its spatula frame.
         cell: Cell (boxes, margin, spatula); default ``robot.cell``.
+        meshes: The loaded link meshes to take the links' shapes from (default: the
+            URDF's, loaded for these shapes alone, :func:`load_mesh_shapes`).
     """
 
-    def __init__(self, robot: Robot, cell: CellConfig | None = None):
+    def __init__(self, robot: Robot, cell: CellConfig | None = None,
+                 meshes: ArmMeshes | None = None):
         self.robot, self.cell = robot, cell or robot.cell
         sp = self.cell.spatula
-        shapes = _mesh_shapes(robot)
+        shapes = load_mesh_shapes(robot) if meshes is None else meshes.shapes(robot)
         tool = robot.spatula_in_joint * pin.SE3(self._tool_in_spatula())
         handle_len = sp.handle - sp.length / 2
         if handle_len > 0:  # capsule along the tool z axis, flange to heel

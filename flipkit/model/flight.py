@@ -14,8 +14,8 @@ for the default patty). In torque-free motion its angular momentum L = I_t ω + 
 (ω·n) n is constant and so is ω·n (Euler's equations of a symmetric body), so ω = L/I_t −
 (κ − 1)(ω·n) n and ṅ = ω × n = (L/I_t) × n: the axis n turns about the fixed direction of L
 at the constant rate |L|/I_t, not about ω. ω is along a principal axis only when the blade
-does not turn about its own normal at release; a flip's ω·n of about 0.5 rad/s over 6 rad/s
-turns the landed face 2-7° from where a rotation about ω would put it.
+does not turn about its own normal at release; a flip's small turn about the normal still
+turns the landed face by degrees from where a rotation about ω would put it.
 
 Release state at the blade pose (p, R), velocity v and angular velocity ω (world frame), the
 burger's centre over the blade point b = (b_x, b_y, 0) (the blade centre unless the burger
@@ -31,15 +31,16 @@ Flight, with τ the time since release and g = |gravity| along −z:
 
 Everything is one CasADi SX graph (exact first derivatives by algorithmic differentiation):
 :func:`landing_function` gives the landing point, tilt and time of flight,
-:func:`clearance_function` the signed clearance of the flying burger from the blade plane at
-a later blade pose. Rotation inputs are perturbed by a small world rotation δ,
-R(δ) = (I + [δ]×) R, so that a derivative with respect to δ at δ = 0 chains with pinocchio's
-angular Jacobian (dR = [J_ω dq]× R).
+:func:`clearance_function` the signed clearance of the flying burger from the blade plane at a
+later blade pose. Both build a new function; :data:`LANDING` and :data:`FLIGHT_CLEARANCE` are
+the ones built when this module loads (a few milliseconds), which every caller shares: a CasADi
+function is immutable once built, and calling it allocates its own work memory. Rotation inputs
+are perturbed by a small world rotation δ, R(δ) = (I + [δ]×) R, so that a derivative with
+respect to δ at δ = 0 chains with pinocchio's angular Jacobian (dR = [J_ω dq]× R).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 
 import casadi as ca
@@ -83,9 +84,8 @@ def _rotate(n, w, tau):
     return n * ca.cos(th) + ca.cross(k, n) * ca.sin(th) + k * ca.dot(k, n) * (1 - ca.cos(th))
 
 
-@functools.lru_cache(maxsize=None)
 def landing_function() -> ca.Function:
-    """CasADi function ``(x, R, par) → (y, dy/dx)``.
+    """A new CasADi function ``(x, R, par) → (y, dy/dx)`` (:data:`LANDING` is one).
 
     ``x`` = (p, v, δ, ω) (12), ``R`` the 3×3 blade rotation, ``par`` = (h, g, z_land, target x,
     target y, bx, by, r) with (bx, by) where the burger's centre sits on the blade (blade frame,
@@ -105,9 +105,9 @@ def landing_function() -> ca.Function:
     return ca.Function("landing", [x, R, par], [y, ca.jacobian(y, x)])
 
 
-@functools.lru_cache(maxsize=None)
 def clearance_function() -> ca.Function:
-    """CasADi function ``(x, R_r, R_i, par) → (d, ∂d/∂x)``: clearance of the flying burger.
+    """A new CasADi function ``(x, R_r, R_i, par) → (d, ∂d/∂x)``: clearance of the flying
+    burger (:data:`FLIGHT_CLEARANCE` is one).
 
     ``x`` = (p_r, v_r, δ_r, ω_r, τ, p_i, δ_i) (19): the release state, the time since release
     τ (s) and a blade pose (p_i, R_i) at that time. ``par`` = (h, radius, g, bx, by). ``d`` (m) is the
@@ -130,6 +130,10 @@ def clearance_function() -> ca.Function:
     return ca.Function("clearance", [x, Rr, Ri, par], [d, ca.jacobian(d, x)])
 
 
+LANDING = landing_function()  # built once, when the module loads (module docstring)
+FLIGHT_CLEARANCE = clearance_function()
+
+
 def gravity_magnitude(gravity) -> float:
     """|g| (m/s²) of a gravity vector along −z, or :class:`ConfigError`."""
     g = np.asarray(gravity, float)
@@ -140,7 +144,7 @@ def gravity_magnitude(gravity) -> float:
 
 def landing_parameters(thickness: float, grill_height: float, gravity, target=(0.0, 0.0),
                        on_blade=(0.0, 0.0), *, diameter: float) -> list:
-    """The ``par`` input of :func:`landing_function`: (h, g, z_land = h_g + h/2, target x,
+    """The ``par`` input of :data:`LANDING`: (h, g, z_land = h_g + h/2, target x,
     target y, bx, by, r = diameter/2) (SI; ``gravity`` the vector, along −z)."""
     return [float(thickness), gravity_magnitude(gravity), grill_height + thickness / 2,
             *np.asarray(target, float)[:2], *np.asarray(on_blade, float)[:2], diameter / 2]
@@ -160,12 +164,13 @@ def predict_landing(p, v, R, w, *, thickness: float, diameter: float, grill_heig
                              diameter=diameter)
     z_land = par[2]
     x = np.concatenate([p, v, np.zeros(3), w])
-    y = np.asarray(landing_function()(x, np.asarray(R, float), par)[0])
+    y = np.asarray(LANDING(x, np.asarray(R, float), par)[0])
     y = y.ravel()
     return {"point": [float(y[3]), float(y[4]), float(z_land)], "offset": float(y[0]),
             "tilt_deg": math.degrees(math.acos(float(np.clip(y[1], -1, 1)))),
             "time_of_flight": float(y[2])}
 
 
-__all__ = ["TILT_MIN_DEG", "landing_function", "landing_parameters", "clearance_function", "gravity_magnitude",
-           "predict_landing", "spin_ratio"]
+__all__ = ["FLIGHT_CLEARANCE", "LANDING", "TILT_MIN_DEG", "clearance_function",
+           "gravity_magnitude", "landing_function", "landing_parameters", "predict_landing",
+           "spin_ratio"]

@@ -47,8 +47,8 @@ from scipy.interpolate import CubicHermiteSpline
 from flipkit.errors import ConfigError
 
 # s: integration step of the friction model. Stick-slip transitions are resolved within a step,
-# so the step only sets how finely the blade's speed is sampled: over the Table I scoops and
-# μ_b 0.4-0.6, ±1 cm placements, 1 ms moves the outcome by at most 0.18 mm from 0.2 ms.
+# so the step only sets how finely the blade's speed is sampled: a finer step moves the
+# outcome by a fraction of a millimetre (docs/history.md).
 STEP_S = 1e-3
 GRAVITY = 9.81  # m/s²
 

@@ -27,7 +27,6 @@ draw; the plan's feed-forward ignores it. After the plan the last desired state 
 
 from __future__ import annotations
 
-import hashlib
 
 import time
 from dataclasses import dataclass, replace
@@ -61,8 +60,8 @@ SETTLED_MOTION = 2e-4  # m
 SETTLED_TURN = 2e-3  # (unitless)
 # The segment after which ``replan`` senses the burger on the blade, the arm at rest: a flip's
 # scoop (the burger lies where the scoop put it); a serve's carry, just before the place (the
-# burger can still shift on the blade in the pickup and carry: 5 cm in one MuJoCo trial with
-# μ × 0.81, sensed after the scoop; the place depends on where it lies then).
+# burger can still shift on the blade in the pickup and carry, and the place depends on
+# where it lies then).
 SENSE_AFTER = {b.name: b.step(b.sensed).name for b in BEHAVIORS.values() if b.sensed}
 # How long before that segment ends the camera sees the burger (s). A serve's re-plan starts
 # where the planned carry ends, so it runs while the carry finishes, as in a cook
@@ -308,7 +307,7 @@ def execute_plan(plan, mode: str = FEEDFORWARD, draw: dict | None = None, *,
 
 def _errors(robot, t, q, q_des, bounds) -> dict:
     """Per-segment spatula position error against the plan (m)."""
-    diff = _positions(robot, q) - _desired_positions(robot, q_des)
+    diff = _positions(robot, q) - _positions(robot, q_des)
     e = np.linalg.norm(diff, axis=1)
     out = {}
     for name, (t0, t1) in bounds.items():
@@ -323,24 +322,6 @@ def _errors(robot, t, q, q_des, bounds) -> dict:
 def _positions(robot, q) -> np.ndarray:
     """Blade-centre positions (m) at each row of q."""
     return np.array([robot.placement(a).translation for a in q])
-
-
-_DESIRED: dict = {}  # digest of a desired path -> its positions: every trial of a plan has it
-
-
-def _desired_positions(robot, q_des) -> np.ndarray:
-    """:func:`_positions` of a desired path, kept for the trials of the same plan (keyed by
-    the path's bytes and the arm's kinematics: joint placements and the spatula's)."""
-    q_des = np.ascontiguousarray(q_des, dtype=float)
-    kinematics = np.concatenate([robot.spatula_in_joint.homogeneous.ravel()] + [
-        placement.homogeneous.ravel() for placement in robot.model.jointPlacements])
-    key = (hashlib.sha1(q_des.tobytes()).hexdigest(), q_des.shape,
-           hashlib.sha1(kinematics.tobytes()).hexdigest())
-    if key not in _DESIRED:
-        if len(_DESIRED) >= 16:
-            _DESIRED.pop(next(iter(_DESIRED)))
-        _DESIRED[key] = _positions(robot, q_des)
-    return _DESIRED[key]
 
 
 __all__ = ["MODES", "HOLD_S", "SENSE_AFTER", "SENSE_LEAD", "NO_DRAW", "Execution", "execute_plan"]

@@ -36,8 +36,9 @@ from flipkit.simulation.run import BurgerRun
 STARTS = ("on_spatula", "on_grill")
 # Burger–grill friction (the paper is silent; "low grill temperature makes the burgers sticky").
 # A rigid puck is harder to scoop than a soft patty: with the 18° scoop wedge and μ = 0.5 on
-# the blade, μ_grill = 0.5 lets the blade push the burger 12 cm instead of sliding under it,
-# 0.8 leaves it 3 cm ahead of the blade centre (on a scripted scoop).
+# the blade, a slipperier grill lets the blade push the burger along instead of sliding under
+# it; 0.8 leaves it a few centimetres ahead of the blade centre on a scripted scoop
+# (docs/history.md).
 GRILL_MU = 0.8
 
 

@@ -40,8 +40,8 @@ the ``noslip`` iterations.
 
 Blade flex (``physics.blade_flex``). The contact above lets the rigid blade sink into the
 grill by the tip's deflection, so its faces go below the grill's surface: under the patty the
-tip's top face rode from 0.35 mm below to 0.8 mm above the grill over the Table I scoops, as
-the servo and the blade's roll shared the press. With ``"hinge"`` the blade is a body of its
+tip's top face rides from below to above the grill over a scoop, as the servo and the
+blade's roll share the press (docs/history.md). With ``"hinge"`` the blade is a body of its
 own on a hinge about its y axis at its neck (x = −l/2), of rotational stiffness k L² and
 damping b L² (:func:`hinge_flex`: the tip meets the cantilever's k and b, L the blade length),
 carrying the spatula's mass and inertia (moved there from the last link, so the arm's

@@ -1,17 +1,18 @@
 """The SQP's workspace: compiled subproblems, one per NLP structure and form, built on first use
 and reused.
 
-Canonicalising a subproblem with cvxpy costs 0.01–0.4 s, so a workspace compiles each
-(structure, form) once; its parameters then take each linearisation's values (DPP) and its
-OSQP solver, set up once, is updated and warm-started. :class:`~flipkit.solvers.sqp_solver.SQPSolver`
-owns one and calls :meth:`SQPWorkspace.reset` at the start of every solve, which forgets the
-OSQP state of the NLP's structure, so a solve never warm-starts from another solve's
-solution: results do not depend on what the workspace solved before.
+Canonicalising a subproblem with cvxpy costs more than many of its solves, so a workspace
+compiles each (structure, form) once; its parameters then take each linearisation's values (DPP)
+and its OSQP solver, set up once, is updated and warm-started.
+:class:`~flipkit.solvers.sqp_solver.SQPSolver` owns one and calls :meth:`SQPWorkspace.reset` at
+the start of every solve, which forgets the OSQP state of the NLP's structure, so a solve never
+warm-starts from another solve's solution: results do not depend on what the workspace solved
+before.
 
-Who keeps a workspace decides how long compiled subproblems live: the planners keep one per
-thread (:mod:`flipkit.planning.planners.workspaces`), so that planners made one after another
-compile each structure once. A workspace serves one solve at a time: solves running
-concurrently in threads need one each.
+Who keeps a workspace decides how long compiled subproblems live: whoever plans many motions
+keeps one in a :class:`~flipkit.planning.planners.caches.PlannerCaches` and passes it to
+every planner, so that planners made one after another compile each structure once. A
+workspace serves one solve at a time: solves running concurrently in threads need one each.
 """
 
 from __future__ import annotations

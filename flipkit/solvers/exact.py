@@ -50,8 +50,8 @@ from flipkit.solvers.stdout_redirect import captured_stdout
 #: smaller there, made FATROP fail a translate (docs/peers.md has the scales tried).
 FATROP_OBJ_SCALE = 1e-4
 
-#: The proximal term of ``sqpmethod``'s Gauss–Newton Hessian (scaled units). On translate 1
-#: 1e-4 converged in 91 iterations; 1e-6 and 1e-3 ran to 200 (docs/peers.md).
+#: The proximal term of ``sqpmethod``'s Gauss–Newton Hessian (scaled units): of the values
+#: tried, the one with which it converges on the translates (docs/peers.md).
 SQPMETHOD_PROXIMAL = 1e-4
 
 
@@ -64,12 +64,12 @@ class ExactOptions:
         fatrop_tol: FATROP's, and ``sqpmethod``'s dual tolerance. FATROP does not scale its
             KKT residual as IPOPT does, so at IPOPT's 1e-8 it reaches IPOPT's optimum (Σu²
             equal to 1e-6) and then iterates to its cap without declaring it. At 1e-6 it
-            stops with Σu² within 5e-5 of IPOPT's optimum, the accuracy the SQP stops at.
+            stops as close to IPOPT's optimum as the SQP does (docs/peers.md).
         constr_viol_tol: Largest scaled violation accepted; also the independent check.
         max_iter: Iteration cap (FATROP, IPOPT).
-        sqpmethod_max_iter: ``sqpmethod``'s (its iterations took 66–250 ms on the translates).
+        sqpmethod_max_iter: ``sqpmethod``'s iteration cap.
         jit: Compile the graph's functions to C before solving (CasADi JIT, ``-O0``: the
-            graph's C is ~40 MB; gcc -O1 on it ran for over 3 min and 3 GB, not finished).
+            graph's C is too large for an optimising compile, docs/peers.md).
         print_level: Solver verbosity (0 silent).
         step_profile: Record each solve's :class:`~flipkit.solvers.step_profile.StepProfile`
             (``ExactSolver.last_profile``): FATROP then prints its iteration table, which is

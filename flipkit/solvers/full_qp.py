@@ -136,7 +136,7 @@ class QPSubproblem:
             self._driver.cold()
 
     def compile(self) -> OSQPDriver:
-        """Canonicalise with cvxpy (once; 0.1–0.4 s) and return the OSQP driver."""
+        """Canonicalise with cvxpy (once) and return the OSQP driver."""
         if not hasattr(self, "_driver"):
             self._driver = OSQPDriver(self.problem)
         return self._driver

@@ -8,8 +8,8 @@ SQP uses (:mod:`flipkit.solvers.sqp`):
 The constraints reach IPOPT through two :class:`casadi.Callback` objects: one returns c̃(z),
 the other — handed to CasADi by ``get_jacobian`` — the sparse Jacobian ∂c̃/∂z on the NLP's
 fixed pattern (``jac_rows``, ``jac_cols``). The constraint callback also declares that
-pattern (``get_jac_sparsity``): without it CasADi takes ∂c̃/∂z as dense, IPOPT's KKT
-matrix fills in (MUMPS fronts of ~1400, ~0.5 s per iteration instead of ~20 ms). Both
+pattern (``get_jac_sparsity``): without it CasADi takes ∂c̃/∂z as dense, and IPOPT's KKT
+matrix fills in, its factorisation many times dearer per iteration. Both
 callbacks read from a one-point cache, so c and its Jacobian at the same z cost one
 :meth:`NLP.evaluate`. The objective is quadratic in the torques and is written as a CasADi
 expression, so its gradient is exact.

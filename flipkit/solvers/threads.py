@@ -1,10 +1,10 @@
 """One BLAS thread inside a solve.
 
 The solvers' linear algebra is small: a 31 × 31 Cholesky, 547 × 31 products, sparse LU
-factorisations of ~520 rows. OpenBLAS's thread pool (two threads on the 2-core machine, by
-default one per core) costs more than it saves on such sizes, and when the cores are busy —
-a second solve in a sweep worker, a notebook, another process — its threads wait for each
-other, and a condensed QP update takes over ten times as long as with one thread.
+factorisations of ~520 rows. OpenBLAS's thread pool (by default one thread per core) costs
+more than it saves on such sizes, and when the cores are busy — a second solve in a sweep
+worker, a notebook, another process — its threads wait for each other, and a condensed QP
+update takes many times as long as with one thread (docs/history.md).
 :func:`single_threaded_blas` limits every BLAS library loaded in the process to one thread
 for the duration of a ``with`` block and restores the previous setting after it, through
 threadpoolctl. Building a controller scans the loaded libraries, so a caller that enters the

@@ -25,9 +25,12 @@ class Layout:
         nq: Number of joints.
         N: Number of intervals (N + 1 nodes); must be even for Hermite–Simpson.
         degree: Bezier degree.
+        patterns: Where the constraint blocks on this layout find and keep their sparsity
+            patterns (:class:`~flipkit.transcription.constraints.base.Patterns`, shared by
+            the layouts of many segments); default none: each block fills its own.
     """
 
-    def __init__(self, nq: int = 6, N: int = N_DEFAULT, degree: int = 6):
+    def __init__(self, nq: int = 6, N: int = N_DEFAULT, degree: int = 6, patterns=None):
         if N < 2 or N % 2:
             raise ConfigError(f"N must be an even number >= 2 (odd nodes are midpoints), got {N}")
         self.nq, self.N, self.bezier = nq, N, Bezier(degree)
@@ -39,6 +42,7 @@ class Layout:
         self.n = self.T_index + 1
         self.s = np.linspace(0.0, 1.0, self.n_nodes)  # node times t_i = s_i T
         self.key = (nq, N, degree)  # what every index of the layout depends on
+        self.patterns = patterns
 
     def _field(self, i: int, k: int) -> np.ndarray:
         start = i * self.node_size + k * self.nq

@@ -13,27 +13,27 @@ import sys
 import warnings
 from pathlib import Path
 
-from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError
 from flipkit.experiments.sweep import make_executor
 from flipkit.fileio import write_text
 from flipkit.planning.planners.atlas import Atlas, default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.inputs import check_start
 from flipkit.planning.planners.planner import (SUMMARY_HEADER, format_summary, plan_batch,
                                                plan_flip, plan_translate, summary_table)
 from flipkit.planning.planners.serve import plan_serve
 
 
-def _start_q(values, cell):
+def _start_q(values, models):
     """``--start-q`` (rad, six finite numbers: :mod:`flipkit.cli.plan`) within the joint
     limits and on q_home's side of the elbow and wrist singularities, SINGULARITY_MARGIN from
-    them (every plan from there would fail verify's ``singularity`` check); ``None`` if not
-    given."""
+    them (every plan from there would fail verify's ``singularity`` check), with the cell's
+    ``models``; ``None`` if not given."""
     if values is None:
         return None
-    robot = models_for(cell).for_segment("go_to_burger")
+    robot = models.for_segment("go_to_burger")
     return check_start(robot, values, what="--start-q", branch_side=True)[0]
 
 
@@ -78,12 +78,12 @@ def run_translate(args: argparse.Namespace) -> int:
 def run_flip(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     _quiet()
-    cell = CellConfig()
+    cell, caches = CellConfig(), PlannerCaches()  # the start's check and the plan share them
     options = SegmentOptions() if args.r_land is None else SegmentOptions(r_land=args.r_land)
-    q_start = _start_q(args.start_q, cell)
+    q_start = _start_q(args.start_q, caches.models(cell))
     atlas = _atlas(args, options, cell)
     plan = plan_flip(args.burger, q_start, cell=cell, solver=args.solver, land=args.land,
-                     options=options, atlas=atlas, heading=args.heading)
+                     options=options, atlas=atlas, heading=args.heading, caches=caches)
     plan.to_json(args.json)
     if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} entries")
@@ -104,11 +104,11 @@ def _atlas(args: argparse.Namespace, options, cell):
 def run_serve(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     _quiet()
-    cell = CellConfig()
-    q_start = _start_q(args.start_q, cell)
+    cell, caches = CellConfig(), PlannerCaches()  # the start's check and the plan share them
+    q_start = _start_q(args.start_q, caches.models(cell))
     atlas = _atlas(args, SegmentOptions(), cell)
     plan = plan_serve(args.burger, args.table_spot, q_start, cell=cell, solver=args.solver,
-                      atlas=atlas, heading=args.heading)
+                      atlas=atlas, heading=args.heading, caches=caches)
     plan.to_json(args.json)
     if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} entries (go to burger, scoop, pickup)")

@@ -26,6 +26,7 @@ from flipkit.fileio import replace_with
 from flipkit.planning.kitchen import motions
 from flipkit.planning.kitchen.clearance import CookConflictError, clear_cook, cook_meetings
 from flipkit.planning.kitchen.cook import check_cook, table_spots
+from flipkit.planning.kitchen.cpsat_process import Child
 from flipkit.planning.kitchen.durations import plan_model, representative_order
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.prefetch import PrefetchPlanners
@@ -35,6 +36,7 @@ from flipkit.planning.kitchen.table import assign_spots
 from flipkit.planning.kitchen.throughput import run_stream, stream_report
 from flipkit.planning.kitchen.windows import WindowsBrokenError, worst_break
 from flipkit.planning.planners.atlas import default_atlas
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.simulation.cook import simulate_cook
 from flipkit.simulation.cook_film import FILM_FPS, write_cook_film
 
@@ -43,12 +45,13 @@ def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:40] or "burger"
 
 
-def _planners(order, kinds, cell, args, atlas, spots, executor):
-    """The real planners, prefetching in ``executor``'s workers when there is one."""
+def _planners(order, kinds, cell, args, atlas, spots, executor, caches):
+    """The real planners, prefetching in ``executor``'s workers when there is one; what is
+    planned in this process uses ``caches``."""
     if executor is None:
-        return motions.default_planners(kinds, cell, args.solver, atlas)
+        return motions.default_planners(kinds, cell, args.solver, atlas, caches)
     return PrefetchPlanners(order, kinds, cell.robot.q_home, spots, executor, cell,
-                            args.solver, atlas)
+                            args.solver, atlas, caches)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -60,15 +63,17 @@ def run(args: argparse.Namespace) -> int:
     burgers = (stream_order(args.stream, args.minutes, args.seed, cell, args.windows)
                if stream else args.order)  # the cook order read by flipkit.cli.schedule
     atlas = None if args.no_atlas else default_atlas(cell)
+    caches = PlannerCaches()  # every motion and re-plan this process plans, one after another
     timeline_path, plans = Path(args.json), Path(args.plans)  # --plans checked there too
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     pool = make_executor(workers=workers) if workers > 1 else contextlib.nullcontext()
-    with pool as executor:  # its workers end with the run, however it ends
+    # the workers, and the CP-SAT child that answers every schedule of the run, end with it
+    with pool as executor, Child() as child:
         if stream and not args.plan:
-            return _modelled_stream(args, cell, atlas, executor, timeline_path)
+            return _modelled_stream(args, cell, atlas, executor, timeline_path, caches, child)
         order = check_cook(burgers, cell)
         spots = [a.spot for a in assign_spots(order, table_spots(cell), args.dwell)]
-        planners = _planners(order, kinds, cell, args, atlas, spots, executor)
+        planners = _planners(order, kinds, cell, args, atlas, spots, executor, caches)
         if executor is None:
             planners = motions.cached_planners(planners)
         common = dict(kinds=kinds, cell=cell, windows=args.windows, dwell_s=args.dwell)
@@ -78,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
                 def cpsat(lands, headings):
                     return schedule_cook_cpsat(burgers, planners, cell.robot.q_home, **common,
                                                lands=lands, headings=headings,
-                                               time_limit_s=args.time_limit, seed=args.seed)
+                                               time_limit_s=args.time_limit, seed=args.seed,
+                                               child=child)
 
                 timeline, lands, headings = clear_cook(cpsat, cell)
             else:
@@ -122,8 +128,9 @@ def run(args: argparse.Namespace) -> int:
                                       args.minutes).to_dict()
     sim = None
     if getattr(args, "simulate", False) and timeline.ok:  # a failed schedule is not simulated
-        sense = (motions.serve_replanner(cell, args.solver, atlas) if args.sense else None)
-        blade = motions.blade_replanner(args.solver) if args.sense else None
+        sense = (motions.serve_replanner(cell, args.solver, atlas, caches) if args.sense
+                 else None)
+        blade = motions.blade_replanner(args.solver, caches) if args.sense else None
         sim = simulate_cook(timeline, mode=args.mode, film_fps=FILM_FPS if args.film else 0.0,
                             sense_serve=sense, sense_blade=blade, seed=args.seed)
         doc["simulation"] = sim.to_dict()
@@ -192,14 +199,14 @@ def _report_simulation(sim, args: argparse.Namespace) -> int:
     return 0
 
 
-def _modelled_stream(args, cell, atlas, executor, timeline_path: Path) -> int:
+def _modelled_stream(args, cell, atlas, executor, timeline_path: Path, caches, child) -> int:
     """A stream scheduled on the durations of representative plans: report and JSON."""
     rep, rep_spots = representative_order(cell)
     model = plan_model(_planners(rep, ("flip", "serve"), cell, args, atlas, rep_spots,
-                                 executor), cell.robot.q_home, cell)
+                                 executor, caches), cell.robot.q_home, cell)
     timeline, report = run_stream(args.stream, args.minutes, model, policy=args.policy,
                                   windows=args.windows, dwell_s=args.dwell, seed=args.seed,
-                                  cell=cell, time_limit_s=args.time_limit)
+                                  cell=cell, time_limit_s=args.time_limit, child=child)
     doc = timeline.to_dict()
     doc["stream"], doc["motion_model"] = report.to_dict(), model.to_dict()
     write_json(timeline_path, doc)

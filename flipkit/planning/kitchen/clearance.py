@@ -44,8 +44,8 @@ MAX_ROUNDS = 8  # plan-schedule-check rounds before a cook with meetings left is
 LOW_SEGMENTS = SERVE.before("carry")  # a serve's segments at the grill: they move with its burger
 TOSS_SEGMENTS = PICKUP_AND_FLIP.since("release")  # a flip's that change with its landing spot
 # Footprint samples tested at once against the candidate spots still in. Each test removes
-# most of them, so small chunks keep the later tests small (the five-burger cook's
-# free_landing: 2.0 s in chunks of 4, 2.9 s of 16, 2.8 s of 64, 2.3 s one sample at a time).
+# most of them, so small chunks keep the later tests small, while a chunk of one pays the
+# call's overhead per sample (docs/history.md).
 CHUNK = 4
 
 

@@ -9,15 +9,17 @@ second fails to load with an undefined symbol (google/or-tools issue #5246). The
 load cvxpy; the child loads only OR-Tools, and no module of the package imports OR-Tools
 but this one's ``__main__``.
 
-One child serves every schedule of the process: it reads one problem per line and answers
-each with one line, so only the first schedule pays its start (about 0.4 s, importing
-OR-Tools), and :func:`warm` starts it ahead, while the motions are being planned. A child
-that fails or does not answer in time is killed, and the next schedule starts a new one.
+A :class:`Child` reads one problem per line and answers each with one line, so it can serve
+many schedules: whoever schedules many times (a cook's clearance rounds, a stream) makes one,
+passes it to each schedule and closes it at the end (``with Child() as child:``), and only the
+first schedule pays its start (importing OR-Tools); :meth:`Child.warm` starts it ahead,
+while the motions are being planned. A schedule given no child starts one for itself and
+stops it. A child that fails or does not answer in time is killed, and the next schedule
+asked of the same :class:`Child` starts a new one.
 """
 
 from __future__ import annotations
 
-import atexit
 import json
 import math
 import select
@@ -34,8 +36,8 @@ from flipkit.planning.kitchen.cpsat import (BurgerJob, CpSatSchedule, MotionTime
 from flipkit.planning.kitchen.windows import WindowBreak, Windows
 
 # The child's wall-time bound only detects a hung child. Its work is bounded in CP-SAT's
-# deterministic time (about seconds on one idle core), and the same work takes several times
-# longer on a loaded machine: at load 4-5 on two cores a 10 s limit overran 70 s of wall time.
+# deterministic time (close to seconds on one idle core), and the same work takes several
+# times longer in wall time on a loaded machine (docs/history.md).
 CHILD_WALL_FACTOR = 30.0  # wall s allowed per deterministic s of the limit
 CHILD_MARGIN_S = 60.0  # s beyond that (start-up, building the model)
 
@@ -55,7 +57,8 @@ def _readable(stream, timeout: float) -> bool:
 
 
 class Child:
-    """The CP-SAT child process of this process (module docstring), started on demand."""
+    """A CP-SAT child process (module docstring), started on demand and stopped by
+    :meth:`close` or at the end of a ``with`` block."""
 
     def __init__(self):
         self._proc: subprocess.Popen | None = None
@@ -101,6 +104,12 @@ class Child:
                 raise CpSatProcessError(f"the CP-SAT process failed (exit {code}): {last}")
             return json.loads(line)
 
+    def __enter__(self) -> "Child":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close()
+
     def close(self) -> None:
         """Stop the child (the next :meth:`ask` starts another)."""
         proc, self._proc = self._proc, None
@@ -112,18 +121,10 @@ class Child:
             self._err = None
 
 
-CHILD = Child()
-atexit.register(CHILD.close)
-
-
-def warm() -> None:
-    """Start the CP-SAT child now, so that the first schedule does not wait for it."""
-    CHILD.warm()
-
-
 def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                    earliest_s: float = -math.inf, time_limit_s: float = 10.0,
-                   workers: int = 1, seed: int = 0, relax: str = "max") -> CpSatSchedule:
+                   workers: int = 1, seed: int = 0, relax: str = "max",
+                   child: Child | None = None) -> CpSatSchedule:
     """Order and time the motions of ``jobs`` (:class:`~flipkit.planning.kitchen.cpsat.BurgerJob`,
     any order) with CP-SAT in a child process; :func:`~flipkit.planning.kitchen.cpsat.solve_here`
     says how.
@@ -134,6 +135,8 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
             seconds on one idle core); the child is given :func:`wall_bound` of wall time.
         workers: CP-SAT search workers. seed: CP-SAT random seed.
         relax: The first objective when the windows cannot be met: "max" or "count".
+        child: The :class:`Child` to ask (started if it is not running); default: one
+            started for this schedule and stopped after it.
 
     Returns:
         The schedule; ``wall_s`` is the round trip to the child (its start too, if this
@@ -151,7 +154,11 @@ def solve_schedule(jobs, windows: Windows = Windows(), *, dwell_s: float = 0.0,
                else None, "time_limit_s": time_limit_s, "workers": workers, "seed": seed,
                "relax": relax}
     t0 = time.perf_counter()
-    reply = CHILD.ask(problem, wall_bound(time_limit_s))
+    if child is None:
+        with Child() as own:
+            reply = own.ask(problem, wall_bound(time_limit_s))
+    else:
+        reply = child.ask(problem, wall_bound(time_limit_s))
     if "timeout" in reply:
         raise ScheduleTimeoutError(reply["timeout"])
     breach = reply["breach"]
@@ -182,8 +189,7 @@ def answer(problem: dict, cp) -> dict:
             "proved_infeasible": r.proved_infeasible}
 
 
-__all__ = ["CHILD", "CHILD_MARGIN_S", "Child", "CpSatProcessError", "answer", "solve_schedule",
-           "warm"]
+__all__ = ["CHILD_MARGIN_S", "Child", "CpSatProcessError", "answer", "solve_schedule"]
 
 
 if __name__ == "__main__":  # the child: a problem per line on stdin, an answer per line out

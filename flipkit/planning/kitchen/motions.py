@@ -18,6 +18,7 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, InvalidChoiceError, UnreachableError
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import plan_flip
 from flipkit.planning.kitchen.sweep import approach_height
 from flipkit.planning.planners.serve import plan_serve, replan_serve, table_spot
@@ -140,19 +141,22 @@ def refused(job: MotionJob, q_start, exc: UnreachableError, t0: float) -> Planne
                                  f"{exc}")
 
 
-def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
-                 ) -> MotionPlanner:
+def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None,
+                 caches: PlannerCaches | None = None) -> MotionPlanner:
     """The real flip: :func:`~flipkit.planning.planners.planner.plan_flip` from ``q_start``, landing
     at the job's ``land`` (default where the burger was picked up), scooping along the job's
     ``heading`` (default the radial one), coming in above the other
     burgers on the grill (:func:`~flipkit.planning.kitchen.sweep.approach_height`),
-    warm-started from ``atlas`` if given."""
+    warm-started from ``atlas`` if given, every flip with ``caches`` (default: new ones,
+    kept by the planner returned)."""
+    caches = PlannerCaches() if caches is None else caches
+
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         try:
             p = plan_flip(job.location, q_start, cell=cell, solver=solver, land=job.land,
                           atlas=atlas, approach_height=approach_height(cell or CellConfig()),
-                          heading=job.heading)
+                          heading=job.heading, caches=caches)
         except UnreachableError as exc:
             return refused(job, q_start, exc, t0)
         return from_plan(p, "flip", time.perf_counter() - t0)
@@ -160,19 +164,22 @@ def flip_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=Non
     return plan
 
 
-def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
-                  ) -> MotionPlanner:
+def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=None,
+                  caches: PlannerCaches | None = None) -> MotionPlanner:
     """The real serve: :func:`~flipkit.planning.planners.serve.plan_serve` from ``q_start`` to the
     job's table spot, placing the burger where the scoop model says the scoop leaves it on the
     blade (``plan_serve``'s default), coming in above the other
     burgers as the flip does; ``atlas`` (a pickup-and-flip atlas) warm-starts its go to
-    burger, scoop and pickup."""
+    burger, scoop and pickup; ``caches`` as :func:`flip_planner`."""
+    caches = PlannerCaches() if caches is None else caches
+
     def plan(job: MotionJob, q_start: np.ndarray) -> PlannedMotion:
         t0 = time.perf_counter()
         try:
             p = plan_serve(job.location, job.table_spot, q_start=q_start, cell=cell,
                            solver=solver, atlas=atlas,
-                           approach_height=approach_height(cell or CellConfig()))
+                           approach_height=approach_height(cell or CellConfig()),
+                           caches=caches)
         except UnreachableError as exc:  # e.g. a flip's predicted landing off the grill area
             return refused(job, q_start, exc, t0)
         return from_plan(p, "serve", time.perf_counter() - t0)
@@ -181,50 +188,58 @@ def serve_planner(cell: CellConfig | None = None, solver: str = "auto", atlas=No
 
 
 def default_planners(kinds=KINDS, cell: CellConfig | None = None, solver: str = "auto",
-                     atlas=None) -> Mapping[str, MotionPlanner]:
-    """The real planners of ``kinds`` (flips warm-started from ``atlas`` if given).
+                     atlas=None, caches: PlannerCaches | None = None
+                     ) -> Mapping[str, MotionPlanner]:
+    """The real planners of ``kinds`` (flips warm-started from ``atlas`` if given), all
+    planning with ``caches`` (default: new ones, which they share).
 
     Raises:
         InvalidChoiceError: An unknown kind.
     """
     makers: dict[str, Callable[..., MotionPlanner]] = {"flip": flip_planner,
                                                        "serve": serve_planner}
+    caches = PlannerCaches() if caches is None else caches
     out = {}
     for kind in kinds:
         if kind not in makers:
             raise InvalidChoiceError("motion kind", kind, KINDS)
-        out[kind] = makers[kind](cell, solver, atlas)
+        out[kind] = makers[kind](cell, solver, atlas, caches)
     return out
 
 
-def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=None
-                    ) -> Callable:
+def serve_replanner(cell: CellConfig | None = None, solver: str = "auto", atlas=None,
+                    caches: PlannerCaches | None = None) -> Callable:
     """Sense, plan, act for a cook's serves: ``replan(motion, xy) -> Plan | None`` plans the
     serve of ``motion`` (a scheduled serve with its ``plan``) again, from the same start
     configuration to the same table spot, for its burger seen at ``xy`` (m) on the grill,
     coming in above the other burgers as :func:`serve_planner` does. The plan returned may
     have failed (its ``failure`` says why); a place the planner refuses (off the grill area,
     say) raises :class:`~flipkit.errors.FlipkitError` with its one-line reason. Either way
-    the caller runs the scheduled serve."""
+    the caller runs the scheduled serve. Every re-plan uses ``caches`` (default: new ones,
+    kept by the re-planner returned)."""
     cell = cell or CellConfig()
+    caches = PlannerCaches() if caches is None else caches
 
     def replan(motion, xy):
         old = motion.plan
         location = (float(xy[0]), float(xy[1]), float(old.burger["location"][2]))
         return plan_serve(location, table_spot(old), q_start=old.segments[0].q[0],
                           cell=cell, solver=solver, atlas=atlas,
-                          approach_height=approach_height(cell))
+                          approach_height=approach_height(cell), caches=caches)
 
     return replan
 
 
-def blade_replanner(solver: str = "auto") -> Callable:
+def blade_replanner(solver: str = "auto", caches: PlannerCaches | None = None) -> Callable:
     """Sense, plan, act on the blade for a cook's serves: ``replan(plan, on_blade) -> Plan``
     plans place and return home of the serve ``plan`` again for its burger seen at
     ``on_blade`` (x, y) (m, blade frame) during the carry
-    (:func:`~flipkit.planning.planners.serve.replan_serve`; :mod:`flipkit.simulation.cook_blade`)."""
+    (:func:`~flipkit.planning.planners.serve.replan_serve`; :mod:`flipkit.simulation.cook_blade`),
+    every re-plan with ``caches`` (default: new ones, kept by the re-planner returned)."""
+    caches = PlannerCaches() if caches is None else caches
+
     def replan(plan, on_blade):
-        return replan_serve(plan, on_blade, solver=solver)
+        return replan_serve(plan, on_blade, solver=solver, caches=caches)
 
     return replan
 

@@ -27,7 +27,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.kitchen.cook import SECOND_SIDE_S
 from flipkit.planning.kitchen.cpsat import BurgerJob, MotionTimes
-from flipkit.planning.kitchen.cpsat_process import solve_schedule, warm
+from flipkit.planning.kitchen.cpsat_process import Child, solve_schedule
 from flipkit.planning.kitchen.motions import KINDS, MotionJob, MotionPlanner
 from flipkit.planning.kitchen.schedule import (BurgerRecord, MotionRecord, Timeline,
                                               check_cook_inputs)
@@ -45,7 +45,7 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
                         plan_start: float | None = None, time_limit_s: float = 10.0,
                         workers: int = 1, seed: int = 0, relax: str = "max",
                         lands: Mapping | None = None,
-                        headings: Mapping | None = None) -> Timeline:
+                        headings: Mapping | None = None, child: Child | None = None) -> Timeline:
     """Plan every motion of a cook order from rest, then schedule them with CP-SAT.
 
     Args:
@@ -58,6 +58,9 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             where it was picked up.
         headings: Burger id -> its flip's scoop heading (rad); a burger not in it gets the
             default heading.
+        child: The CP-SAT :class:`~flipkit.planning.kitchen.cpsat_process.Child` to ask,
+            started here while the motions are planned; default: one started for this
+            schedule and stopped after it.
 
     Returns:
         The timeline (``policy`` :data:`CPSAT`; ``solver``: status, objectives, wall time).
@@ -70,9 +73,16 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             that does not end at rest at ``q_start``.
         ScheduleTimeoutError: CP-SAT found no schedule within the time limit.
     """
+    if child is None:  # a child for this schedule alone (it starts only when warmed)
+        with Child() as own:
+            return schedule_cook_cpsat(burgers, planners, q_start, kinds=kinds, cell=cell,
+                                       spots=spots, windows=windows, dwell_s=dwell_s,
+                                       plan_start=plan_start, time_limit_s=time_limit_s,
+                                       workers=workers, seed=seed, relax=relax, lands=lands,
+                                       headings=headings, child=own)
     cell, kinds, order, spots, assigned = check_cook_inputs(burgers, planners, kinds, cell,
                                                             spots, dwell_s)
-    warm()  # the CP-SAT child starts while the motions are planned
+    child.warm()  # the CP-SAT child starts while the motions are planned
     serve = "serve" in kinds
     q0 = np.asarray(q_start, float)
     t0 = min(b.t_drop for b in order) if plan_start is None else float(plan_start)
@@ -123,7 +133,7 @@ def schedule_cook_cpsat(burgers, planners: Mapping[str, MotionPlanner], q_start,
             for b in flipped]
     result = solve_schedule(jobs, windows, dwell_s=dwell_s, earliest_s=t0 + ready + time_limit_s,
                             time_limit_s=time_limit_s, workers=workers, seed=seed,
-                            relax=relax) if jobs else None
+                            relax=relax, child=child) if jobs else None
     known = t0 + ready + (result.wall_s if result else 0.0)
     motions = []
     for (kind, burger), pm in plans.items():

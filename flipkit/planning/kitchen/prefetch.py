@@ -32,13 +32,16 @@ from tqdm import tqdm
 
 from flipkit.config import CellConfig
 from flipkit.planning.kitchen.motions import MotionJob, PlannedMotion, default_planners
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.planner import REST_TOL
 
 
 def plan_motion(kind: str, job: MotionJob, q_start, cell: CellConfig, solver: str,
-                atlas=None) -> PlannedMotion:
-    """Plan one motion with the real planner of ``kind`` (a worker's task)."""
-    return default_planners((kind,), cell, solver, atlas)[kind](job, np.asarray(q_start, float))
+                atlas=None, caches: PlannerCaches | None = None) -> PlannedMotion:
+    """Plan one motion with the real planner of ``kind`` and ``caches`` (a worker's task
+    gives none: its own, for the task)."""
+    planners = default_planners((kind,), cell, solver, atlas, caches)
+    return planners[kind](job, np.asarray(q_start, float))
 
 
 class PrefetchPlanners(Mapping):
@@ -51,11 +54,16 @@ class PrefetchPlanners(Mapping):
         spots: Table spots (x, y) (m), the k-th for the k-th burger of ``order``.
         executor: A :class:`concurrent.futures.Executor` (worker processes or Dask).
         cell, solver, atlas: As :func:`~flipkit.planning.kitchen.motions.default_planners`.
+        caches: What the motions planned on demand, in this process, reuse
+            (:class:`~flipkit.planning.planners.caches.PlannerCaches`; default: new ones).
+            Each worker's task plans with its own.
     """
 
     def __init__(self, order, kinds, q_rest, spots, executor: cf.Executor,
-                 cell: CellConfig, solver: str = "auto", atlas=None):
+                 cell: CellConfig, solver: str = "auto", atlas=None,
+                 caches: PlannerCaches | None = None):
         self.kinds, self.cell, self.solver, self.atlas = tuple(kinds), cell, solver, atlas
+        self.caches = PlannerCaches() if caches is None else caches
         self.q_rest, self.executor = np.asarray(q_rest, float), executor
         self._spots = {b.burger: tuple(spots[k]) for k, b in enumerate(order) if k < len(spots)}
         self._t0 = time.perf_counter()
@@ -92,7 +100,8 @@ class PrefetchPlanners(Mapping):
         if fut is None or not at_rest:
             self.on_demand += 1
             t = time.perf_counter()
-            pm = plan_motion(job.kind, job, q_start, self.cell, self.solver, self.atlas)
+            pm = plan_motion(job.kind, job, q_start, self.cell, self.solver, self.atlas,
+                             self.caches)
             pm.ready_s = time.perf_counter() - self._t0
             pm.planning_time_s = time.perf_counter() - t
             return pm

@@ -27,9 +27,9 @@ them in three ways, each computed from the plan and the cell (no other numbers):
 (:class:`~flipkit.config.ScoopUncertainty`: ``k_sigma × placement_sigma``): a burger may
 lie that far from where it was recorded. A burger a flip landed may lie farther from the
 landing point, by the flip's landing spread (``Lying.spread``: where the landing disc
-reaches beyond the burger's radius); each distance above grows by it. (In a simulated
-five-burger cook a burger landed 2.8 cm from its predicted point, and the next flip's blade
-came down on its rim.)
+reaches beyond the burger's radius); each distance above grows by it: a landed burger may lie
+centimetres from its predicted point, where the next flip's blade would come down on its
+rim.
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ import numpy as np
 from flipkit.config import CellConfig
 from flipkit.errors import InvalidChoiceError
 from flipkit.planning.kitchen.durations import MotionModel
+from flipkit.planning.kitchen.cpsat_process import Child
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
 from flipkit.planning.kitchen.schedule import Timeline, schedule_cook
 from flipkit.planning.kitchen.stream import StreamError, stream_order
@@ -81,10 +82,11 @@ def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: f
 def run_stream(rate_per_h: float, minutes: float, model: MotionModel, *,
                policy: str = "cpsat", windows: Windows = Windows(), dwell_s: float = DWELL_S,
                seed: int = 0, cell: CellConfig | None = None, time_limit_s: float = 10.0,
-               workers: int = 1) -> tuple[Timeline, StreamReport]:
+               workers: int = 1, child: Child | None = None) -> tuple[Timeline, StreamReport]:
     """Schedule a stream (:func:`~flipkit.planning.kitchen.stream.stream_order`) on the
     model's times with ``policy`` ("cpsat": fewest burgers beyond their windows first, see
-    :mod:`~flipkit.planning.kitchen.cpsat`; "greedy") and measure it.
+    :mod:`~flipkit.planning.kitchen.cpsat`, asked of ``child`` if given, as
+    :func:`~flipkit.planning.kitchen.optimal.schedule_cook_cpsat`; "greedy") and measure it.
 
     Raises:
         InvalidChoiceError: An unknown policy. StreamError: As ``stream_order``.
@@ -98,7 +100,7 @@ def run_stream(rate_per_h: float, minutes: float, model: MotionModel, *,
     if policy == "cpsat":
         tl = schedule_cook_cpsat(order, planners, q, cell=cell, windows=windows,
                                  dwell_s=dwell_s, time_limit_s=time_limit_s, workers=workers,
-                                 seed=seed, relax="count")
+                                 seed=seed, relax="count", child=child)
     else:
         tl = schedule_cook(order, planners, q, cell=cell, dwell_s=dwell_s, windows=windows)
     return tl, stream_report(tl, policy, rate_per_h, minutes)
@@ -108,7 +110,11 @@ def sweep_rates(rates, minutes: float, model: MotionModel, policies=POLICIES,
                 **kw) -> list[dict]:
     """:func:`run_stream` at each rate and policy; one row per pair: the report's fields, or
     ``{"policy", "rate_per_h", "refused": reason}`` where the stream cannot be made (a full
-    grill). ``kw``: as :func:`run_stream`."""
+    grill). ``kw``: as :func:`run_stream`; without a ``child``, one CP-SAT child serves every
+    schedule of the sweep and is stopped at its end."""
+    if kw.get("child") is None:
+        with Child() as child:
+            return sweep_rates(rates, minutes, model, policies, **{**kw, "child": child})
     rows = []
     for rate in rates:
         for policy in policies:

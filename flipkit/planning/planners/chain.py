@@ -12,7 +12,6 @@ from dataclasses import replace
 import numpy as np
 
 from flipkit.behaviors import library
-from flipkit.behaviors.models import models_for
 from flipkit.behaviors.options import SegmentOptions
 from flipkit.behaviors.spec import Behavior, Task
 from flipkit.behaviors.transcribe import transcribe
@@ -22,28 +21,30 @@ from flipkit.errors import (AtlasError, ConfigError, FlipkitError, InvalidChoice
 from flipkit.planning.plans.plan_file import Plan
 from flipkit.planning.plans.segment import Segment
 from flipkit.planning.plans.verify import verify_plan
-from flipkit.planning.planners.workspaces import thread_workspace
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.solvers.names import SOLVERS
 from flipkit.solvers.result import SolveResult, Status
 
 
-# The IPOPT fallback of ``auto``: the budget is above the slowest fallback that has succeeded
-# on the planner's segments, and bounds a hopeless one. An explicit ``ipopt`` keeps
-# IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
-# (flipkit.model.goal_check), so the fallback no longer spends its budget on them.
+# The IPOPT fallback of ``auto``: the budget is above the slowest fallback that succeeds on
+# the planner's segments (docs/history.md), and bounds a hopeless one. An explicit ``ipopt``
+# keeps IPOPT's own defaults. Goals that no branch reaches are refused before any NLP
+# (flipkit.model.goal_check), so the fallback does not spend its budget on them.
 FALLBACK_IPOPT = {"max_wall_time": 60.0, "max_iter": 1000}
 
 
-def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResult:
+def solve_segment(nlp, solver: str = "sqp", x0=None, *, caches: PlannerCaches | None = None,
+                  **sqp_kwargs) -> SolveResult:
     """Solve one segment NLP with ``solver`` from ``x0`` (default ``nlp.x0``, unscaled).
 
     ``auto`` runs the SQP and, when it fails, IPOPT from the same start within
     :data:`FALLBACK_IPOPT`'s budget (60 s, 1000 iterations); the segment's ``solver.name`` in
     the plan file records which one produced it and the wall time counts both.
 
-    ``sqp_kwargs`` go to :func:`~flipkit.solvers.sqp.solve_sqp` (e.g. ``options``); without
-    a ``workspace`` among them the SQP solves in this thread's
-    (:func:`~flipkit.planning.planners.workspaces.thread_workspace`).
+    ``sqp_kwargs`` go to :func:`~flipkit.solvers.sqp.solve_sqp` (e.g. ``options``,
+    ``workspace``); without a ``workspace`` among them the SQP solves in ``caches``'s
+    (:meth:`~flipkit.planning.planners.caches.PlannerCaches.workspace`), or, without
+    ``caches`` either, in a workspace of its own, compiled for this solve alone.
 
     Returns the result whatever its status (``result.success`` tells); the worst constraint
     group of a failure is ``nlp.worst_group(result.x)``.
@@ -51,13 +52,13 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     Raises:
         InvalidChoiceError: ``solver`` is not one of :data:`SOLVERS`.
     """
-    # The solvers load cvxpy and CasADi (0.4 s): imported on the first solve, so that input
-    # checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
+    # The solvers load cvxpy and CasADi, slow to import: imported on the first solve, so that
+    # input checks (flipkit.model.goal_check, planning.inputs) refuse bad goals without them.
     from flipkit.solvers import compiled, ipopt, sqp
 
     if solver == "sqp":
-        if sqp_kwargs.get("workspace") is None:
-            sqp_kwargs["workspace"] = thread_workspace(compiled.SQPWorkspace)
+        if sqp_kwargs.get("workspace") is None and caches is not None:
+            sqp_kwargs["workspace"] = caches.workspace(compiled.SQPWorkspace)
         try:
             return sqp.solve_sqp(nlp, x0, raise_on_failure=False, **sqp_kwargs)
         except SolverError:  # OSQP or a factorisation broke down inside a subproblem
@@ -68,7 +69,7 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     if solver == "ipopt":
         return ipopt.solve_ipopt(nlp, x0, raise_on_failure=False)
     if solver == "auto":  # the SQP, and IPOPT from the same start if the SQP fails
-        first = solve_segment(nlp, "sqp", x0, **sqp_kwargs)
+        first = solve_segment(nlp, "sqp", x0, caches=caches, **sqp_kwargs)
         if first.success:
             return first
         second = ipopt.solve_ipopt(nlp, x0, ipopt.IpoptOptions(**FALLBACK_IPOPT),
@@ -78,10 +79,12 @@ def solve_segment(nlp, solver: str = "sqp", x0=None, **sqp_kwargs) -> SolveResul
     raise InvalidChoiceError("solver", solver, SOLVERS)
 
 
-def finish_plan(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None) -> Plan:
-    """Verify ``plan`` in ``cell``, the cell it was planned in (default the defaults); set
-    status, ``failure``, ``report`` and ``wall_time_s``."""
-    plan.report = verify_plan(plan, cell=cell)
+def finish_plan(plan: Plan, failure: str | None, t0: float, cell: CellConfig | None = None,
+                meshes=None) -> Plan:
+    """Verify ``plan`` in ``cell``, the cell it was planned in (default the defaults), with
+    the arm's link meshes ``meshes`` if given (:func:`~flipkit.planning.plans.verify.verify_plan`);
+    set status, ``failure``, ``report`` and ``wall_time_s``."""
+    plan.report = verify_plan(plan, cell=cell, meshes=meshes)
     if failure is None and not plan.report.ok:
         group, k, amount = plan.report.worst()
         failure = f"{plan.segments[k].name}: {group} violated by {amount:.3g} (verify)"
@@ -181,19 +184,20 @@ class Planner:
         cell: The cell (default :class:`~flipkit.config.CellConfig`).
         solver: One of :data:`SOLVERS`.
         options: Transcription options.
-        workspace: The SQP's compiled subproblems
-            (:class:`~flipkit.solvers.compiled.SQPWorkspace`) this planner solves in, passed
-            down to every segment's solve; ``None``: the solving thread's
-            (:func:`~flipkit.planning.planners.workspaces.thread_workspace`), so that
-            planners made one after another in a thread (every ``plan_flip`` call) compile
-            each subproblem structure once.
+        caches: What this planner reuses and adds to
+            (:class:`~flipkit.planning.planners.caches.PlannerCaches`): its cell's models,
+            the blocks' patterns, the SQP's workspace and the meshes its plans are verified
+            with, each passed down to where it is used; default: new ones, for this planner
+            alone. Planners made one after another with the same ones (every ``plan_flip``
+            of a cook) build each model and compile each subproblem structure once.
 
     Raises:
         InvalidChoiceError: Unknown solver.
     """
 
     def __init__(self, cell: CellConfig | None = None, *, solver: str = "auto",
-                 options: SegmentOptions = SegmentOptions(), workspace=None):
+                 options: SegmentOptions = SegmentOptions(),
+                 caches: PlannerCaches | None = None):
         if not isinstance(solver, str) or solver not in SOLVERS:
             raise InvalidChoiceError("solver", solver, SOLVERS)
         if cell is not None and not isinstance(cell, CellConfig):
@@ -202,8 +206,8 @@ class Planner:
             raise ConfigError(f"options: expected SegmentOptions, got {type(options).__name__}")
         self.cell = cell or CellConfig()
         self.solver, self.options = solver, options
-        self.models = models_for(self.cell)
-        self.workspace = workspace
+        self.caches = PlannerCaches() if caches is None else caches
+        self.models = self.caches.models(self.cell)
 
     def chain(self, behavior: Behavior | str, task: Task, q, qd, *, done=(), guess=None,
               t0: float | None = None) -> Plan:
@@ -254,23 +258,22 @@ class Planner:
             q, qd = seg.q[-1], seg.qd[-1]
         plan = Plan.from_segments(behavior.name, self.cell, segments, location=task.location,
                                   heading=task.heading, cone=self.options.cone, status="failed")
-        return finish_plan(plan, failure, t0, self.cell)
+        return finish_plan(plan, failure, t0, self.cell, self.caches.meshes)
 
     def _solve(self, spec, task: Task, q, qd, stretch: bool, guess):
         def build(options):
-            return transcribe(spec, self.models, q, qd, options=options, task=task)
+            return transcribe(spec, self.models, q, qd, options=options, task=task,
+                              patterns=self.caches.patterns)
 
-        # without one of its own, solve_segment solves in the thread's
-        own = {} if self.workspace is None else {"workspace": self.workspace}
         if not stretch:
             nlp = build(self.options)
-            return nlp, solve_segment(nlp, self.solver, **own)
+            return nlp, solve_segment(nlp, self.solver, caches=self.caches)
         seed = None if guess is None else (lambda nlp: guess(spec.name, nlp, q, qd))
         stretched = getattr(guess, "stretched", None)  # atlas seeds know (Seeding.stretched)
         first = (lambda nlp: False) if stretched is None else \
             (lambda nlp: stretched(spec.name, nlp))
         return solve_stretched(build, self.options, self.solver, seed, stretch_first=first,
-                               **own)
+                               caches=self.caches)
 
 
 __all__ = ["SOLVERS", "Planner", "finish_plan", "solve_segment", "solve_stretched",

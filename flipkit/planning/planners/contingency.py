@@ -1,16 +1,15 @@
 """Contingency flips: the re-plans that sense-plan-act is likely to need, made ahead.
 
 After the scoop the cell measures where the burger lies on the blade and re-plans the flip
-(:func:`~flipkit.planning.planners.planner.replan_flip`). A robust plan lands every place
-within its scenarios' promise, and then the re-plan returns it at once. A place outside
-costs an SQP solve of flip and turn back (about 0.5 s on the 2-core machine) while the arm
-holds. Such places lie beyond the scenario set: in the tails of the placement and sensing
-errors, and where the scoop's unmodelled drift takes the burger, further along the blade or
-to its side (``docs/robust-flips.md`` §4). :class:`Contingencies` solves the flips for four
-such places before they are needed, which a cell can do while the arm goes to the burger
-and scoops (1.1 s). At the measurement it hands out the one that keeps its promise for the
-measured place (its scenarios' hull holds the place, or its own release and flight land it
-within its promise): a check of milliseconds instead of a solve.
+(:func:`~flipkit.planning.planners.planner.replan_flip`). A robust plan lands every place within
+its scenarios' promise, and then the re-plan returns it at once. A place outside costs an SQP
+solve of flip and turn back while the arm holds. Such places lie beyond the scenario set: in the
+tails of the placement and sensing errors, and where the scoop's unmodelled drift takes the
+burger, further along the blade or to its side (``docs/robust-flips.md`` §4).
+:class:`Contingencies` solves the flips for four such places before they are needed, which a
+cell can do while the arm goes to the burger and scoops. At the measurement it hands out the one
+that keeps its promise for the measured place (its scenarios' hull holds the place, or its own
+release and flight land it within its promise): a check of milliseconds instead of a solve.
 
 Every contingency is a re-plan as :func:`replan_flip` makes it (go to burger, scoop and
 pickup kept), solved and verified. Like every re-plan it is robust to the camera's error: it
@@ -18,7 +17,7 @@ lands the places 1 cm around its own, so it covers a patch of the blade, not a p
 that none of them covers is solved as before.
 
 A contingency may not be ready when the camera looks: the preparation starts with the plan,
-and its solves can outlast the 1.1 s of motion before the sense. The object records when
+and its solves can outlast the motion before the sense. The object records when
 each one became ready (``ready_s``, from the start of the preparation). Given ``sense_s``,
 the time of the sense on that clock, handing out a contingency that was not ready by then
 waits the rest of its solve, as a cell would wait for a solve under way. A plan that is
@@ -34,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flipkit.errors import ConfigError
-from flipkit.planning.planners.chain import Planner
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.inputs import check_replan
 from flipkit.planning.planners.planner import keeps_promise, replan_flip
 from flipkit.planning.plans.plan_file import Plan
@@ -65,11 +64,11 @@ def contingency_places(plan: Plan, margin=MARGIN) -> list[tuple[float, float]]:
     return [tuple(float(v) for v in np.clip(p, -half, half)) for p in places]
 
 
-def solve_contingency(job: tuple) -> Plan:
-    """``replan_flip(plan, place, solver=solver, keep=False)`` of ``job = (plan, place,
-    solver)`` (a worker)."""
+def solve_contingency(job: tuple, caches: PlannerCaches | None = None) -> Plan:
+    """``replan_flip(plan, place, solver=solver, keep=False, caches=caches)`` of ``job =
+    (plan, place, solver)`` (a worker's task gives no ``caches``: its own, for the task)."""
     plan, place, solver = job
-    return replan_flip(plan, place, solver=solver, keep=False)
+    return replan_flip(plan, place, solver=solver, keep=False, caches=caches)
 
 
 @dataclass
@@ -85,6 +84,9 @@ class Contingencies:
         ready_s: For each of ``flips``, when it was ready (s after the preparation began).
         sense_s: When the camera looks, on the same clock (s); ``None``: every contingency
             counts as ready (module docstring).
+        caches: What the re-plans made here reuse
+            (:class:`~flipkit.planning.planners.caches.PlannerCaches`): those of
+            :meth:`prepare` without an executor, and the solve of a place none covers.
     """
 
     plan: Plan
@@ -93,16 +95,19 @@ class Contingencies:
     wall_time_s: float
     ready_s: list = field(default_factory=list)
     sense_s: float | None = None
+    caches: PlannerCaches = field(default_factory=PlannerCaches, repr=False, compare=False)
 
     @classmethod
     def prepare(cls, plan: Plan, places=None, *, solver: str = "auto",
-                executor=None) -> "Contingencies":
+                executor=None, caches: PlannerCaches | None = None) -> "Contingencies":
         """Solve the re-plans of ``plan`` for ``places`` (default
-        :func:`contingency_places`), on ``executor`` (an Executor) if given.
+        :func:`contingency_places`), on ``executor`` (an Executor) if given, else here with
+        ``caches`` (default: new ones, kept by the result).
 
         Raises:
             ConfigError: ``plan`` is not a solved flip plan, or a place is off the blade.
         """
+        caches = PlannerCaches() if caches is None else caches
         t0 = time.perf_counter()
         places = contingency_places(plan) if places is None else [
             tuple(float(v) for v in check_replan(plan, "flip", p)[1]) for p in places]
@@ -110,7 +115,7 @@ class Contingencies:
         made, ready = [None] * len(jobs), [0.0] * len(jobs)
         if executor is None:
             for i, job in enumerate(jobs):
-                made[i], ready[i] = solve_contingency(job), time.perf_counter() - t0
+                made[i], ready[i] = solve_contingency(job, caches), time.perf_counter() - t0
         else:
             futures = {executor.submit(solve_contingency, job): i for i, job in enumerate(jobs)}
             for future in cf.as_completed(futures):
@@ -119,7 +124,7 @@ class Contingencies:
         ok = [i for i, m in enumerate(made) if m.status == "solved"]
         return cls(plan, [(places[i], made[i]) for i in ok],
                    [places[i] for i in range(len(made)) if i not in ok],
-                   time.perf_counter() - t0, [ready[i] for i in ok])
+                   time.perf_counter() - t0, [ready[i] for i in ok], caches=caches)
 
     def wait_s(self, k: int) -> float:
         """How long (s) handing out contingency ``k`` at the sense waits for its solve."""
@@ -137,7 +142,7 @@ class Contingencies:
             ConfigError: ``on_blade`` is off the blade.
         """
         cell, xy = check_replan(self.plan, "flip", on_blade)
-        k = self._lookup(xy, Planner(cell).models)
+        k = self._lookup(xy, self.caches.models(cell))
         return None if k is None else self.flips[k][1]
 
     def _lookup(self, xy, models) -> int | None:
@@ -160,12 +165,12 @@ class Contingencies:
         if plan is not self.plan:
             raise ConfigError("these contingencies were made for another plan")
         cell, xy = check_replan(plan, "flip", on_blade)
-        models = Planner(cell).models
+        models = self.caches.models(cell)
         if keeps_promise(plan, xy, models):
             return plan
         k = self._lookup(xy, models)
         if k is None:
-            return replan_flip(plan, xy, keep=False)
+            return replan_flip(plan, xy, keep=False, caches=self.caches)
         time.sleep(self.wait_s(k))  # the solve still under way (module docstring)
         return self.flips[k][1]
 

@@ -38,6 +38,7 @@ from flipkit.errors import ConfigError, FlipkitError, UnreachableError
 from flipkit.model.goal_check import check_goal
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import (MAX_BATCH, check_approach_height, resolve_heading,
                                               check_joint_vector, check_on_blade,
@@ -50,7 +51,8 @@ REST_TOL = 1e-6  # rad: a motion ending this close to the rest configuration end
 
 def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str = "auto",
                    q_start=None, yaw: float = 0.0,
-                   options: SegmentOptions = SegmentOptions()) -> Plan:
+                   options: SegmentOptions = SegmentOptions(),
+                   caches: PlannerCaches | None = None) -> Plan:
     """Carry the burger on a flat spatula from ``start`` to ``goal`` (paper eq. 9), at rest
     at both ends.
 
@@ -66,13 +68,16 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
             limits and, if ``start`` is given too, put the blade within 1 mm of it.
         yaw: Heading o_z of the spatula (rad).
         options: Transcription options.
+        caches: What the planner reuses and adds to
+            (:class:`~flipkit.planning.planners.caches.PlannerCaches`): pass the same one to
+            every plan of a loop; default: new ones, for this plan alone.
 
     Raises:
         ConfigError: Malformed input. UnreachableError: A position outside the task area or
             out of reach. InvalidChoiceError: Unknown solver.
     """
     t0 = time.perf_counter()
-    planner = Planner(cell, solver=solver, options=options)
+    planner = Planner(cell, solver=solver, options=options, caches=caches)
     cell, robot = planner.cell, planner.models.loaded
     p_goal = check_position("translate goal", goal, cell)
     yaw = real_number("yaw", yaw, "rad")
@@ -92,7 +97,7 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
                 raise ConfigError(f"start configuration puts the blade {gap * 1e3:.1f} mm from "
                                   "the start position; give one of them")
     o = planner.options
-    try:  # every IK branch against the NLP's joint bounds and the cell, before any NLP (~1 ms)
+    try:  # every IK branch against the NLP's joint bounds and the cell, cheaper than any NLP
         check_goal(robot, planner.models.shapes, cell, p_goal, (0.0, 0.0, yaw), q_start=q0,
                    singularity_margin=o.singularity_margin, clearance=o.arm_clearance)
     except UnreachableError as exc:
@@ -107,7 +112,8 @@ def plan_translate(start, goal, *, cell: CellConfig | None = None, solver: str =
 def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
               solver: str = "auto", land=None, on_blade=None,
               options: SegmentOptions = SegmentOptions(), atlas=None,
-              approach_height=None, heading=None) -> Plan:
+              approach_height=None, heading=None,
+              caches: PlannerCaches | None = None) -> Plan:
     """Pick up and flip the burger at ``location``: the five subbehaviours of
     :data:`~flipkit.behaviors.library.FLIP_NAMES` chained by (29) — each segment starts at the
     previous segment's final (q, q̇).
@@ -122,7 +128,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
             when it is released; default ``None``: where the scoop model
             (:func:`~flipkit.behaviors.pick.scoop_scenarios`) says the planned scoop leaves it, and with
             ``options.robust`` every scenario of its spread lands too.
-        cell, solver, options: As :func:`plan_translate`.
+        cell, solver, options, caches: As :func:`plan_translate`.
         atlas: A warm-start :class:`~flipkit.planning.planners.atlas.Atlas` built for ``cell`` and
             ``options``: each segment starts from the atlas's interpolated solution (and
             from its own initial guess if that fails); ``None`` (default): cold starts.
@@ -146,7 +152,7 @@ def plan_flip(location, q_start=None, qd_start=None, *, cell: CellConfig | None 
         AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
     t0 = time.perf_counter()
-    planner = Planner(cell, solver=solver, options=options)
+    planner = Planner(cell, solver=solver, options=options, caches=caches)
     cell = planner.cell
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, location)
@@ -216,13 +222,14 @@ def sensed_scenarios(cell: CellConfig, on_blade,
 
 def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
                 options: SegmentOptions = SegmentOptions(), keep: bool = True,
-                sensing: SensingUncertainty = SensingUncertainty()) -> Plan:
+                sensing: SensingUncertainty = SensingUncertainty(),
+                caches: PlannerCaches | None = None) -> Plan:
     """Re-plan pickup, flip and turn back of a solved flip plan for a burger measured at
     ``on_blade`` on the blade after the scoop (sense, plan, act).
 
     The scoop ends at rest with the blade flat on the grill and the burger on it, so the cell
-    can measure where the burger lies on the blade (a scoop drags it forward, by 2–7 cm in
-    simulation) and wait there while this runs. Go to burger, scoop and pickup are kept (the
+    can measure where the burger lies on the blade (a scoop drags it forward by centimetres)
+    and wait there while this runs. Go to burger, scoop and pickup are kept (the
     pickup's constraints do not depend on where the burger lies); the flip is solved again
     with the release state of a burger at ``on_blade``, to the plan's landing target, then the
     turn back from its end, each SQP started from the plan's own solution of that segment (the
@@ -240,7 +247,8 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
 
     Args:
         plan: A solved flip plan. on_blade: (x, y) of the burger's centre in the blade frame
-            (m). solver, options: As :func:`plan_flip` (``r_land`` from the plan's landing).
+            (m). solver, options, caches: As :func:`plan_flip` (``r_land`` from the plan's
+            landing).
         keep: Return ``plan`` itself where it already lands the measured place (default);
             ``False`` always solves.
         sensing: The camera's error that the re-plan's scenarios span.
@@ -252,7 +260,8 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
     cell, on_blade = check_replan(plan, "flip", on_blade)
     flip = plan.step("release")
     planner = Planner(cell, solver=solver,
-                      options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone))
+                      options=replace(options, r_land=flip.landing["r_land"], cone=plan.cone),
+                      caches=caches)
     if keep and keeps_promise(plan, on_blade, planner.models):
         return plan
     done = [s for s in plan.segments if s.name in PICKUP_AND_FLIP.kept()]
@@ -273,7 +282,7 @@ def replan_flip(plan: Plan, on_blade, *, solver: str = "auto",
 
 def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solver: str = "auto",
                progress: bool = True, options: SegmentOptions = SegmentOptions(),
-               executor=None, atlas=None) -> list[Plan]:
+               executor=None, atlas=None, caches: PlannerCaches | None = None) -> list[Plan]:
     """Pickup-and-flip plans for up to :data:`MAX_BATCH` burgers, one after the other.
 
     Burger k starts where the last *solved* plan ended (a solved flip ends at q_home at
@@ -282,7 +291,9 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
     one. Since every solved plan ends at q_home, the burgers after the first are independent:
     with an ``executor`` (worker processes or Dask) they are planned at once, from q_home, and
     a burger whose start that assumption got wrong (every plan before it failed, and the
-    batch started elsewhere) is planned again, here, from the right start.
+    batch started elsewhere) is planned again, here, from the right start. The burgers are
+    dealt to one task per worker (:func:`plan_flips`; the executor's ``workers``, else one
+    task per burger), so that each worker compiles the subproblems once.
 
     Args:
         locations: Burger locations p^b (m), in order.
@@ -291,12 +302,13 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
         cell, solver, options, atlas: As :func:`plan_flip` (``atlas`` warm-starts every
             burger's chain; default cold starts).
         executor: Optional :class:`concurrent.futures.Executor` to plan in parallel.
+        caches: As :func:`plan_flip`, for the burgers planned in this process.
 
     Raises:
         ConfigError: No location, more than :data:`MAX_BATCH`, or a malformed start.
         UnreachableError: A location off the grill (named by its index, from 1).
     """
-    planner = Planner(cell, solver=solver, options=options)  # checks the solver
+    planner = Planner(cell, solver=solver, options=options, caches=caches)  # checks the solver
     cell, home = planner.cell, planner.models.bare.q_home
     locs = list(locations)
     if not 1 <= len(locs) <= MAX_BATCH:
@@ -309,9 +321,9 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
             raise UnreachableError(f"burger {k}: {exc}") from None
     check_atlas(atlas, cell, options)
     kw = {"cell": cell, "solver": solver, "options": options, "atlas": atlas}
-    ahead = None if executor is None else [
-        executor.submit(plan_flip, pb, q_start if k == 0 else home, None, **kw)
-        for k, pb in enumerate(checked)]
+    ahead = None if executor is None else _deal(executor, [
+        (pb, q_start if k == 0 else home) for k, pb in enumerate(checked)], kw)
+    kw = {**kw, "caches": planner.caches}  # the burgers planned here (the workers' kw stays)
     q, qd, plans = q_start, None, []
     bar = tqdm(checked, desc="burgers", unit="burger", disable=not progress)
     for k, pb in enumerate(bar, 1):
@@ -331,16 +343,46 @@ def plan_batch(locations, q_start=None, *, cell: CellConfig | None = None, solve
     return plans
 
 
-def _ahead_or_here(future, k: int, pb, q, qd, kw: dict) -> Plan:
-    """Burger ``k``'s plan made ahead by a worker, or, if that worker died (its pool broke:
-    the OOM killer, a crash in native code, a signal), made here from the same start, with
-    one line on stderr."""
+def plan_flips(jobs, kw: dict) -> list:
+    """:func:`plan_flip` of each ``(location, q_start)`` of ``jobs`` with the keywords ``kw``,
+    all with one :class:`~flipkit.planning.planners.caches.PlannerCaches` (a worker's task of
+    :func:`plan_batch`). A job that raises :class:`~flipkit.errors.FlipkitError` gets the
+    error in its place, so that the others' plans are kept."""
+    caches, out = PlannerCaches(), []
+    for location, q_start in jobs:
+        try:
+            out.append(plan_flip(location, q_start, None, caches=caches, **kw))
+        except FlipkitError as exc:
+            out.append(exc)
+    return out
+
+
+def _deal(executor, jobs: list, kw: dict) -> list[tuple]:
+    """Burger k's ``(future, place)``: the ``jobs`` dealt in turn to one :func:`plan_flips`
+    task per worker of ``executor`` (its ``workers``; else one task per job)."""
+    tasks = max(1, min(len(jobs), getattr(executor, "workers", None) or len(jobs)))
+    futures = [executor.submit(plan_flips, jobs[j::tasks], kw) for j in range(tasks)]
+    return [(futures[k % tasks], k // tasks) for k in range(len(jobs))]
+
+
+def _ahead_or_here(ahead: tuple, k: int, pb, q, qd, kw: dict) -> Plan:
+    """Burger ``k``'s plan made ahead by a worker (``ahead``: its task's future and its place
+    there), or, if that worker died (its pool broke: the OOM killer, a crash in native code,
+    a signal), made here from the same start, with one line on stderr.
+
+    Raises:
+        FlipkitError: The worker's planning of burger ``k`` raised it.
+    """
+    future, place = ahead
     try:
-        return future.result()
+        plan = future.result()[place]
     except cf.BrokenExecutor as exc:
         tqdm.write(f"flipkit: the worker planning burger {k} died ({type(exc).__name__}); "
                    "planning it in this process", file=sys.stderr)
         return plan_flip(pb, q, qd, **kw)
+    if isinstance(plan, FlipkitError):
+        raise plan
+    return plan
 
 
 SUMMARY_HEADER = ("burger", "location_m", "status", "solve_time_s", "iterations",
@@ -372,5 +414,6 @@ def format_summary(rows) -> str:
 
 
 __all__ = ["MAX_BATCH", "REST_TOL", "SUMMARY_HEADER", "covers", "format_summary", "keeps_promise",
-           "landing_miss", "plan_batch", "plan_flip", "plan_translate", "promise", "replan_flip",
+           "landing_miss", "plan_batch", "plan_flip", "plan_flips", "plan_translate", "promise",
+           "replan_flip",
            "sensed_scenarios", "summary_table"]

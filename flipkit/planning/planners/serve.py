@@ -24,6 +24,7 @@ from flipkit.config import CellConfig
 from flipkit.errors import FlipkitError, UnreachableError
 from flipkit.model.ik import solve_pose
 from flipkit.planning.planners.atlas import check_atlas, seeding
+from flipkit.planning.planners.caches import PlannerCaches
 from flipkit.planning.planners.chain import Planner
 from flipkit.planning.planners.inputs import (check_approach_height, check_on_blade,
                                               check_replan, check_start, resolve_heading)
@@ -33,7 +34,7 @@ from flipkit.planning.plans.plan_file import Plan
 def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellConfig | None = None,
                solver: str = "auto", on_blade=None,
                options: SegmentOptions = SegmentOptions(), atlas=None,
-               approach_height=None, heading=None) -> Plan:
+               approach_height=None, heading=None, caches: PlannerCaches | None = None) -> Plan:
     """Serve the burger at ``burger`` to ``table_spot``: go to burger, scoop, pickup (eqs.
     22–25), carry with the friction cone throughout, place by a tilt-off, return home.
 
@@ -57,7 +58,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
             segments, the same NLPs) start from its interpolated solutions, carry, place
             and return home from their own guesses; ``None`` (default): cold starts.
         heading: The scoop heading (rad), as :func:`~flipkit.planning.planners.planner.plan_flip`.
-        approach_height: As :func:`~flipkit.planning.planners.planner.plan_flip`.
+        approach_height, caches: As :func:`~flipkit.planning.planners.planner.plan_flip`.
 
     Returns:
         The :class:`~flipkit.planning.plans.plan_file.Plan`, behaviour ``serve``: status
@@ -71,7 +72,7 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
         AtlasError: ``atlas`` was built for other options, another cell or other NLPs.
     """
     t0 = time.perf_counter()
-    planner = Planner(cell, solver=solver, options=options)
+    planner = Planner(cell, solver=solver, options=options, caches=caches)
     cell, models = planner.cell, planner.models
     check_atlas(atlas, cell, options)
     pb = tg.check_location(cell, burger)
@@ -94,27 +95,29 @@ def plan_serve(burger, table_spot, q_start=None, qd_start=None, *, cell: CellCon
 
 
 def replan_serve(plan: Plan, on_blade, *, solver: str = "auto",
-                 options: SegmentOptions = SegmentOptions()) -> Plan:
+                 options: SegmentOptions = SegmentOptions(),
+                 caches: PlannerCaches | None = None) -> Plan:
     """Re-plan place and return home of a solved serve plan for a burger measured at
     ``on_blade`` on the blade during the carry (sense, plan, act; as
     :func:`~flipkit.planning.planners.planner.replan_flip`): the re-plan starts where the
     planned carry ends, at rest with the blade flat above the table, so it can run while the
     carry finishes (a cook's serves, :mod:`flipkit.simulation.cook_blade`) or while the arm
-    waits there (``flipkit validate``'s serve trials). Go to burger, scoop, pickup and carry are kept; the place is moved so that the
-    burger where it really lies comes to rest on the spot. (Sensed after the scoop instead, a
-    burger that shifted on the blade during the pickup and carry was placed 5.5 cm off in
-    MuJoCo.)
+    waits there (``flipkit validate``'s serve trials). Go to burger, scoop, pickup and carry
+    are kept; the place is moved so that the burger where it really lies comes to rest on the
+    spot. The burger is sensed at the carry's end, not after the scoop, because it can still
+    shift on the blade during the pickup and carry.
 
     Args:
         plan: A solved serve plan. on_blade: (x, y) of the burger's centre in the blade frame
-            (m). solver, options: As :func:`plan_serve` (the cone form from the plan).
+            (m). solver, options, caches: As :func:`plan_serve` (the cone form from the plan).
 
     Raises:
         ConfigError: ``plan`` is not a solved serve plan, or ``on_blade`` is off the blade.
     """
     t0 = time.perf_counter()
     cell, on_blade = check_replan(plan, "serve", on_blade)
-    planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone))
+    planner = Planner(cell, solver=solver, options=replace(options, cone=plan.cone),
+                      caches=caches)
     done = [s for s in plan.segments if s.name in SERVE.kept()]
     task = Task(location=np.asarray(plan.burger["location"], float), spot=table_spot(plan),
                 on_blade=on_blade, heading=plan.burger["heading"])

@@ -26,8 +26,8 @@ def check_array(name: str, value, shape: tuple) -> np.ndarray:
     return arr
 
 
-# Nodes per segment read: the planners use 21 (N = 20), the scaling study up to 81; verify
-# takes about 0.25 ms a node, so a file cannot make it run for minutes.
+# Nodes per segment read: the planners use 21 (N = 20), the scaling study up to 81; verify's
+# time grows with the nodes, and this bound keeps a file from making it run for minutes.
 MAX_NODES = 1001
 
 

@@ -108,7 +108,7 @@ from flipkit.transcription.layout import Layout
 
 
 def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
-                where: str = "plan") -> VerificationReport:
+                where: str = "plan", meshes=None) -> VerificationReport:
     """Check every segment of ``plan`` and the joints between them, in the cell it will run in.
 
     Args:
@@ -121,6 +121,10 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
         cell: The cell the plan will run in (:class:`~flipkit.config.CellConfig`); default
             the defaults. The plan's record of its cell must match it.
         where: How a refusal names the plan (its file).
+        meshes: The arm's link meshes, loaded before
+            (:class:`~flipkit.model.collision.ArmMeshes`; a planner passes its own); default:
+            loaded from the plan's URDF for this check. The check places them with its own
+            models of the plan's arm.
 
     Raises:
         CellMismatchError: The plan's record of its cell differs from ``cell`` (one line
@@ -151,7 +155,7 @@ def verify_plan(plan: Plan, tol: float = TOL, space=None, *, cell=None,
         bodies = tuple(seg.payload)
         if bodies not in robots:
             robots[bodies] = plan.robot_for(seg, cell)
-        geometry = geometry or CellGeometry(robots[bodies], cell)
+        geometry = geometry or CellGeometry(robots[bodies], cell, meshes)
         view = _view(report, k, seg, robots[bodies], plan, cell, tol, geometry)
         for check in CHECKS:  # every independent check, in order (verify_checks)
             check.run(view)

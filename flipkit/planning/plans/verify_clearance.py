@@ -25,12 +25,13 @@ import coal
 
 
 class CellGeometry:
-    """The arm's shapes and the cell's boxes as a pinocchio GeometryModel of ``robot``."""
+    """The arm's shapes and the cell's boxes as a pinocchio GeometryModel of ``robot``
+    (the link meshes from ``meshes``, an :class:`~flipkit.model.collision.ArmMeshes`, if
+    given, else loaded for this geometry)."""
 
-    def __init__(self, robot, cell):
-
+    def __init__(self, robot, cell, meshes=None):
         self.robot, self.cell = robot, cell
-        arm = ArmShapes(robot, cell)
+        arm = ArmShapes(robot, cell, meshes)
         self.shape_names, self.box_names = arm.names, arm.box_names
         # bounding spheres (shape frame) and the boxes' corners, for the lower bounds of
         # :meth:`distances`
@@ -54,7 +55,7 @@ class CellGeometry:
         Args:
             q: Configuration (rad).
             floor: Pairs whose bounding sphere lies at least ``floor`` (m) from the box are
-                not measured: they get that lower bound (≥ ``floor``) instead of their
+                not queried: they get that lower bound (≥ ``floor``) instead of their
                 distance. A check of d ≥ floor reads the same either way; the default
                 measures every pair.
         """

@@ -15,7 +15,7 @@ from flipkit.fileio import write_text
 
 TOL = 1e-5  # scaled units: 10 × SQPOptions.tol (verify's module docstring)
 # scaled units: tighter than TOL down to 1e-9, looser at most 10 ×, so that no pose or burger
-# centimetres off passes (at 1, a burger moved 5 cm did)
+# centimetres off passes (a tolerance near 1 lets one pass)
 TOL_RANGE = (1e-9, 1e-4)
 
 GROUPS = {"time_grid": "s", "dynamics": "N·m", "defects": "rad | rad/s", "q_limits": "rad",

@@ -14,7 +14,30 @@ from flipkit.errors import ConfigError, NoSymbolicFormError
 from flipkit.transcription.constraints.registry import BLOCK_TERMS, Check
 from flipkit.transcription.layout import Evaluation, Layout
 
-_PATTERNS: dict = {}  # Block._pattern's cache: (block type, key) -> (rows, cols), read-only
+class Patterns:
+    """Sparsity patterns of constraint blocks by (block type, key), each filled by the first
+    block that asks for it and shared, read-only, by later blocks with the same key.
+
+    A chain builds the same patterns for every burger, and filling them is a large share of
+    a segment's build: whoever transcribes many segments keeps one and passes it in their
+    :class:`~flipkit.transcription.layout.Layout` (``patterns``), as the planners do
+    (:class:`~flipkit.planning.planners.caches.PlannerCaches`).
+    """
+
+    def __init__(self):
+        self._filled: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+
+    def get(self, key: tuple, fill):
+        """(rows, cols) of ``key``, from ``fill()`` (which returns them) the first time."""
+        if key not in self._filled:
+            rows, cols = fill()
+            rows.setflags(write=False)
+            cols.setflags(write=False)
+            self._filled[key] = rows, cols
+        return self._filled[key]
+
+    def __len__(self) -> int:
+        return len(self._filled)
 
 
 class Block:
@@ -49,19 +72,20 @@ class Block:
         self.m = 0
 
     def _pattern(self, key: tuple, fill) -> None:
-        """Fill the pattern by ``fill()`` (calls of :meth:`_add`) once per process for each
-        ``key`` — everything the pattern depends on — and reuse it (read-only) for later blocks
-        with the same key: a chain builds the same patterns for every burger, and filling
-        them is a large share of a segment's build."""
-        key = (type(self).__name__, *key)
-        if key not in _PATTERNS:
+        """Fill the pattern by ``fill()`` (calls of :meth:`_add`), or take it from the
+        layout's :class:`Patterns` (if it has them) where a block of this type with the same
+        ``key`` — everything the pattern depends on — filled it before."""
+        patterns = self.layout.patterns
+        if patterns is None:
             fill()
-            rows, cols = (np.concatenate(a) if a else np.zeros(0, int)
-                          for a in (self._rows, self._cols))
-            rows.setflags(write=False)
-            cols.setflags(write=False)
-            _PATTERNS[key] = rows, cols
-        rows, cols = _PATTERNS[key]
+            return
+
+        def filled():
+            fill()
+            return tuple(np.concatenate(a) if a else np.zeros(0, int)
+                         for a in (self._rows, self._cols))
+
+        rows, cols = patterns.get((type(self).__name__, *key), filled)
         self._rows, self._cols = [rows], [cols]
 
     def _add(self, row0: int, nrows: int, cols) -> None:

@@ -13,14 +13,13 @@ down. The release time is then t_r = r T / N, a variable through T.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
 from flipkit.errors import ConfigError
-from flipkit.model.flight import (TILT_MIN_DEG, clearance_function, gravity_magnitude,
-                                  landing_function, landing_parameters, predict_landing)
+from flipkit.model.flight import (FLIGHT_CLEARANCE, LANDING, TILT_MIN_DEG, gravity_magnitude,
+                                  landing_parameters, predict_landing)
 from flipkit.transcription.constraints.base import Block
 from flipkit.transcription.constraints.registry import Check
 from flipkit.transcription.layout import Evaluation
@@ -55,7 +54,7 @@ def _landing_rows(ev, r: int, pars):
     x, R, dq, dqd = _release_inputs(ev, r)
     values, entries = [], []
     for par in pars:
-        y, J = (np.asarray(a) for a in landing_function()(x, R, par))
+        y, J = (np.asarray(a) for a in LANDING(x, R, par))
         values.append(y[:2, 0])
         entries.append(np.hstack([J[:2] @ dq, J[:2] @ dqd]).ravel())
     return np.concatenate(values), np.concatenate(entries)
@@ -172,6 +171,8 @@ class ScenarioLanding(Block):
 class FlightClearance(Block):
     """After the release at node r, the blade plane at nodes r+1..N separates the blade from
     the flying burger by at least ``margin`` (m) (see :func:`~flipkit.model.flight.clearance_function`).
+    The block keeps :data:`~flipkit.model.flight.FLIGHT_CLEARANCE` mapped over its nodes,
+    so that one CasADi call evaluates every node.
 
     Args:
         layout: Variable layout. release: Release node r. margin: Clearance (m) per node
@@ -194,6 +195,7 @@ class FlightClearance(Block):
                                              [layout.T_index]]))
         self.m = len(self.nodes)
         self._finish(margin, np.inf, 1.0)
+        self._mapped = FLIGHT_CLEARANCE.map(self.m) if self.m else None
 
     check = Check(("flight_clearance",))
     no_symbolic_form = NO_SX
@@ -210,7 +212,7 @@ class FlightClearance(Block):
         X[12] = ds * ev.T
         X[13:16] = st.p.T
         Ri = st.R.transpose(1, 0, 2).reshape(3, 3 * n)  # the nodes' rotations side by side
-        d, J = _mapped_clearance(n)(X, R_r, Ri, self.par)  # every node in one call
+        d, J = self._mapped(X, R_r, Ri, self.par)  # every node in one call
         J = np.asarray(J).reshape(n, 19)
         dp, Jw = st.dp_dq, st.Jw  # (n, 3, nq)
         jac = np.concatenate([J[:, :12] @ dq_r, J[:, :12] @ dqd_r,
@@ -219,9 +221,3 @@ class FlightClearance(Block):
                               (J[:, 12] * ds)[:, None]], axis=1)
         return np.asarray(d).ravel(), jac.ravel()
 
-
-@functools.lru_cache(maxsize=None)
-def _mapped_clearance(n: int):
-    """:func:`~flipkit.model.flight.clearance_function` mapped over n blade poses (one CasADi
-    call instead of n, a third of the time per flip evaluation)."""
-    return clearance_function().map(n)
