@@ -99,8 +99,9 @@ def resample(plan: Plan, rate: float, *, force: bool = False):
     # A grid time within MIN_GAP periods of a node gives way to the node: two samples a few
     # nanoseconds apart (a node just off the grid) are one time stamp once written, and a
     # spline through them asks for unbounded acceleration.
-    near = np.abs(t[:, None] - knots[None, :]).min(axis=1) < MIN_GAP / rate
-    t = np.union1d(t[~near], knots)
+    k = np.clip(np.searchsorted(knots, t), 1, len(knots) - 1)  # the nodes either side
+    gap = np.minimum(np.abs(t - knots[k - 1]), np.abs(knots[k] - t))
+    t = np.union1d(t[gap >= MIN_GAP / rate], knots)
     q, qd, _ = evaluate(plan, t)
     return t, q, qd
 
