@@ -12,8 +12,10 @@ import pytest
 
 from flipkit.config import CellConfig
 from flipkit.planning.kitchen.clearance import (CookConflictError, clear_cook, free_landing,
+                                               landing_candidates,
                                                lying_burgers)
 from flipkit.planning.kitchen.cook import CookBurger
+from flipkit.planning.kitchen.turns import MAX_TRIES
 from flipkit.planning.kitchen.sweep import (Footprint, Lying, approach_height,
                                            blade_rectangle, blade_section, blade_sections, default_margin, meetings,
                                            point_polygon_distance, point_segment_distance,
@@ -231,17 +233,24 @@ def test_a_moved_landing_keeps_the_landed_burger_inside_the_grill_area():
     assert min(np.hypot(0.0, y + 0.20) for y in edge) < np.hypot(spot[0] - back, spot[1] + 0.20)
 
 
-def test_a_spot_nearer_the_edge_is_offered_when_no_inner_spot_is_clear():
-    """A grill area 2.5 cm deep has no spot 1.5 cm inside both its edges: the nearest clear
-    spot is offered all the same, not None."""
+def test_no_spot_is_offered_where_the_burger_could_land_off_the_grill_area():
+    """A grill area 2.5 cm deep has no spot 1.5 cm (the landing spread) inside both its
+    edges: no spot is offered, though clear spots lie on its edges (a burger landed from one
+    could lie where no serve may be planned), and the 3 cm deep area offers one."""
     back = CELL.grill.x_range[1]
-    cell = dataclasses.replace(CELL, grill=dataclasses.replace(CELL.grill,
-                                                               x_range=(back - 0.025, back)))
-    tl, fps = fake_timeline((back, -0.20), (back, -0.20), (back, -0.20))
-    spot = free_landing("b1", tl, cell, fps.__getitem__)
     blade = blade_at(back, -0.20).blade[0][2]
-    assert spot is not None and cell.grill.contains(spot)
-    assert point_polygon_distance(spot, blade) >= R + 0.015 + M - 1e-9
+    for depth, offered in ((0.025, False), (0.030, True)):
+        cell = dataclasses.replace(CELL, grill=dataclasses.replace(CELL.grill,
+                                                                   x_range=(back - depth, back)))
+        tl, fps = fake_timeline((back, -0.20), (back, -0.20), (back, -0.20))
+        spot = free_landing("b1", tl, cell, fps.__getitem__)
+        edge = [(x, y) for x, y in landing_candidates(cell, M / 2)
+                if point_polygon_distance((x, y), blade) >= R + 0.015 + M]
+        assert edge  # clear spots exist on the edges either way
+        assert (spot is not None) == offered
+        if offered:
+            assert spot[0] == pytest.approx(back - 0.015)
+            assert point_polygon_distance(spot, blade) >= R + 0.015 + M - 1e-9
 
 
 def test_clear_cook_moves_a_landing_then_refuses_what_no_landing_avoids(monkeypatch):
@@ -308,32 +317,48 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
     with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped.*every "
                                                 "scoop heading tried"):
         clear_cook(lambda lands, headings: schedule(lands, headings, moves=False), CELL)
-    # two other landing spots, then the headings within 60° of +x: b2's radial heading
-    # (−31°) turned by −15°, +15° and +30° (−30° is past the limit); the toss is fixed here
-    assert len(calls) == 6 and len({tuple(c.get("b2", ())) for c in calls}) == 3
+    # two other landing spots, then MAX_TRIES turned headings (the toss is fixed here)
+    assert len(calls) == 3 + MAX_TRIES and len({tuple(c.get("b2", ())) for c in calls}) == 3
 
 
-def test_a_scoop_that_meets_a_dropped_burger_is_turned_away_from_it(monkeypatch):
-    """b2's scoop passes over b1 while b1 still lies where it was dropped: the cook turns
-    b2's scoop heading 15° away from b1 (b1 lies to the left of b2's radial heading) and
-    plans again; the turned scoop keeps clear."""
+def test_a_scoop_that_meets_a_dropped_burger_is_turned_to_the_smallest_clear_turn(monkeypatch):
+    """b2's scoop passes 1 cm inside b1's clearance while b1 still lies where it was
+    dropped: the cook ranks b2's headings by its footprint turned about b2 and plans the
+    smallest turn predicted clear; here the fake plans' footprints are exactly the turned
+    ones, so that plan keeps clear, while every smaller turn meets b1."""
     import math
 
     import flipkit.planning.kitchen.clearance as clearance
     from flipkit.behaviors.targets import default_heading
+    from flipkit.planning.kitchen.heading_model import turned_footprint
+    from flipkit.planning.kitchen.turns import Turns
 
+    b1, b2 = np.array([0.64, -0.33]), np.array([0.75, -0.45])
+    u = (b2 - b1) / np.linalg.norm(b2 - b1)
+    n = np.array([-u[1], u[0]])
+    tip = b1 + (R + M - 0.01) * (u + n) / math.sqrt(2)  # 1 cm inside b1's clearance
+    square = tip + 0.005 * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
+    base = Footprint(blade=[(1.0, "scoop", square)])
+    psi0 = default_heading(CELL, (*b2, 0.0))
     seen = []
 
     def schedule(lands, headings):
-        seen.append(dict(headings))  # turned, b2's blade passes beside b1
-        return b1_unflipped(fps, blade_at(0.80, -0.10, t=1.0) if "b2" in headings else None)
+        seen.append(dict(headings))
+        turn = headings.get("b2", psi0) - psi0
+        return b1_unflipped(fps, turned_footprint(base, b2, turn))
+
+    def clear(turn):
+        return not meetings(turned_footprint(base, b2, turn), "flip:b2", 102.0,
+                            [Lying("b1", tuple(b1), 0.0, 1e9)], CELL)
 
     fps = {}
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
     timeline, lands, headings = clear_cook(schedule, CELL)
-    psi0 = default_heading(CELL, (0.75, -0.45, 0.0))
-    assert lands == {} and seen[0] == {}
-    assert headings == {"b2": pytest.approx(psi0 - math.radians(15.0))}
+    turns = [p - psi0 for p in Turns(CELL).candidates(b2)]
+    expected = next(t for t in turns if clear(t))
+    assert not clear(0.0) and lands == {} and seen[0] == {} and len(seen) == 2
+    assert headings == {"b2": pytest.approx(psi0 + expected)}
+    assert all(not clear(t) for t in turns if abs(t) < abs(expected) - 1e-9)
 
 
 def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():

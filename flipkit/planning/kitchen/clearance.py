@@ -35,6 +35,7 @@ import numpy as np
 from flipkit.behaviors.library import PICKUP_AND_FLIP, SERVE
 from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
+from flipkit.planning.kitchen.heading_model import predicted_overlap
 from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
 from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
 from flipkit.planning.kitchen.turns import CookConflictError, Turns
@@ -111,6 +112,20 @@ def cook_meetings(timeline, cell: CellConfig, footprints: Footprints | None = No
     return sorted(out, key=lambda ml: ml[0].t)
 
 
+def _turned_overlap(burger: str, timeline, cell: CellConfig, footprints: Footprints,
+                    margin: float | None) -> Callable[[float], float]:
+    """``turn (rad) -> m``: how deep ``burger``'s present flip, turned by that much about
+    its burger, would come inside the clearance of the burgers lying while it runs
+    (:func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`)."""
+    flip = next(m for m in timeline.motions if m.key == f"flip:{burger}")
+    fp = footprints(flip.plan)
+    rec = next(r for r in timeline.burgers if r.burger.burger == burger)
+    pb = (rec.burger.x, rec.burger.y)  # where the flip scoops it from: its drop place
+    others = [lie for lie in lying_burgers(timeline, cell, footprints) if lie.burger != burger]
+    return lambda turn: predicted_overlap(fp, pb, turn, flip.key, flip.start, others, cell,
+                                          margin)
+
+
 def landing_candidates(cell: CellConfig, step: float) -> np.ndarray:
     """Centres (n×2, m) on the grill, ``step`` apart."""
     g = cell.grill
@@ -126,11 +141,10 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
     moved with the spot) meets nobody; ``None`` if there is none. ``exclude``: spots
     already tried (nothing within ``margin`` of them is offered again).
 
-    Spots at least the flip's landing spread inside the grill area's edges come first: the
-    burger lands within that spread of its spot, so from such a spot its centre stays in the
-    area, where the grill's re-plan takes burgers from. A spot nearer an edge is offered only
-    when no such spot is clear; the burger may then land beyond the area, and its serve is the
-    one scheduled, not one re-planned for where it lies."""
+    Only spots at least the flip's landing spread inside the grill area's edges are offered:
+    the burger lands within that spread of its spot, so its centre stays in the area, where
+    its serve (and the grill's re-plan) takes burgers from. A spot nearer an edge could land
+    it where no serve may be planned."""
     margin = default_margin() if margin is None else margin
     r = cell.burger.diameter / 2
     motions = {m.key: m for m in timeline.motions if m.ok and m.event is not None}
@@ -143,7 +157,9 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
     t0, t1 = flip.event, serve.start if serve is not None else math.inf
     lying = lying_burgers(timeline, cell, footprints)
     P = landing_candidates(cell, margin / 2)
-    ok = np.ones(len(P), bool)
+    g, spread = cell.grill, radius - r  # the burger lands within its spread of the spot
+    ok = ((P[:, 0] >= g.x_range[0] + spread - 1e-12) & (P[:, 0] <= g.x_range[1] - spread + 1e-12)
+          & (P[:, 1] >= g.y_range[0] + spread - 1e-12) & (P[:, 1] <= g.y_range[1] - spread + 1e-12))
 
     def keep(passes):  # narrow the candidates still in to those ``passes(points)`` accepts
         idx = np.flatnonzero(ok)
@@ -183,11 +199,6 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
                      >= 2 * r + lie.spread + margin)
     if not ok.any():
         return None
-    g, spread = cell.grill, radius - r
-    inner = ((P[:, 0] >= g.x_range[0] + spread - 1e-12) & (P[:, 0] <= g.x_range[1] - spread + 1e-12)
-             & (P[:, 1] >= g.y_range[0] + spread - 1e-12) & (P[:, 1] <= g.y_range[1] - spread + 1e-12))
-    if (ok & inner).any():
-        ok &= inner
     drop = np.array([rec.burger.x, rec.burger.y])
     best = np.argmin(np.where(ok, np.hypot(*(P - drop).T), np.inf))
     return tuple(float(v) for v in P[best])
@@ -266,7 +277,7 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
         if round_ == max_rounds:
             raise CookConflictError(f"{found[0][0].describe()}; still after {max_rounds} "
                                     f"rounds of moving landing spots")
-        move, turn = [], {}
+        move, turn = {}, {}
         for meet, lie in found:
             kind, owner = meet.motion.split(":", 1)
             if lie.landed:
@@ -279,16 +290,15 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
             else:  # the scoop, or a toss moved twice: the flip is turned
                 turn.setdefault(owner, (meet, lie))
                 continue
-            if who not in move:
-                move.append(who)
+            move.setdefault(who, meet)
         for owner, (meet, lie) in turn.items():
-            turns.next(owner, lie, timeline, meet=meet)
-        for who in move:
+            turns.next(owner, lie, timeline, meet=meet,
+                       overlap=_turned_overlap(owner, timeline, cell, fps, margin))
+        for who, meet in move.items():
             spot = free_landing(who, timeline, cell, fps, margin,
                                 exclude=tried.get(who, []) + ([lands[who]] if who in lands
                                                                else []))
             if spot is None:
-                meet = next(m for m, lie in found if who in (lie.burger, m.motion.split(":")[1]))
                 raise CookConflictError(f"{meet.describe()}; no landing spot for burger {who} "
                                         f"keeps clear of the other burgers and motions")
             tried.setdefault(who, []).append(spot)

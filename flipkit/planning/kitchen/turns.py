@@ -3,23 +3,30 @@
 :func:`~flipkit.planning.kitchen.clearance.clear_cook` asks :class:`Turns` for a flip's next
 heading when its go to burger, scoop, pickup or toss meets a burger still lying where it was
 dropped (or when its plan fails at the heading it has). The candidates are the default
-heading turned by each of :data:`HEADING_STEPS`, away from
-the burger met first (the blade then sweeps farther from it), then toward it, each within
-±:data:`~flipkit.config.task.HEADING_LIMIT` of the world's +x.
+(radial) heading turned by each multiple of :data:`TURN_STEP` up to :data:`MAX_TURN` either
+way, within ±:data:`~flipkit.config.task.HEADING_LIMIT` of the world's +x. Each is ranked by
+the flip's footprint turned to it (:mod:`flipkit.planning.kitchen.heading_model`) against the
+burgers lying while it runs: those predicted clear first, the smallest turn first (the radial
+heading is the fastest scoop, ``docs/heading.md``), then the others by predicted depth. At
+most :data:`MAX_TRIES` headings are planned per burger: a plan costs about a second, and one
+that fails at a heading out of reach up to fifteen.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 
 from flipkit.behaviors.targets import default_heading
 from flipkit.config import CellConfig
-from flipkit.config.task import HEADING_LIMIT, HEADING_STEPS
+from flipkit.config.task import HEADING_LIMIT
 from flipkit.errors import FlipkitError
 
-
+TURN_STEP = math.radians(5.0)  # rad: turns the blade's far corner about 1.5 cm
+MAX_TURN = math.radians(30.0)  # rad: the atlas's widest turn (flipkit.config.task.HEADING_STEPS)
+MAX_TRIES = 4  # headings planned per burger beyond its first
 
 
 class CookConflictError(FlipkitError):
@@ -31,23 +38,33 @@ class Turns:
 
     Args:
         cell: The cell (its base gives the default headings).
-        steps: Turns (rad) from the default heading, tried in order on each side.
+        step, max_turn: The candidate turns (rad): multiples of ``step`` up to ``max_turn``.
+        max_tries: Headings planned per burger beyond its default.
     """
 
-    def __init__(self, cell: CellConfig, steps=HEADING_STEPS):
-        self.cell, self.steps = cell, tuple(float(s) for s in steps)
+    def __init__(self, cell: CellConfig, step: float = TURN_STEP, max_turn: float = MAX_TURN,
+                 max_tries: int = MAX_TRIES):
+        if not 0 < step <= max_turn:
+            raise FlipkitError(f"turn step {step} rad must lie in (0, max_turn {max_turn}]")
+        self.cell, self.max_tries = cell, int(max_tries)
+        n = int(round(max_turn / step))
+        self.turns = tuple(sorted((k * step for k in range(-n, n + 1) if k), key=abs))
         self.headings: dict[str, float] = {}
         self.tried: dict[str, list[float]] = {}
+        self.depths: dict[str, dict[float, float]] = {}  # burger -> heading -> predicted m
 
-    def candidates(self, xy, away: float) -> list[float]:
-        """The headings (rad) to try for a burger at ``xy`` (m): the default turned by each
-        step toward the side ``away`` (±1) first, then toward the other side, within
-        ±HEADING_LIMIT."""
-        psi0 = default_heading(self.cell, (*xy, 0.0))
-        out = [psi0 + side * s for side in (away, -away) for s in self.steps]
-        return [p for p in out if abs(p) <= HEADING_LIMIT + 1e-12]
+    def default(self, xy) -> float:
+        """The default heading (rad) of a burger at ``xy`` (m)."""
+        return default_heading(self.cell, (*xy, 0.0))
 
-    def next(self, burger: str, lie, timeline, *, meet=None, failed: bool = False) -> float:
+    def candidates(self, xy) -> list[float]:
+        """The headings (rad) a burger at ``xy`` (m) may be turned to, smallest turn first,
+        within ±HEADING_LIMIT."""
+        psi0 = self.default(xy)
+        return [psi0 + d for d in self.turns if abs(psi0 + d) <= HEADING_LIMIT + 1e-12]
+
+    def next(self, burger: str, lie, timeline, *, meet=None, failed: bool = False,
+             overlap: Callable[[float], float] | None = None) -> float:
         """Turn ``burger``'s flip to its next heading and return it (rad).
 
         Args:
@@ -55,32 +72,37 @@ class Turns:
                 burger its motion meets (``None`` when its plan failed). timeline: The cook's
                 timeline (where ``burger`` was dropped). meet: The meeting, for the message.
             failed: The flip's plan failed at its present heading.
+            overlap: ``turn (rad) -> m``: the predicted depth inside the other burgers'
+                clearance of the present plan turned by that much
+                (:func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`); without
+                it the candidates keep their order.
 
         Raises:
-            CookConflictError: Every candidate heading was tried (one line naming the burger,
-                the headings tried and the burger met, or that its plans failed).
+            CookConflictError: No candidate left, or :data:`MAX_TRIES` planned (one line
+                naming the burger, the headings tried and the burger met, or that its plans
+                failed).
         """
         rec = next(r for r in timeline.burgers if r.burger.burger == burger)
         xy = np.asarray(rec.burger.location(self.cell), float)[:2]
-        psi = self.headings.get(burger, default_heading(self.cell, (*xy, 0.0)))
-        if burger in self.headings:
-            self.tried.setdefault(burger, []).append(psi)
-        away = 1.0
-        if lie is not None:  # the side the met burger lies on, seen along the heading
-            d = np.array([math.cos(psi), math.sin(psi)])
-            v = np.asarray(lie.xy, float) - xy
-            away = -1.0 if d[0] * v[1] - d[1] * v[0] > 0 else 1.0
-        done = self.tried.get(burger, [])
-        left = [p for p in self.candidates(xy, away) if all(abs(p - q) > 1e-9 for q in done)]
-        if not left:
-            span = sorted([default_heading(self.cell, (*xy, 0.0)), *done])
-            tried = ", ".join(f"{math.degrees(p):.0f}" for p in span)
-            why = (f"{meet.describe()}; burger {lie.burger} still lies where it was dropped"
-                   if lie is not None else f"flip:{burger}: its plan fails")
-            raise CookConflictError(f"{why} at every scoop heading tried ({tried} deg): "
-                                    f"drop them farther apart")
-        self.headings[burger] = left[0]
-        return left[0]
+        psi = self.headings.get(burger, self.default(xy))
+        done = self.tried.setdefault(burger, [])
+        if all(abs(psi - q) > 1e-9 for q in done):
+            done.append(psi)
+        left = [p for p in self.candidates(xy) if all(abs(p - q) > 1e-9 for q in done)]
+        if left and len(done) <= self.max_tries:
+            if overlap is not None:  # a failed plan's turn keeps the last ranking
+                self.depths[burger] = {p: overlap(p - psi) for p in left}
+            depth = self.depths.get(burger, {})
+            left.sort(key=lambda p: depth.get(p, 0.0))  # stable: clear ones by turn
+            self.headings[burger] = left[0]
+            return left[0]
+        tried = ", ".join(f"{math.degrees(p):.0f}" for p in sorted(done))
+        why = (f"{meet.describe()}; burger {lie.burger} still lies where it was dropped"
+               if lie is not None and meet is not None else f"flip:{burger}: its plan fails")
+        widest = math.degrees(max(abs(d) for d in self.turns))
+        raise CookConflictError(f"{why} at every scoop heading tried ({tried} deg; turns "
+                                f"within {widest:.0f} deg of radial, at most "
+                                f"{self.max_tries + 1} planned): drop them farther apart")
 
 
-__all__ = ["HEADING_STEPS", "CookConflictError", "Turns"]
+__all__ = ["MAX_TRIES", "MAX_TURN", "TURN_STEP", "CookConflictError", "Turns"]

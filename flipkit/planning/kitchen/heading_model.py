@@ -1,0 +1,63 @@
+"""A flip's footprint at another scoop heading, predicted from its plan at one heading.
+
+The paper's constraints (22)–(26) hold in the task frame turned by the scoop heading ψ about
+the burger p^b (:mod:`flipkit.model.task_frame`): the go to burger's end, the scoop, the
+pickup and a toss that lands the burger where it lay are the same motion in that frame at
+every heading. What reaches down among the other burgers (the blade's low section, the
+carried burger) therefore turns with ψ about p^b. The approach from the rest configuration
+changes with ψ, but a cook's approach comes in above the burgers
+(:func:`~flipkit.planning.kitchen.sweep.approach_height`) until its descent onto the scoop's
+start, which is in the task frame. So the footprint at ψ + Δ is, to that approximation, the
+footprint at ψ turned by Δ about p^b. The landing disc stays where it is: it is the landing
+spot's, chosen apart (:func:`~flipkit.planning.kitchen.clearance.free_landing`).
+
+A cook ranks a flip's headings with it before planning any
+(:class:`~flipkit.planning.kitchen.turns.Turns`); the plan made at the heading chosen is then
+checked from its own footprint, as every plan is. ``tests/test_heading_model.py`` compares the
+prediction with plans made at the turned headings.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flipkit.config import CellConfig
+from flipkit.planning.kitchen.sweep import Footprint, meetings
+
+PARTS = ("blade", "carried burger")  # what turns with the heading (not the landing disc)
+
+
+def _turn(points, pb, delta: float) -> np.ndarray:
+    """``points`` (…×2, m) turned by ``delta`` (rad) about ``pb``."""
+    c, s = math.cos(delta), math.sin(delta)
+    R = np.array([[c, -s], [s, c]])
+    pb = np.asarray(pb, float)[:2]
+    return (np.asarray(points, float) - pb) @ R.T + pb
+
+
+def turned_footprint(fp: Footprint, pb, delta: float) -> Footprint:
+    """``fp`` (a flip's footprint at heading ψ, burger at ``pb`` (m)) predicted at ψ + ``delta``
+    (rad): its blade sections and carried burger turned about ``pb``, its landing unchanged
+    (module docstring)."""
+    if delta == 0.0:
+        return fp
+    return Footprint(
+        blade=[(t, seg, _turn(poly, pb, delta)) for t, seg, poly in fp.blade],
+        carried=[(t, seg, tuple(_turn(a, pb, delta)), tuple(_turn(b, pb, delta)))
+                 for t, seg, a, b in fp.carried],
+        landing=fp.landing)
+
+
+def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float, lying,
+                      cell: CellConfig, margin: float | None = None) -> float:
+    """How deep (m) the flip of footprint ``fp``, turned by ``delta`` (rad) about ``pb`` and
+    started at ``start`` (s, cook clock), would come inside the clearance of the ``lying``
+    burgers (:class:`~flipkit.planning.kitchen.sweep.Lying`) with its blade or carried burger;
+    0 when it keeps clear."""
+    met = meetings(turned_footprint(fp, pb, delta), motion, start, lying, cell, margin)
+    return max([m.overlap_m for m in met if m.part in PARTS], default=0.0)
+
+
+__all__ = ["PARTS", "predicted_overlap", "turned_footprint"]
