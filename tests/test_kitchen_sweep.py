@@ -382,3 +382,29 @@ def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():
     for bad in (-0.01, math.nan, "x"):
         with pytest.raises(ConfigError, match="approach_height"):
             check_approach_height(bad)
+
+
+def test_a_landing_that_meets_a_landed_burger_moves_its_own_when_that_one_cannot(monkeypatch):
+    """b2's flip lands its burger on b1, which its flip landed there: b1's landing moves
+    first; when no spot is free for b1, b2's own landing moves instead; when neither has one,
+    the cook is refused naming both."""
+    import flipkit.planning.kitchen.clearance as clearance
+
+    def schedule(lands, headings):
+        t, f = fake_timeline()
+        f[t.motions[1].plan] = Footprint(landing=(3.0, lands.get("b2", (0.66, -0.35)),
+                                                  R + 0.015))
+        fps.clear()
+        fps.update(f)
+        return t
+
+    fps, free = {}, {}
+    monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
+    monkeypatch.setattr(clearance, "free_landing",
+                        lambda who, *a, **k: free.get(who))
+    free.update(b1=None, b2=(0.80, 0.05))
+    timeline, lands, headings = clear_cook(schedule, CELL)
+    assert lands == {"b2": (0.80, 0.05)} and headings == {}
+    free.update(b2=None)
+    with pytest.raises(CookConflictError, match="flip:b2: the landing .* burger b1 or b2"):
+        clear_cook(schedule, CELL)

@@ -19,9 +19,11 @@ The cook is planned and scheduled again with the new spots and checked again.
 The second freedom is **the scoop heading of a flip** (``plan_flip(..., heading=...)``;
 by default radial from the base, :mod:`flipkit.model.task_frame`). A flip whose go to burger,
 scoop or pickup meets a burger still lying where it was dropped, or whose toss still does
-from two other landing spots, is turned (:class:`~flipkit.planning.kitchen.turns.Turns`): 15° then 30° away from
-the burger it meets, then toward it, within ±:data:`~flipkit.config.task.HEADING_LIMIT`. A
-flip turned every way and still meeting it, or whose plan fails at every heading tried, refuses the cook
+from two other landing spots, is turned (:class:`~flipkit.planning.kitchen.turns.Turns`): its
+headings within 30° of radial are ranked by its footprint turned about its burger
+(:mod:`flipkit.planning.kitchen.heading_model`) against the burgers lying while it runs, and
+the smallest turn predicted clear is planned next. A flip still meeting a burger after the
+headings allowed, or whose plan fails at every heading tried, refuses the cook
 (:class:`CookConflictError`, naming the burger, the headings tried and the one it meets).
 """
 
@@ -277,32 +279,39 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
         if round_ == max_rounds:
             raise CookConflictError(f"{found[0][0].describe()}; still after {max_rounds} "
                                     f"rounds of moving landing spots")
-        move, turn = {}, {}
+        move, turn = {}, {}  # move: meeting -> the burgers whose landing may move, in turn
         for meet, lie in found:
             kind, owner = meet.motion.split(":", 1)
-            if lie.landed:
-                who = lie.burger
-            elif kind == "serve" or meet.part == "landing" or (
-                    meet.segment in TOSS_SEGMENTS and len(tried.get(owner, ())) < 2):
+            follows = kind == "serve" or meet.part == "landing" or meet.segment in TOSS_SEGMENTS
+            if lie.landed:  # the burger met moves, else the motion's own where it follows it
+                move.setdefault(meet, [lie.burger] + ([owner] if follows else []))
+            elif follows and (kind == "serve" or meet.part == "landing"
+                              or len(tried.get(owner, ())) < 2):
                 # a flip's toss goes where it lands its burger: a toss that meets a burger
                 # still lying where it was dropped lands its own elsewhere (two spots tried)
-                who = owner
+                move.setdefault(meet, [owner])
             else:  # the scoop, or a toss moved twice: the flip is turned
                 turn.setdefault(owner, (meet, lie))
-                continue
-            move.setdefault(who, meet)
         for owner, (meet, lie) in turn.items():
             turns.next(owner, lie, timeline, meet=meet,
                        overlap=_turned_overlap(owner, timeline, cell, fps, margin))
-        for who, meet in move.items():
-            spot = free_landing(who, timeline, cell, fps, margin,
-                                exclude=tried.get(who, []) + ([lands[who]] if who in lands
-                                                               else []))
-            if spot is None:
-                raise CookConflictError(f"{meet.describe()}; no landing spot for burger {who} "
-                                        f"keeps clear of the other burgers and motions")
+        moved: set[str] = set()
+        for meet, whom in move.items():
+            if moved & set(whom):
+                continue  # one landing moved this round for this meeting already
+            for who in whom:
+                spot = free_landing(who, timeline, cell, fps, margin,
+                                    exclude=tried.get(who, []) + ([lands[who]] if who in lands
+                                                                   else []))
+                if spot is not None:
+                    break
+            else:
+                raise CookConflictError(
+                    f"{meet.describe()}; no landing spot for burger {' or '.join(whom)} keeps "
+                    f"clear of the other burgers and motions")
             tried.setdefault(who, []).append(spot)
             lands[who] = spot
+            moved.add(who)
     raise CookConflictError(f"no landing spot for burgers {', '.join(sorted(tried))} "
                             f"gives a flip that can be planned")
 
