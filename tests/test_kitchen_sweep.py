@@ -408,3 +408,25 @@ def test_a_landing_that_meets_a_landed_burger_moves_its_own_when_that_one_cannot
     free.update(b2=None)
     with pytest.raises(CookConflictError, match="flip:b2: the landing .* burger b1 or b2"):
         clear_cook(schedule, CELL)
+
+
+def test_a_scoop_that_meets_a_landed_burger_that_cannot_move_is_turned(monkeypatch):
+    """b2's scoop passes over b1 where b1's flip landed it, and no spot is free for b1: the
+    cook turns b2's scoop instead of refusing; with no heading left it refuses."""
+    import flipkit.planning.kitchen.clearance as clearance
+
+    def schedule(lands, headings, clears=True):
+        t, f = fake_timeline()
+        if "b2" in headings and clears:
+            f[t.motions[1].plan] = blade_at(0.80, -0.10, t=1.0)
+        fps.clear()
+        fps.update(f)
+        return t
+
+    fps = {}
+    monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
+    monkeypatch.setattr(clearance, "free_landing", lambda *a, **k: None)
+    timeline, lands, headings = clear_cook(schedule, CELL)
+    assert lands == {} and set(headings) == {"b2"}
+    with pytest.raises(CookConflictError, match="flip:b2: the blade .* every scoop heading"):
+        clear_cook(lambda lands, headings: schedule(lands, headings, clears=False), CELL)

@@ -22,7 +22,8 @@ scoop or pickup meets a burger still lying where it was dropped, or whose toss s
 from two other landing spots, is turned (:class:`~flipkit.planning.kitchen.turns.Turns`): its
 headings within 30° of radial are ranked by its footprint turned about its burger
 (:mod:`flipkit.planning.kitchen.heading_model`) against the burgers lying while it runs, and
-the smallest turn predicted clear is planned next. A flip still meeting a burger after the
+the smallest turn predicted clear is planned next. A flip whose blade meets a burger its own
+flip landed is turned too when no spot is free for that burger. A flip still meeting a burger after the
 headings allowed, or whose plan fails at every heading tried, refuses the cook
 (:class:`CookConflictError`, naming the burger, the headings tried and the one it meets).
 """
@@ -37,7 +38,7 @@ import numpy as np
 from flipkit.behaviors.library import PICKUP_AND_FLIP, SERVE
 from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
-from flipkit.planning.kitchen.heading_model import predicted_overlap
+from flipkit.planning.kitchen.heading_model import PARTS, predicted_overlap
 from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
 from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
 from flipkit.planning.kitchen.turns import CookConflictError, Turns
@@ -306,6 +307,15 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
                 if spot is not None:
                     break
             else:
+                kind, owner = meet.motion.split(":", 1)
+                if kind == "flip" and meet.part in PARTS and meet.segment not in TOSS_SEGMENTS:
+                    lie = next(lie for m, lie in found if m == meet)  # its scoop is turned
+                    if owner not in turn:
+                        turn[owner] = (meet, lie)
+                        turns.next(owner, lie, timeline, meet=meet,
+                                   overlap=_turned_overlap(owner, timeline, cell, fps,
+                                                           margin))
+                    continue
                 raise CookConflictError(
                     f"{meet.describe()}; no landing spot for burger {' or '.join(whom)} keeps "
                     f"clear of the other burgers and motions")
