@@ -430,3 +430,16 @@ def test_a_scoop_that_meets_a_landed_burger_that_cannot_move_is_turned(monkeypat
     assert lands == {} and set(headings) == {"b2"}
     with pytest.raises(CookConflictError, match="flip:b2: the blade .* every scoop heading"):
         clear_cook(lambda lands, headings: schedule(lands, headings, clears=False), CELL)
+
+
+def test_a_spot_keeps_clear_of_the_landings_given_in_the_same_round():
+    """Two landings moved in one round are chosen against the same timeline: the second keeps
+    clear of the first's landing disc (``taken``), which the timeline does not hold yet."""
+    tl, fps = fake_timeline()
+    first = free_landing("b1", tl, CELL, fps.__getitem__)
+    taken = (first, R + 0.015)
+    second = free_landing("b1", tl, CELL, fps.__getitem__, taken=[taken])
+    assert first is not None and second is not None
+    assert np.hypot(second[0] - first[0], second[1] - first[1]) >= 2 * (R + 0.015) + M - 1e-9
+    alone = free_landing("b1", tl, CELL, fps.__getitem__, exclude=[first])
+    assert np.hypot(alone[0] - first[0], alone[1] - first[1]) < 2 * (R + 0.015) + M

@@ -74,6 +74,13 @@ def lying_burgers(timeline, cell: CellConfig | None = None,
     return out
 
 
+def _landing_radius(burger: str, timeline, cell: CellConfig, footprints) -> float:
+    """The radius (m) within which ``burger``'s flip lands it: its landing disc."""
+    flip = next((m for m in timeline.motions if m.key == f"flip:{burger}"), None)
+    return cell.burger.diameter / 2 + (0.0 if flip is None else
+                                       _landing_spread(flip, cell, footprints))
+
+
 def _landing_spread(flip, cell, footprints) -> float:
     """How far (m) beyond the burger's radius a flip's landing disc reaches (0 unknown)."""
     if cell is None or footprints is None or flip.plan is None:
@@ -138,11 +145,13 @@ def landing_candidates(cell: CellConfig, step: float) -> np.ndarray:
 
 
 def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints,
-                 margin: float | None = None, exclude=()) -> tuple | None:
+                 margin: float | None = None, exclude=(), taken=()) -> tuple | None:
     """The landing spot (x, y) (m) for ``burger`` nearest its drop place that keeps clear of
     every other motion and burger over its stay, and whose serve (its present footprint,
     moved with the spot) meets nobody; ``None`` if there is none. ``exclude``: spots
-    already tried (nothing within ``margin`` of them is offered again).
+    already tried (nothing within ``margin`` of them is offered again). ``taken``: landing
+    discs ``(xy, radius)`` (m) just given to other burgers, which the timeline does not hold
+    yet; the spot keeps clear of them.
 
     Only spots at least the flip's landing spread inside the grill area's edges are offered:
     the burger lands within that spread of its spot, so its centre stays in the area, where
@@ -171,6 +180,8 @@ def free_landing(burger: str, timeline, cell: CellConfig, footprints: Footprints
 
     for spot in exclude:
         keep(lambda Q: np.hypot(*(Q - np.asarray(spot)).T) > margin)
+    for spot, other in taken:
+        keep(lambda Q: np.hypot(*(Q - np.asarray(spot)).T) >= other + radius + margin)
     for lie in lying:
         if lie.burger != burger and lie.t0 <= t1 and lie.t1 >= t0:
             keep(lambda Q: np.hypot(*(Q - np.asarray(lie.xy)).T)
@@ -303,7 +314,9 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
             for who in whom:
                 spot = free_landing(who, timeline, cell, fps, margin,
                                     exclude=tried.get(who, []) + ([lands[who]] if who in lands
-                                                                   else []))
+                                                                   else []),
+                                    taken=[(lands[b], _landing_radius(b, timeline, cell, fps))
+                                           for b in moved])
                 if spot is not None:
                     break
             else:
