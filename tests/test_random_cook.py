@@ -47,6 +47,31 @@ def test_the_places_are_spread_over_the_grill():
     assert bands.min() > 0
 
 
+@pytest.mark.parametrize("gap", [0.03, 0.04])
+def test_a_gap_keeps_the_burgers_edges_that_far_apart(gap):
+    """With ``gap`` the least edge-to-edge distance over 20 seeds is at least the gap, and
+    below it with the default (1 mm): the default cooks have burgers closer than 3 cm."""
+    def least(order):
+        xy = np.array([(b.x, b.y) for b in order])
+        return (np.linalg.norm(xy[:, None] - xy[None], axis=2) + np.eye(len(xy))).min()
+
+    d = CELL.burger.diameter
+    assert min(least(random_order(5, s, CELL, gap=gap)) for s in range(20)) >= d + gap - 1e-4
+    assert min(least(random_order(5, s, CELL)) for s in range(20)) < d + 0.03
+
+
+@pytest.mark.parametrize("gap", [0.0, -0.01, 0.25, math.nan, True, "5"])
+def test_a_gap_out_of_range_is_refused(gap):
+    with pytest.raises(ConfigError, match=r"--gap must be a distance in \[0.001, 0.2\] m"):
+        random_order(5, 0, CELL, gap=gap)
+
+
+def test_twelve_burgers_a_wide_gap_apart_do_not_fit():
+    with pytest.raises(ConfigError, match=r"no free place on the grill for burger .* smaller "
+                                          r"gap"):
+        random_order(12, 0, CELL, gap=0.1)
+
+
 @pytest.mark.parametrize("n", [0, MAX_RANDOM + 1, 2.5, True])
 def test_a_count_out_of_range_is_refused(n):
     with pytest.raises(ConfigError, match=r"--random N must be a whole number"):
@@ -57,6 +82,8 @@ def test_a_count_out_of_range_is_refused(n):
     (["--random", "13"], "in [1, 12]"),
     (["--random", "3", "--stream", "60", "--minutes", "1"], "not --stream and --random"),
     (["flipkit/data/cook_five.csv", "--random", "3"], "not BURGERS.csv and --random"),
+    (["flipkit/data/cook_five.csv", "--gap", "0.03"], "--gap goes with --random"),
+    (["--random", "3", "--gap", "0.5"], "--gap must be a distance"),
 ])
 def test_the_cli_refuses_in_one_line(tmp_path, capsys, args, message):
     out = tmp_path / "t.json"

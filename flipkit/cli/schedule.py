@@ -105,6 +105,9 @@ def register(subparsers) -> None:
     p.add_argument("--random", type=int, metavar="N",
                    help="instead of BURGERS.csv, N burgers (1 to 12) dropped 4-5 s apart at "
                         "random places on the grill, at least a diameter apart (--seed)")
+    p.add_argument("--gap", type=float, default=None, metavar="M",
+                   help="with --random: the least distance between two burgers' edges, m, in "
+                        "[0.001, 0.2] (default 0.001: they may all but touch)")
     p.add_argument("--minutes", type=float, metavar="M",
                    help="the stream's length, min (with --stream)")
     p.add_argument("--seed", type=int, default=0, metavar="N",
@@ -183,8 +186,11 @@ def run(args: argparse.Namespace) -> int:
     check_float("--time-limit", args.time_limit, 0.0, MAX_TIME_LIMIT_S, "s")
     check_int("--seed", args.seed, 0, 2**31 - 1)
     args.order = read_cook_csv(args.burgers, CellConfig()) if args.burgers else None
+    if args.gap is not None and args.random is None:
+        raise ConfigError("--gap goes with --random")
     if args.random is not None:
-        args.order = random_order(args.random, args.seed, CellConfig())
+        args.order = random_order(args.random, args.seed, CellConfig(),
+                                  **({} if args.gap is None else {"gap": args.gap}))
     if args.plans is None:  # TIMELINE_plans/ beside the timeline
         args.plans = str(Path(args.json).with_name(Path(args.json).stem + "_plans"))
     if args.order is not None or args.plan:

@@ -59,15 +59,15 @@ def n_drops(rate_per_h: float, minutes: float) -> int:
     return int(math.floor(rate_per_h * minutes / 60.0 - 1e-9)) + 1 if minutes > 0 else 0
 
 
-def free_place(rng, area, others, diameter: float):
+def free_place(rng, area, others, diameter: float, gap: float = CLEARANCE):
     """A uniformly random (x, y) (m, rounded to 0.1 mm) in ``area`` ((x0, x1), (y0, y1)) at
-    least ``diameter`` + :data:`CLEARANCE` from each of ``others``: the first of
-    :data:`PLACE_TRIES` draws of ``rng`` that is, or ``None``."""
+    least ``diameter`` + ``gap`` (m, default :data:`CLEARANCE`) from each of ``others``: the
+    first of :data:`PLACE_TRIES` draws of ``rng`` that is, or ``None``."""
     (x0, x1), (y0, y1) = area
     xy = rng.uniform((x0, y0), (x1, y1), size=(PLACE_TRIES, 2))
     if len(others):
         gaps = np.linalg.norm(xy[:, None, :] - np.asarray(others, float)[None], axis=2)
-        free = gaps.min(axis=1) >= diameter + CLEARANCE
+        free = gaps.min(axis=1) >= diameter + gap
     else:
         free = np.ones(len(xy), bool)
     if not free.any():
