@@ -140,6 +140,30 @@ def test_stream_report_below_and_at_a_resonant_rate():
         "the grill is full")
 
 
+def test_a_burger_blocked_at_every_heading_counts_as_missed():
+    """With the plans' footprints, a stream counts the burgers whose motions meet another
+    burger at every scoop heading as missed: a footprint reaching 40 cm round its burger
+    blocks every burger that shares the grill with another while its motions run; at 20 per
+    hour none does (each is served before the next drops) and none is blocked."""
+    import dataclasses
+
+    from flipkit.planning.kitchen.reach import blocked_burgers
+    from flipkit.planning.kitchen.sweep import Footprint
+
+    wide = Footprint(blade=[(1.0, "scoop", np.array([[-0.4, -0.4], [0.4, -0.4], [0.4, 0.4],
+                                                      [-0.4, 0.4]]))])
+    model = dataclasses.replace(MODEL, footprints={"flip": wide, "serve": wide})
+    tl, plain = run_stream(50, 10, MODEL, policy="greedy")
+    tl2, rep = run_stream(50, 10, model, policy="greedy")
+    blocked = blocked_burgers(tl2, model.footprints, CELL)
+    assert plain.n_blocked is None and "not checked" in plain.summary()
+    assert rep.n_blocked == len(blocked) > 0 and f"{rep.n_blocked} blocked" in rep.summary()
+    assert rep.n_within == plain.n_within - rep.n_blocked
+    assert rep.per_hour_within == pytest.approx(50 * rep.n_within / rep.n_burgers)
+    _, sparse = run_stream(20, 10, model, policy="greedy")
+    assert sparse.n_blocked == 0 and sparse.n_within == sparse.n_burgers
+
+
 # ---------------------------------------------------------------- the command line
 @pytest.fixture
 def fake_planners(monkeypatch):

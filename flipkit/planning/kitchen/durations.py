@@ -13,7 +13,7 @@ every motion takes the model's times, lands where it was picked up and ends at r
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
@@ -38,11 +38,16 @@ class MotionModel:
     Attributes:
         flip, serve: :class:`~flipkit.planning.kitchen.cpsat.MotionTimes`.
         source: Where the times come from (one line).
+        footprints: Per kind, the footprint of the plan the times come from, in its
+            burger's task frame (:func:`~flipkit.planning.kitchen.reach.to_task_frame`), or
+            ``None`` (times given, no plans): what
+            :func:`~flipkit.planning.kitchen.reach.blocked_burgers` checks a stream with.
     """
 
     flip: MotionTimes
     serve: MotionTimes
     source: str = "given"
+    footprints: dict | None = field(default=None, compare=False, repr=False)
 
     def times(self, kind: str) -> MotionTimes:
         """The times of ``kind`` ("flip" or "serve")."""
@@ -117,7 +122,25 @@ def plan_model(planners: Mapping[str, MotionPlanner], q_rest,
               f"{spread['flip'][1]:.2f} s) and serves ({spread['serve'][0]:.2f}-"
               f"{spread['serve'][1]:.2f} s)")
     return MotionModel(*(MotionTimes(longest[k].duration_s, longest[k].event_s)
-                         for k in ("flip", "serve")), source=source)
+                         for k in ("flip", "serve")), source=source,
+                       footprints=_task_footprints(longest, cell))
+
+
+def _task_footprints(longest: dict, cell: CellConfig) -> dict | None:
+    """Each kind's plan's footprint in its burger's task frame; ``None`` without plans."""
+    if any(pm.plan is None for pm in longest.values()):
+        return None
+    from flipkit.model.robot import Robot
+    from flipkit.planning.kitchen.reach import to_task_frame
+    from flipkit.planning.kitchen.sweep import footprint
+
+    robot = Robot(cell, with_burger=False)
+    out = {}
+    for kind, pm in longest.items():
+        pb = np.asarray(pm.plan.burger["location"], float)[:2]
+        out[kind] = to_task_frame(footprint(pm.plan, cell, robot), pb,
+                                  float(pm.plan.burger["heading"]))
+    return out
 
 
 __all__ = ["REPRESENTATIVE", "ModelPlanError", "MotionModel", "plan_model",

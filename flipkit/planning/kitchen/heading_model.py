@@ -37,17 +37,20 @@ def _turn(points, pb, delta: float) -> np.ndarray:
     return (np.asarray(points, float) - pb) @ R.T + pb
 
 
-def turned_footprint(fp: Footprint, pb, delta: float) -> Footprint:
+def turned_footprint(fp: Footprint, pb, delta: float, landing: bool = False) -> Footprint:
     """``fp`` (a flip's footprint at heading ψ, burger at ``pb`` (m)) predicted at ψ + ``delta``
-    (rad): its blade sections and carried burger turned about ``pb``, its landing unchanged
-    (module docstring)."""
+    (rad): its blade sections and carried burger turned about ``pb``; its landing disc turned
+    too with ``landing``, else left where it is (module docstring)."""
     if delta == 0.0:
         return fp
+    land = fp.landing
+    if landing and land is not None:
+        land = (land[0], tuple(float(v) for v in _turn(land[1], pb, delta)), land[2])
     return Footprint(
         blade=[(t, seg, _turn(poly, pb, delta)) for t, seg, poly in fp.blade],
         carried=[(t, seg, tuple(_turn(a, pb, delta)), tuple(_turn(b, pb, delta)))
                  for t, seg, a, b in fp.carried],
-        landing=fp.landing)
+        landing=land)
 
 
 def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float, lying,

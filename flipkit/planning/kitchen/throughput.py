@@ -2,8 +2,10 @@
 utilisation and the largest lateness; and a sweep of drop rates for the ``throughput`` figure.
 
 * **Burgers per hour within windows**: the drop rate times the share of burgers whose flip
-  and serve both lie within their windows (to 2 ms, the optimiser's rounding); the drop
-  rate when all do.
+  and serve both lie within their windows (to 2 ms, the optimiser's rounding) and could
+  run: a burger that another burger blocks at every scoop heading
+  (:func:`~flipkit.planning.kitchen.reach.blocked_burgers`, when the model has its plans'
+  footprints) is missed; the drop rate when all are within and none is blocked.
 * **Utilisation**: the arm's motion time over the span from its first motion's start to
   its last motion's end.
 * **Largest lateness**: the largest deviation of an event past its mark (s, ≥ 0): a flip's
@@ -25,6 +27,7 @@ from flipkit.errors import InvalidChoiceError
 from flipkit.planning.kitchen.durations import MotionModel
 from flipkit.planning.kitchen.cpsat_process import Child
 from flipkit.planning.kitchen.optimal import schedule_cook_cpsat
+from flipkit.planning.kitchen.reach import blocked_burgers
 from flipkit.planning.kitchen.schedule import Timeline, schedule_cook
 from flipkit.planning.kitchen.stream import StreamError, stream_order
 from flipkit.planning.kitchen.table import DWELL_S
@@ -47,6 +50,7 @@ class StreamReport:
     max_lateness_s: float
     windows_met: bool
     status: str
+    n_blocked: int | None = None
 
     def to_dict(self) -> dict:
         """The report as a dict (JSON)."""
@@ -54,20 +58,27 @@ class StreamReport:
 
     def summary(self) -> str:
         """One line."""
+        reach = ("the motions' sweeps not checked against the burgers on the grill"
+                 if self.n_blocked is None else
+                 f"{self.n_blocked} blocked by other burgers at every scoop heading")
         return (f"{self.policy}: {self.n_within}/{self.n_burgers} burgers within their "
                 f"windows, {self.per_hour_within:.0f} per hour (drops {self.rate_per_h:g} per "
-                f"hour); arm utilisation {100 * self.utilisation:.0f} %; largest lateness "
-                f"{self.max_lateness_s:.2f} s")
+                f"hour); {reach}; arm utilisation {100 * self.utilisation:.0f} %; largest "
+                f"lateness {self.max_lateness_s:.2f} s")
 
 
-def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: float
-                  ) -> StreamReport:
-    """Measure a stream's timeline (module docstring)."""
+def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: float,
+                  blocked=None) -> StreamReport:
+    """Measure a stream's timeline (module docstring); ``blocked``: the burgers whose motions
+    are clear at no heading (:func:`~flipkit.planning.kitchen.reach.blocked_burgers`), counted
+    as missed, or ``None``: not checked."""
     w = timeline.windows
     within, late = 0, 0.0
+    missed = set() if blocked is None else {b.burger for b in blocked}
     for b in timeline.burgers:
         dev = event_deviations(b)
-        done = all(dev[k] is not None for k in timeline.kinds)
+        done = (all(dev[k] is not None for k in timeline.kinds)
+                and b.burger.burger not in missed)
         within += done and all(w.excess(k, dev[k]) <= 2e-3 for k in timeline.kinds)
         late = max([late] + [v for v in dev.values() if v is not None])
     ran = [m for m in timeline.motions if m.ok]
@@ -76,7 +87,8 @@ def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: f
     status = timeline.solver["status"] if timeline.solver else "greedy"
     return StreamReport(policy, rate_per_h, minutes, len(timeline.burgers), int(within),
                         rate_per_h * within / max(len(timeline.burgers), 1), busy / span if span > 0 else 0.0,
-                        max(late, 0.0), worst_break(timeline.burgers, w) is None, status)
+                        max(late, 0.0), worst_break(timeline.burgers, w) is None, status,
+                        None if blocked is None else len(missed))
 
 
 def run_stream(rate_per_h: float, minutes: float, model: MotionModel, *,
@@ -103,7 +115,9 @@ def run_stream(rate_per_h: float, minutes: float, model: MotionModel, *,
                                  seed=seed, relax="count", child=child)
     else:
         tl = schedule_cook(order, planners, q, cell=cell, dwell_s=dwell_s, windows=windows)
-    return tl, stream_report(tl, policy, rate_per_h, minutes)
+    blocked = (None if model.footprints is None
+               else blocked_burgers(tl, model.footprints, cell))
+    return tl, stream_report(tl, policy, rate_per_h, minutes, blocked)
 
 
 def sweep_rates(rates, minutes: float, model: MotionModel, policies=POLICIES,
