@@ -38,7 +38,12 @@ POLICIES = ("cpsat", "greedy")
 
 @dataclass(frozen=True)
 class StreamReport:
-    """A stream's schedule, measured (module docstring); rates per hour, times in s."""
+    """A stream's schedule, measured (module docstring); rates per hour, times in s.
+
+    ``n_within`` counts the burgers within their windows and not blocked; ``n_blocked`` the
+    burgers blocked at every scoop heading and ``n_within_timing`` those within their windows
+    whatever the geometry (``n_blocked`` ``None``: the sweeps were not checked).
+    """
 
     policy: str
     rate_per_h: float
@@ -51,6 +56,7 @@ class StreamReport:
     windows_met: bool
     status: str
     n_blocked: int | None = None
+    n_within_timing: int | None = None
 
     def to_dict(self) -> dict:
         """The report as a dict (JSON)."""
@@ -75,11 +81,13 @@ def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: f
     w = timeline.windows
     within, late = 0, 0.0
     missed = set() if blocked is None else {b.burger for b in blocked}
+    timed = 0
     for b in timeline.burgers:
         dev = event_deviations(b)
         done = (all(dev[k] is not None for k in timeline.kinds)
-                and b.burger.burger not in missed)
-        within += done and all(w.excess(k, dev[k]) <= 2e-3 for k in timeline.kinds)
+                and all(w.excess(k, dev[k]) <= 2e-3 for k in timeline.kinds))
+        timed += done
+        within += done and b.burger.burger not in missed
         late = max([late] + [v for v in dev.values() if v is not None])
     ran = [m for m in timeline.motions if m.ok]
     span = max(m.end for m in ran) - min(m.start for m in ran) if ran else 0.0
@@ -88,7 +96,7 @@ def stream_report(timeline: Timeline, policy: str, rate_per_h: float, minutes: f
     return StreamReport(policy, rate_per_h, minutes, len(timeline.burgers), int(within),
                         rate_per_h * within / max(len(timeline.burgers), 1), busy / span if span > 0 else 0.0,
                         max(late, 0.0), worst_break(timeline.burgers, w) is None, status,
-                        None if blocked is None else len(missed))
+                        None if blocked is None else len(missed), int(timed))
 
 
 def run_stream(rate_per_h: float, minutes: float, model: MotionModel, *,
