@@ -37,20 +37,35 @@ def _turn(points, pb, delta: float) -> np.ndarray:
     return (np.asarray(points, float) - pb) @ R.T + pb
 
 
+def mapped_footprint(fp: Footprint, f, landing: bool = True) -> Footprint:
+    """``fp`` with every point moved by ``f`` (a rigid map of …×2 arrays, m): its blade
+    sections and carried burger, and its landing disc's centre with ``landing``. Works on the
+    footprint's arrays at once, and hands them on made."""
+    out = Footprint(landing=fp.landing)
+    if fp.blade:
+        ts, segs, polys, counts = fp.blade_arrays()
+        moved = f(polys)
+        out.blade = [(t, seg, moved[i, :counts[i]]) for i, (t, seg) in enumerate(zip(ts, segs))]
+        out._arrays["blade"] = (ts, segs, moved, counts)
+    if fp.carried:
+        ts, segs, a, b = fp.carried_arrays()
+        fa, fb = f(a), f(b)
+        out.carried = [(t, seg, tuple(fa[i]), tuple(fb[i])) for i, (t, seg) in
+                       enumerate(zip(ts, segs))]
+        out._arrays["carried"] = (ts, segs, fa, fb)
+    if landing and fp.landing is not None:
+        centre = f(np.asarray(fp.landing[1], float)[None])[0]
+        out.landing = (fp.landing[0], tuple(float(v) for v in centre), fp.landing[2])
+    return out
+
+
 def turned_footprint(fp: Footprint, pb, delta: float, landing: bool = False) -> Footprint:
     """``fp`` (a flip's footprint at heading ψ, burger at ``pb`` (m)) predicted at ψ + ``delta``
     (rad): its blade sections and carried burger turned about ``pb``; its landing disc turned
     too with ``landing``, else left where it is (module docstring)."""
     if delta == 0.0:
         return fp
-    land = fp.landing
-    if landing and land is not None:
-        land = (land[0], tuple(float(v) for v in _turn(land[1], pb, delta)), land[2])
-    return Footprint(
-        blade=[(t, seg, _turn(poly, pb, delta)) for t, seg, poly in fp.blade],
-        carried=[(t, seg, tuple(_turn(a, pb, delta)), tuple(_turn(b, pb, delta)))
-                 for t, seg, a, b in fp.carried],
-        landing=land)
+    return mapped_footprint(fp, lambda P: _turn(P, pb, delta), landing)
 
 
 def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float, lying,
@@ -63,4 +78,4 @@ def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float
     return max([m.overlap_m for m in met if m.part in PARTS], default=0.0)
 
 
-__all__ = ["PARTS", "predicted_overlap", "turned_footprint"]
+__all__ = ["PARTS", "mapped_footprint", "predicted_overlap", "turned_footprint"]

@@ -26,8 +26,8 @@ import numpy as np
 
 from flipkit.config import CellConfig
 from flipkit.planning.kitchen.clearance import lying_burgers
-from flipkit.planning.kitchen.heading_model import turned_footprint
-from flipkit.planning.kitchen.sweep import Footprint, meetings
+from flipkit.planning.kitchen.heading_model import mapped_footprint, turned_footprint
+from flipkit.planning.kitchen.sweep import Footprint, default_margin, meetings
 from flipkit.planning.kitchen.turns import Turns
 
 
@@ -47,11 +47,7 @@ def placed(task_fp: Footprint, pb, psi: float) -> Footprint:
 
 def _moved(fp: Footprint, d) -> Footprint:
     d = np.asarray(d, float)
-    landing = None if fp.landing is None else (
-        fp.landing[0], tuple(np.asarray(fp.landing[1], float) + d), fp.landing[2])
-    return Footprint(blade=[(t, s, np.asarray(p, float) + d) for t, s, p in fp.blade],
-                     carried=[(t, s, tuple(np.asarray(a) + d), tuple(np.asarray(b) + d))
-                              for t, s, a, b in fp.carried], landing=landing)
+    return mapped_footprint(fp, lambda P: P + d)
 
 
 @dataclass(frozen=True)
@@ -82,6 +78,13 @@ def blocked_burgers(timeline, footprints, cell: CellConfig,
     lying = [dataclasses.replace(lie, spread=spread.get("flip", 0.0)) if lie.landed else lie
              for lie in lying_burgers(timeline)]
     where = {rec.burger.burger: rec for rec in timeline.burgers}
+    # how far from its burger a motion reaches a lying burger's clearance (m): no one farther
+    # can be met, so the check looks at the burgers lying nearer while it runs
+    margin_m = default_margin() if margin is None else margin
+    reach = {k: _extent(fp) + r + margin_m + max([lie.spread for lie in lying], default=0.0)
+             for k, fp in footprints.items()}
+    xy = np.array([lie.xy for lie in lying], float).reshape(-1, 2)
+    t0, t1 = (np.array([getattr(lie, f) for lie in lying], float) for f in ("t0", "t1"))
     out: dict[str, Blocked] = {}
     for m in timeline.motions:
         if not m.ok or m.event is None or m.kind not in footprints or m.burger in out:
@@ -89,7 +92,11 @@ def blocked_burgers(timeline, footprints, cell: CellConfig,
         rec = where[m.burger]
         pb = ((rec.burger.x, rec.burger.y) if m.kind == "flip" or rec.landing is None
               else tuple(rec.landing))
-        others = [lie for lie in lying if lie.burger != m.burger]
+        near = ((t0 <= m.end) & (t1 >= m.start)
+                & (np.hypot(*(xy - np.asarray(pb)).T) <= reach[m.kind]))
+        others = [lying[i] for i in np.flatnonzero(near) if lying[i].burger != m.burger]
+        if not others:
+            continue
         best = None
         for psi in [turns.default(pb), *turns.candidates(pb)]:
             met = meetings(placed(footprints[m.kind], pb, psi), m.key, m.start, others, cell,
@@ -103,6 +110,17 @@ def blocked_burgers(timeline, footprints, cell: CellConfig,
         if best is not None:
             out[m.burger] = Blocked(m.burger, m.kind, best.burger, best.overlap_m)
     return sorted(out.values(), key=lambda b: b.burger)
+
+
+def _extent(fp: Footprint) -> float:
+    """The farthest (m) a task-frame footprint reaches from its burger: its blade's corners,
+    its carried burger's centre and its landing disc."""
+    points = [np.asarray(p, float).reshape(-1, 2) for _t, _s, p in fp.blade]
+    points += [np.asarray([a, b], float) for _t, _s, a, b in fp.carried]
+    far = max([float(np.hypot(*P.T).max()) for P in points if len(P)], default=0.0)
+    if fp.landing is not None:
+        far = max(far, float(np.hypot(*fp.landing[1])) + fp.landing[2])
+    return far
 
 
 __all__ = ["Blocked", "blocked_burgers", "placed", "to_task_frame"]
