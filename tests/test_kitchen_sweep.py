@@ -15,6 +15,7 @@ from flipkit.planning.kitchen.clearance import (CookConflictError, clear_cook, f
                                                landing_candidates,
                                                lying_burgers)
 from flipkit.planning.kitchen.cook import CookBurger
+from flipkit.planning.kitchen.heading_model import MODEL_MARGIN
 from flipkit.planning.kitchen.turns import MAX_TRIES
 from flipkit.planning.kitchen.sweep import (Footprint, Lying, approach_height,
                                            blade_rectangle, blade_section, blade_sections, default_margin, meetings,
@@ -324,8 +325,9 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
 def test_a_scoop_that_meets_a_dropped_burger_is_turned_to_the_smallest_clear_turn(monkeypatch):
     """b2's scoop passes 1 cm inside b1's clearance while b1 still lies where it was
     dropped: the cook ranks b2's headings by its footprint turned about b2 and plans the
-    smallest turn predicted clear; here the fake plans' footprints are exactly the turned
-    ones, so that plan keeps clear, while every smaller turn meets b1."""
+    smallest turn predicted clear by the margin plus the model's error; here the fake plans'
+    footprints are exactly the turned ones, so that plan keeps clear, while every smaller
+    turn comes within the widened clearance."""
     import math
 
     import flipkit.planning.kitchen.clearance as clearance
@@ -347,18 +349,20 @@ def test_a_scoop_that_meets_a_dropped_burger_is_turned_to_the_smallest_clear_tur
         turn = headings.get("b2", psi0) - psi0
         return b1_unflipped(fps, turned_footprint(base, b2, turn))
 
-    def clear(turn):
+    def clear(turn, widen=MODEL_MARGIN):  # the ranking widens the margin by the model's error
         return not meetings(turned_footprint(base, b2, turn), "flip:b2", 102.0,
-                            [Lying("b1", tuple(b1), 0.0, 1e9)], CELL)
+                            [Lying("b1", tuple(b1), 0.0, 1e9)], CELL, M + widen)
 
     fps = {}
     monkeypatch.setattr(clearance, "Footprints", lambda cell: fps.__getitem__)
     timeline, lands, headings = clear_cook(schedule, CELL)
     turns = [p - psi0 for p in Turns(CELL).candidates(b2)]
     expected = next(t for t in turns if clear(t))
-    assert not clear(0.0) and lands == {} and seen[0] == {} and len(seen) == 2
+    assert not clear(0.0, 0.0) and lands == {} and seen[0] == {} and len(seen) == 2
     assert headings == {"b2": pytest.approx(psi0 + expected)}
     assert all(not clear(t) for t in turns if abs(t) < abs(expected) - 1e-9)
+    # a smaller turn clears by the margin alone: the model's error margin skipped it
+    assert any(clear(t, 0.0) for t in turns if abs(t) < abs(expected) - 1e-9)
 
 
 def test_the_go_to_burger_comes_in_above_the_burgers_when_the_task_says_so():

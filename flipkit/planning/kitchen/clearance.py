@@ -38,7 +38,7 @@ import numpy as np
 from flipkit.behaviors.library import PICKUP_AND_FLIP, SERVE
 from flipkit.config import CellConfig
 from flipkit.model.robot import Robot
-from flipkit.planning.kitchen.heading_model import PARTS, predicted_overlap
+from flipkit.planning.kitchen.heading_model import MODEL_MARGIN, PARTS, predicted_overlap
 from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
 from flipkit.planning.kitchen.sweep import Lying, Meeting, default_margin, footprint, meetings
 from flipkit.planning.kitchen.turns import CookConflictError, Turns
@@ -125,15 +125,17 @@ def cook_meetings(timeline, cell: CellConfig, footprints: Footprints | None = No
 def _turned_overlap(burger: str, timeline, cell: CellConfig, footprints: Footprints,
                     margin: float | None) -> Callable[[float], float]:
     """``turn (rad) -> m``: how deep ``burger``'s present flip, turned by that much about
-    its burger, would come inside the clearance of the burgers lying while it runs
-    (:func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`)."""
+    its burger, would come inside the clearance of the burgers lying while it runs, widened
+    by the model's error (:data:`~flipkit.planning.kitchen.heading_model.MODEL_MARGIN`;
+    :func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`)."""
     flip = next(m for m in timeline.motions if m.key == f"flip:{burger}")
     fp = footprints(flip.plan)
     rec = next(r for r in timeline.burgers if r.burger.burger == burger)
     pb = (rec.burger.x, rec.burger.y)  # where the flip scoops it from: its drop place
     others = [lie for lie in lying_burgers(timeline, cell, footprints) if lie.burger != burger]
+    wide = (default_margin() if margin is None else margin) + MODEL_MARGIN
     return lambda turn: predicted_overlap(fp, pb, turn, flip.key, flip.start, others, cell,
-                                          margin)
+                                          wide)
 
 
 def landing_candidates(cell: CellConfig, step: float) -> np.ndarray:

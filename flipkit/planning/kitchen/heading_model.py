@@ -27,6 +27,10 @@ from flipkit.config import CellConfig
 from flipkit.planning.kitchen.sweep import Footprint, meetings
 
 PARTS = ("blade", "carried burger")  # what turns with the heading (not the landing disc)
+# m added to the clearance when ranking headings: the prediction's error where the sweep
+# passes, 95th percentile over four places turned by ±15° (0.7-1.8 cm; docs/benchmarks/
+# 2026-12-02-random-cooks.md), so that a heading predicted clear is clear when planned
+MODEL_MARGIN = 0.015
 
 
 def _turn(points, pb, delta: float) -> np.ndarray:
@@ -78,4 +82,4 @@ def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float
     return max([m.overlap_m for m in met if m.part in PARTS], default=0.0)
 
 
-__all__ = ["PARTS", "mapped_footprint", "predicted_overlap", "turned_footprint"]
+__all__ = ["MODEL_MARGIN", "PARTS", "mapped_footprint", "predicted_overlap", "turned_footprint"]
