@@ -20,9 +20,12 @@ import numpy as np
 
 from flipkit.config import TABLE1_LOCATIONS, CellConfig
 from flipkit.errors import FlipkitError
+from flipkit.model.robot import Robot
 from flipkit.planning.kitchen.cook import CookBurger, table_spots
 from flipkit.planning.kitchen.cpsat import MotionTimes
 from flipkit.planning.kitchen.motions import MotionJob, MotionPlanner, PlannedMotion
+from flipkit.planning.kitchen.reach import to_task_frame
+from flipkit.planning.kitchen.sweep import footprint
 
 REPRESENTATIVE = tuple(TABLE1_LOCATIONS[k - 1][:2] for k in (1, 6, 10))  # (x, y) (m)
 
@@ -130,10 +133,6 @@ def _task_footprints(longest: dict, cell: CellConfig) -> dict | None:
     """Each kind's plan's footprint in its burger's task frame; ``None`` without plans."""
     if any(pm.plan is None for pm in longest.values()):
         return None
-    from flipkit.model.robot import Robot
-    from flipkit.planning.kitchen.reach import to_task_frame
-    from flipkit.planning.kitchen.sweep import footprint
-
     robot = Robot(cell, with_burger=False)
     out = {}
     for kind, pm in longest.items():

@@ -28,8 +28,7 @@ from flipkit.planning.kitchen.sweep import Footprint, meetings
 
 PARTS = ("blade", "carried burger")  # what turns with the heading (not the landing disc)
 # m added to the clearance when ranking headings: the prediction's error where the sweep
-# passes, 95th percentile over four places turned by ±15° (0.7-1.8 cm; docs/benchmarks/
-# 2026-12-02-random-cooks.md), so that a heading predicted clear is clear when planned
+# passes (docs/history.md), so that a heading predicted clear is clear when planned
 MODEL_MARGIN = 0.015
 
 
