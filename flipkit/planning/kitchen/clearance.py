@@ -22,10 +22,10 @@ scoop or pickup meets a burger still lying where it was dropped, or whose toss s
 from two other landing spots, is turned (:class:`~flipkit.planning.kitchen.turns.Turns`): its
 headings within 30° of radial are ranked by its footprint turned about its burger
 (:mod:`flipkit.planning.kitchen.heading_model`) against the burgers lying while it runs, and
-the smallest turn predicted clear is planned next. A flip whose blade meets a burger its own
-flip landed is turned too when no spot is free for that burger. A flip still meeting a burger after the
-headings allowed, or whose plan fails at every heading tried, refuses the cook
-(:class:`CookConflictError`, naming the burger, the headings tried and the one it meets).
+the smallest turn predicted clear is planned next. A flip whose blade meets a burger that
+its own flip landed is turned too when no spot is free for that burger. A flip still meeting
+a burger after the headings allowed, or whose plan fails at every heading tried, refuses the
+cook (:class:`CookConflictError`, naming the burger, the headings tried and the one it meets).
 """
 
 from __future__ import annotations
