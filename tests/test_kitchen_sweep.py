@@ -447,3 +447,32 @@ def test_a_spot_keeps_clear_of_the_landings_given_in_the_same_round():
     assert np.hypot(second[0] - first[0], second[1] - first[1]) >= 2 * (R + 0.015) + M - 1e-9
     alone = free_landing("b1", tl, CELL, fps.__getitem__, exclude=[first])
     assert np.hypot(alone[0] - first[0], alone[1] - first[1]) < 2 * (R + 0.015) + M
+
+
+def test_turns_beyond_those_the_atlas_solved_near_the_burger_are_tried_last():
+    """With the turns solved near the burger (-15..30 deg here), a turn more than half the
+    atlas's step beyond them (-25, -30) comes after every other, whatever their order by
+    size; without them the order is by size alone. The package atlas solved its near corner
+    at -15, 0, 15 and 30 deg."""
+    import math
+
+    from flipkit.planning.kitchen.turns import Turns
+    from flipkit.planning.planners.atlas import default_atlas
+
+    b = CookBurger("b", 0.0, 0.70, -0.20)
+    tl = SimpleNamespace(burgers=[SimpleNamespace(burger=b, landing=None)])
+
+    def order(turns):
+        psi0, out = turns.default((b.x, b.y)), []
+        for _ in range(len(turns.candidates((b.x, b.y)))):
+            out.append(round(math.degrees(turns.next("b", None, tl, overlap=lambda t: 0.0)
+                                          - psi0)))
+        return out
+
+    solved = np.radians([-15.0, 0.0, 15.0, 30.0])
+    near = order(Turns(CELL, max_tries=20, solved=lambda xy: solved))
+    plain = order(Turns(CELL, max_tries=20))
+    assert plain == [-5, 5, -10, 10, -15, 15, -20, 20, -25, 25, -30, 30]
+    assert near == [-5, 5, -10, 10, -15, 15, -20, 20, 25, 30, -25, -30]
+    turns = default_atlas(CELL).solved_turns((0.63, -0.45), CELL)
+    assert np.allclose(np.degrees(turns), [-15.0, 0.0, 15.0, 30.0], atol=1e-6)

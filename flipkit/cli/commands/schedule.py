@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
                                                time_limit_s=args.time_limit, seed=args.seed,
                                                child=child)
 
-                timeline, lands, headings = clear_cook(cpsat, cell)
+                timeline, lands, headings = clear_cook(cpsat, cell, atlas=atlas)
             else:
                 timeline = schedule_cook(burgers, planners, cell.robot.q_home, **common,
                                          progress=not args.no_progress)

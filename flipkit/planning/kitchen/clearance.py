@@ -248,7 +248,7 @@ def _carried_chunks(fp, start, t0, t1, only=None):
 
 
 def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
-               margin: float | None = None, max_rounds: int = MAX_ROUNDS):
+               margin: float | None = None, max_rounds: int = MAX_ROUNDS, atlas=None):
     """Schedule a cook whose motions meet no other burger.
 
     Args:
@@ -258,6 +258,8 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
             :func:`~flipkit.planning.kitchen.optimal.schedule_cook_cpsat`).
         cell: The cell. margin: As :func:`~flipkit.planning.kitchen.sweep.meetings`.
         max_rounds: Plan-schedule-check rounds at most.
+        atlas: The planners' :class:`~flipkit.planning.planners.atlas.Atlas`, if any: turns
+            it solved near a burger are tried before the others (:class:`Turns`).
 
     Returns:
         ``(timeline, lands, headings)``: the first timeline without meetings (or one with a
@@ -270,7 +272,8 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
     """
     lands: dict[str, tuple] = {}
     tried: dict[str, list] = {}
-    turns = Turns(cell)
+    turns = Turns(cell, solved=None if atlas is None else
+                  (lambda xy: atlas.solved_turns(xy, cell)))
     fps = Footprints(cell)  # kept over the rounds: a plan made again is a new key
     for round_ in range(max_rounds + 1):
         timeline = schedule(dict(lands), dict(turns.headings))

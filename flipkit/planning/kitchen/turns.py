@@ -7,7 +7,8 @@ dropped (or when its plan fails at the heading it has). The candidates are the d
 way, within ±:data:`~flipkit.config.task.HEADING_LIMIT` of the world's +x. Each is ranked by
 the flip's footprint turned to it (:mod:`flipkit.planning.kitchen.heading_model`) against the
 burgers lying while it runs: those predicted clear first, the smallest turn first (the radial
-heading is the fastest scoop, ``docs/heading.md``), then the others by predicted depth. At
+heading is the fastest scoop, ``docs/heading.md``), then the others by predicted depth; turns
+beyond those the atlas solved near the burger come after the rest. At
 most :data:`MAX_TRIES` headings are planned per burger: a plan costs about a second, and one
 that fails at a heading out of reach up to fifteen.
 """
@@ -21,7 +22,7 @@ import numpy as np
 
 from flipkit.behaviors.targets import default_heading
 from flipkit.config import CellConfig
-from flipkit.config.task import HEADING_LIMIT
+from flipkit.config.task import HEADING_LIMIT, HEADING_STEPS
 from flipkit.errors import FlipkitError
 
 TURN_STEP = math.radians(5.0)  # rad: turns the blade's far corner about 1.5 cm
@@ -40,13 +41,16 @@ class Turns:
         cell: The cell (its base gives the default headings).
         step, max_turn: The candidate turns (rad): multiples of ``step`` up to ``max_turn``.
         max_tries: Headings planned per burger beyond its default.
+        solved: ``xy -> turns (rad)`` solved near a place
+            (:meth:`~flipkit.planning.planners.atlas.Atlas.solved_turns`), or ``None``:
+            turns beyond those, by more than half the atlas's step, are tried last.
     """
 
     def __init__(self, cell: CellConfig, step: float = TURN_STEP, max_turn: float = MAX_TURN,
-                 max_tries: int = MAX_TRIES):
+                 max_tries: int = MAX_TRIES, solved=None):
         if not 0 < step <= max_turn:
             raise FlipkitError(f"turn step {step} rad must lie in (0, max_turn {max_turn}]")
-        self.cell, self.max_tries = cell, int(max_tries)
+        self.cell, self.max_tries, self.solved = cell, int(max_tries), solved
         n = int(round(max_turn / step))
         self.turns = tuple(sorted((k * step for k in range(-n, n + 1) if k), key=abs))
         self.headings: dict[str, float] = {}
@@ -62,6 +66,18 @@ class Turns:
         within ±HEADING_LIMIT."""
         psi0 = self.default(xy)
         return [psi0 + d for d in self.turns if abs(psi0 + d) <= HEADING_LIMIT + 1e-12]
+
+    def _out_of_reach(self, xy) -> Callable[[float], bool]:
+        """``heading -> bool``: its turn lies beyond the turns solved near ``xy`` by more
+        than half the atlas's step (always ``False`` without ``solved``)."""
+        if self.solved is None:
+            return lambda p: False
+        turns = np.asarray(self.solved(xy), float)
+        if not turns.size:
+            return lambda p: False
+        half, psi0 = HEADING_STEPS[0] / 2, self.default(xy)
+        lo, hi = turns.min() - half, turns.max() + half
+        return lambda p: not lo - 1e-9 <= p - psi0 <= hi + 1e-9
 
     def next(self, burger: str, lie, timeline, *, meet=None, failed: bool = False,
              overlap: Callable[[float], float] | None = None) -> float:
@@ -93,7 +109,8 @@ class Turns:
             if overlap is not None:  # a failed plan's turn keeps the last ranking
                 self.depths[burger] = {p: overlap(p - psi) for p in left}
             depth = self.depths.get(burger, {})
-            left.sort(key=lambda p: depth.get(p, 0.0))  # stable: clear ones by turn
+            far = self._out_of_reach(xy)
+            left.sort(key=lambda p: (far(p), depth.get(p, 0.0)))  # stable: clear ones by turn
             self.headings[burger] = left[0]
             return left[0]
         tried = ", ".join(f"{math.degrees(p):.0f}" for p in sorted(done))

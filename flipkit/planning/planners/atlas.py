@@ -32,6 +32,7 @@ import numpy as np
 
 from flipkit.behaviors.library import FLIP_NAMES, PICKUP_AND_FLIP
 from flipkit.behaviors.options import SegmentOptions
+from flipkit.behaviors.targets import default_heading
 from flipkit.config import CellConfig
 from flipkit.config.physics import SIMULATION_ONLY
 from flipkit.errors import AtlasError
@@ -192,6 +193,15 @@ class Atlas:
         return atlas
 
     # ----------------------------------------------------------------- lookup
+    def solved_turns(self, location, cell: CellConfig) -> np.ndarray:
+        """The turns (rad) from the default heading that were solved at the atlas location
+        nearest ``location`` (m, its x-y): where a turned plan is likely to solve."""
+        xy = np.asarray(location, float)[:2]
+        d = np.hypot(*(self.locations[:, :2] - xy).T)
+        near = np.flatnonzero(d <= d.min() + 1e-9)
+        at = self.locations[near[0]]
+        return np.sort(self.headings[near] - default_heading(cell, at))
+
     def distance(self, location, heading: float) -> np.ndarray:
         """Each entry's :func:`entry_distance` (m) from ``location`` and ``heading``."""
         return entry_distance(self.locations, self.headings, location, heading,
