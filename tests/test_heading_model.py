@@ -77,3 +77,26 @@ def test_the_predicted_overlap_is_that_of_the_turned_footprint(footprints):
         lie = [Lying("other", tuple(xy), 0.0, 1e9)]
         assert predicted_overlap(fp0, PB, 0.0, "flip:b", 0.0, lie, CELL, margin) == 0.0
         assert predicted_overlap(fp0, PB, psi1 - psi0, "flip:b", 0.0, lie, CELL, margin) > 0.0
+
+
+def test_the_predicted_overlap_keeps_ranking_once_a_burger_lies_under_the_sweep():
+    """Two sweeps over a burger wholly under the blade meet it equally deep (the deepest
+    meeting stops growing), but the one passing over it for ten samples predicts more
+    overlap than the one passing for three; a sweep that keeps clear predicts 0."""
+    from flipkit.planning.kitchen.sweep import SAMPLE_DT, meetings
+
+    square = np.array([[0.60, -0.30], [0.80, -0.30], [0.80, -0.10], [0.60, -0.10]])
+    lie = [Lying("o", (0.70, -0.20), 0.0, 1e9)]
+
+    def sweep(n_over, n=12):
+        away = square + np.array([0.0, 0.5])
+        return Footprint(blade=[(k * SAMPLE_DT, "scoop", square if k < n_over else away)
+                                for k in range(n)])
+
+    long, short, clear = sweep(10), sweep(3), sweep(0)
+    deep = [max(m.overlap_m for m in meetings(fp, "flip:b", 0.0, lie, CELL, 0.01))
+            for fp in (long, short)]
+    assert deep[0] == pytest.approx(deep[1]) == pytest.approx(CELL.burger.diameter / 2 + 0.01)
+    over = [predicted_overlap(fp, PB, 0.0, "flip:b", 0.0, lie, CELL, 0.01)
+            for fp in (long, short, clear)]
+    assert over[0] == pytest.approx(10 / 3 * over[1]) and over[1] > 0.0 and over[2] == 0.0

@@ -124,8 +124,8 @@ def cook_meetings(timeline, cell: CellConfig, footprints: Footprints | None = No
 
 def _turned_overlap(burger: str, timeline, cell: CellConfig, footprints: Footprints,
                     margin: float | None) -> Callable[[float], float]:
-    """``turn (rad) -> m``: how deep ``burger``'s present flip, turned by that much about
-    its burger, would come inside the clearance of the burgers lying while it runs, widened
+    """``turn (rad) -> m·s``: how far ``burger``'s present flip, turned by that much about
+    its burger, would sweep inside the clearance of the burgers lying while it runs, widened
     by the model's error (:data:`~flipkit.planning.kitchen.heading_model.MODEL_MARGIN`;
     :func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`)."""
     flip = next(m for m in timeline.motions if m.key == f"flip:{burger}")

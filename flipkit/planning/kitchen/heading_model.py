@@ -24,7 +24,8 @@ import math
 import numpy as np
 
 from flipkit.config import CellConfig
-from flipkit.planning.kitchen.sweep import Footprint, meetings
+from flipkit.planning.kitchen.planar import polygon_distances, segment_distances
+from flipkit.planning.kitchen.sweep import SAMPLE_DT, Footprint, default_margin
 
 PARTS = ("blade", "carried burger")  # what turns with the heading (not the landing disc)
 # m added to the clearance when ranking headings: the prediction's error where the sweep
@@ -73,12 +74,39 @@ def turned_footprint(fp: Footprint, pb, delta: float, landing: bool = False) -> 
 
 def predicted_overlap(fp: Footprint, pb, delta: float, motion: str, start: float, lying,
                       cell: CellConfig, margin: float | None = None) -> float:
-    """How deep (m) the flip of footprint ``fp``, turned by ``delta`` (rad) about ``pb`` and
+    """How far (m·s) the flip of footprint ``fp``, turned by ``delta`` (rad) about ``pb`` and
     started at ``start`` (s, cook clock), would come inside the clearance of the ``lying``
-    burgers (:class:`~flipkit.planning.kitchen.sweep.Lying`) with its blade or carried burger;
-    0 when it keeps clear."""
-    met = meetings(turned_footprint(fp, pb, delta), motion, start, lying, cell, margin)
-    return max([m.overlap_m for m in met if m.part in PARTS], default=0.0)
+    burgers (:class:`~flipkit.planning.kitchen.sweep.Lying`) with its blade or carried burger:
+    each sample's depth inside a clearance, summed over the samples and burgers and times
+    the sampling interval. 0 exactly when :func:`~flipkit.planning.kitchen.sweep.meetings`
+    finds neither part meeting anyone; unlike the deepest meeting, which stops growing once a
+    burger lies wholly under the sweep, it keeps ranking how much of the sweep passes over
+    burgers."""
+    margin = default_margin() if margin is None else margin
+    lying = list(lying)
+    if not lying:
+        return 0.0
+    turned = turned_footprint(fp, pb, delta)
+    r = cell.burger.diameter / 2
+    xy = np.array([b.xy for b in lying], float)
+    since, until, spread = (np.array([getattr(b, f) for b in lying], float)
+                            for f in ("t0", "t1", "spread"))
+    total = 0.0
+    if turned.blade:
+        ts, _segs, polys, counts = turned.blade_arrays()
+        depth = r + spread[None] + margin - polygon_distances(xy, polys, counts)
+        total += _live_sum(depth, start + ts, since, until)
+    if turned.carried:
+        ts, _segs, a, b = turned.carried_arrays()
+        depth = 2 * r + spread[None] + margin - segment_distances(xy, a, b)
+        total += _live_sum(depth, start + ts, since, until)
+    return total * SAMPLE_DT
+
+
+def _live_sum(depth, when, since, until) -> float:
+    """The positive ``depth`` (samples × burgers) summed where the burger lies at that time."""
+    live = (since[None] <= when[:, None]) & (when[:, None] <= until[None])
+    return float(np.where(live, np.clip(depth, 0.0, None), 0.0).sum())
 
 
 __all__ = ["MODEL_MARGIN", "PARTS", "mapped_footprint", "predicted_overlap", "turned_footprint"]

@@ -7,9 +7,9 @@ dropped (or when its plan fails at the heading it has). The candidates are the d
 way, within ±:data:`~flipkit.config.task.HEADING_LIMIT` of the world's +x. Each is ranked by
 the flip's footprint turned to it (:mod:`flipkit.planning.kitchen.heading_model`) against the
 burgers lying while it runs: those predicted clear first, the smallest turn first (the radial
-heading is the fastest scoop, ``docs/heading.md``), then the others by predicted depth; turns
-beyond those the atlas solved near the burger come after the rest. At
-most :data:`MAX_TRIES` headings are planned per burger: a plan costs about a second, and one
+heading is the fastest scoop, ``docs/heading.md``), then the others by how far they are
+predicted to sweep inside the clearances; turns beyond those the atlas solved near the burger
+come after the rest. At most :data:`MAX_TRIES` headings are planned per burger: a plan costs about a second, and one
 that fails at a heading out of reach up to fifteen.
 """
 
@@ -55,7 +55,7 @@ class Turns:
         self.turns = tuple(sorted((k * step for k in range(-n, n + 1) if k), key=abs))
         self.headings: dict[str, float] = {}
         self.tried: dict[str, list[float]] = {}
-        self.depths: dict[str, dict[float, float]] = {}  # burger -> heading -> predicted m
+        self.depths: dict[str, dict[float, float]] = {}  # burger -> heading -> predicted m·s
 
     def default(self, xy) -> float:
         """The default heading (rad) of a burger at ``xy`` (m)."""
@@ -88,8 +88,8 @@ class Turns:
                 burger its motion meets (``None`` when its plan failed). timeline: The cook's
                 timeline (where ``burger`` was dropped). meet: The meeting, for the message.
             failed: The flip's plan failed at its present heading.
-            overlap: ``turn (rad) -> m``: the predicted depth inside the other burgers'
-                clearance of the present plan turned by that much
+            overlap: ``turn (rad) -> m·s``: how far inside the other burgers' clearance
+                the present plan, turned by that much, is predicted to sweep
                 (:func:`~flipkit.planning.kitchen.heading_model.predicted_overlap`); without
                 it the candidates keep their order.
 
