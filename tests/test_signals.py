@@ -31,12 +31,19 @@ def _alive(pgid: int) -> list:
     return out
 
 
+def _interruptible():
+    """In the child before it runs flipkit: SIGINT as a terminal delivers it. A test suite run
+    as a background job of a non-interactive shell inherits SIGINT ignored, and Python keeps
+    an ignored SIGINT ignored."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _run_and_signal(argv, signum, children: int, cwd):
     """Start ``flipkit argv`` in its own process group, wait for ``children`` descendants,
     send ``signum``; return (exit status, stderr, seconds to exit, survivors)."""
     proc = subprocess.Popen([sys.executable, "-m", "flipkit", *map(str, argv)], cwd=cwd,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_interruptible)
     try:
         me, t0 = psutil.Process(proc.pid), time.monotonic()
         while len(me.children(recursive=True)) < children:
