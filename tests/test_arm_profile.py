@@ -116,6 +116,9 @@ def test_tool_motion_matches_finite_differences():
     mass = sum(inertia.mass for inertia in robot.model.inertias[1:])  # [0]: the fixed base
     v_com = (com(q + h * qd) - com(q - h * qd)) / (2 * h)
     assert tool.momentum(q, qd) == pytest.approx(mass * np.linalg.norm(v_com), rel=1e-6)
+    # the safety system's one-pass form gives the same two numbers
+    assert tool.speed_and_momentum(q, qd) == pytest.approx(
+        (tool.tcp_speed(q, qd), tool.momentum(q, qd)), rel=1e-12)
 
 
 def tool_flange(robot, q):

@@ -48,8 +48,9 @@ class SafetyMonitor:
         self.joints = robot.profile.joints
         self.qd_limit = robot.qd_limit
         self.enabled = enabled
-        self._limits = np.array([self.limits[k] for k in QUANTITIES])
-        self._peaks = np.zeros(len(QUANTITIES))
+        self._limits = [float(self.limits[k]) for k in QUANTITIES]
+        self._qd_limit = [float(v) for v in self.qd_limit]
+        self._peaks = [0.0] * len(QUANTITIES)
         self.stop: dict | None = None
 
     @property
@@ -60,18 +61,19 @@ class SafetyMonitor:
     def __call__(self, t: float, q: np.ndarray, qd: np.ndarray, force: float) -> None:
         """Watch the state at time ``t`` (s): joint positions (rad) and speeds (rad/s), and
         the steel's normal force on the blade (N)."""
-        ratio = np.abs(qd) / self.qd_limit
-        speed = self.tool.tcp_speed(q, qd)
-        values = np.array([ratio.max(), speed, force, self.tool.momentum(q, qd),
-                           force * speed])  # in the order of QUANTITIES
-        np.maximum(self._peaks, values, out=self._peaks)
-        if self.stop is None and (values > self._limits).any():
-            i = int(np.argmax(values > self._limits))  # the first quantity over its limit
-            name = QUANTITIES[i]
-            self.stop = {"time_s": float(t), "quantity": name, "value": float(values[i]),
-                         "limit": self.limits[name],
-                         "joint": self.joints[int(np.argmax(ratio))]
-                         if name == "joint_speed" else None}
+        ratios = [abs(v) / lim for v, lim in zip(qd.tolist(), self._qd_limit)]
+        speed, momentum = self.tool.speed_and_momentum(q, qd)
+        # in the order of QUANTITIES; plain floats: this runs at every 1 ms step
+        values = (max(ratios), speed, force, momentum, force * speed)
+        self._peaks = [max(p, v) for p, v in zip(self._peaks, values)]
+        if self.stop is None:
+            over = [i for i, (v, lim) in enumerate(zip(values, self._limits)) if v > lim]
+            if over:  # the first quantity over its limit
+                name = QUANTITIES[over[0]]
+                self.stop = {"time_s": float(t), "quantity": name,
+                             "value": float(values[over[0]]), "limit": self.limits[name],
+                             "joint": self.joints[ratios.index(values[0])]
+                             if name == "joint_speed" else None}
 
     @property
     def tripped(self) -> bool:
