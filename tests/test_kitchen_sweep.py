@@ -316,8 +316,9 @@ def test_a_toss_that_meets_a_dropped_burger_lands_its_own_burger_elsewhere(monke
     assert set(lands) == {"b2"} and calls[0] == {} and len(calls) == 2 and headings == {}
     calls.clear()
     with pytest.raises(CookConflictError, match="flip:b2.*b1.*where it was dropped.*every "
-                                                "scoop heading tried"):
+                                                "scoop heading tried") as err:
         clear_cook(lambda lands, headings: schedule(lands, headings, moves=False), CELL)
+    assert err.value.kind == "heading"
     # two other landing spots, then MAX_TRIES turned headings (the toss is fixed here)
     assert len(calls) == 3 + MAX_TRIES and len({tuple(c.get("b2", ())) for c in calls}) == 3
 
@@ -410,8 +411,9 @@ def test_a_landing_that_meets_a_landed_burger_moves_its_own_when_that_one_cannot
     timeline, lands, headings = clear_cook(schedule, CELL)
     assert lands == {"b2": (0.80, 0.05)} and headings == {}
     free.update(b2=None)
-    with pytest.raises(CookConflictError, match="flip:b2: the landing .* burger b1 or b2"):
+    with pytest.raises(CookConflictError, match="flip:b2: the landing .* burger b1 or b2") as err:
         clear_cook(schedule, CELL)
+    assert err.value.kind == "landing"
 
 
 def test_a_scoop_that_meets_a_landed_burger_that_cannot_move_is_turned(monkeypatch):
@@ -432,8 +434,9 @@ def test_a_scoop_that_meets_a_landed_burger_that_cannot_move_is_turned(monkeypat
     monkeypatch.setattr(clearance, "free_landing", lambda *a, **k: None)
     timeline, lands, headings = clear_cook(schedule, CELL)
     assert lands == {} and set(headings) == {"b2"}
-    with pytest.raises(CookConflictError, match="flip:b2: the blade .* every scoop heading"):
+    with pytest.raises(CookConflictError, match="flip:b2: the blade .* every scoop heading") as err:
         clear_cook(lambda lands, headings: schedule(lands, headings, clears=False), CELL)
+    assert err.value.kind == "heading"
 
 
 def test_a_spot_keeps_clear_of_the_landings_given_in_the_same_round():

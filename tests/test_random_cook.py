@@ -11,7 +11,10 @@ from flipkit.cli import main
 from flipkit.config import CellConfig
 from flipkit.errors import ConfigError
 from flipkit.planning.kitchen.cook import check_cook
+from flipkit.planning.kitchen.cook_plan import PlannedCook, first_random_cook
 from flipkit.planning.kitchen.random_cook import MAX_RANDOM, random_order
+from flipkit.planning.kitchen.turns import CookConflictError
+from flipkit.planning.kitchen.windows import WindowBreak
 
 CELL = CellConfig()
 
@@ -105,3 +108,51 @@ def test_a_random_cook_is_scheduled(tmp_path, capsys):
     assert places == {(b.x, b.y) for b in random_order(2, 4, CELL)}
     assert doc["status"] == "solved"
     assert all(m["status"] == "solved" and math.isfinite(m["start"]) for m in doc["motions"])
+
+
+# ---------------------------------------------------- the first random cook that plans
+class _Timeline:
+    def __init__(self, ok=True, failed=()):
+        self.ok = ok
+        self.motions = [type("M", (), {"key": k, "ok": False})() for k in failed]
+
+
+def _fake_plan(outcomes):
+    """A cook planner that answers by the cook's places: ``outcomes`` maps the first burger's
+    x (m, rounded to µm) to "conflict", "broken", "failed" or "ok"; records what it saw."""
+    seen = []
+
+    def plan(burgers):
+        seen.append(burgers)
+        what = outcomes[round(burgers[0].x, 6)]
+        if what == "conflict":
+            raise CookConflictError("flip:r1: no landing spot for burger r1", kind="landing")
+        breach = WindowBreak("r2", "flip", 3.1, 1.1, (0.0, 2.0)) if what == "broken" else None
+        timeline = _Timeline(ok=what != "failed", failed=("serve:r2",) if what == "failed" else ())
+        return PlannedCook(burgers, timeline, {}, {}, breach, 0.1)
+    return plan, seen
+
+
+def test_first_random_cook_keeps_the_first_seed_planned_and_names_the_seeds_refused():
+    x = {s: round(random_order(3, s, CELL)[0].x, 6) for s in range(5)}
+    plan, seen = _fake_plan({x[0]: "conflict", x[1]: "broken", x[2]: "failed", x[3]: "ok",
+                             x[4]: "ok"})
+    drawn = first_random_cook(3, range(5), plan, CELL)
+    assert drawn.seed == 3 and drawn.cook.burgers == random_order(3, 3, CELL)
+    assert len(seen) == 4  # seed 4 is never planned
+    assert [(s, kind) for s, kind, _ in drawn.refused] == [(0, "landing"), (1, "windows"),
+                                                            (2, "other")]
+    reasons = [why for _, _, why in drawn.refused]
+    assert "no landing spot" in reasons[0]
+    assert reasons[1].startswith("windows broken: burger r2")
+    assert reasons[2] == "motions not planned: serve:r2"
+    assert drawn.refusal_counts() == {"landing": 1, "heading": 0, "windows": 1, "other": 1}
+
+
+def test_no_random_cook_planned_is_one_error_with_every_seed_reason():
+    x = {s: round(random_order(2, s, CELL)[0].x, 6) for s in range(3)}
+    plan, _ = _fake_plan({v: "conflict" for v in x.values()})
+    with pytest.raises(ConfigError) as err:
+        first_random_cook(2, range(3), plan, CELL)
+    text = str(err.value)
+    assert "\n" not in text and all(f"seed {s}: " in text for s in range(3))

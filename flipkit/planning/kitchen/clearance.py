@@ -336,12 +336,12 @@ def clear_cook(schedule: Callable[[dict], object], cell: CellConfig,
                     continue
                 raise CookConflictError(
                     f"{meet.describe()}; no landing spot for burger {' or '.join(whom)} keeps "
-                    f"clear of the other burgers and motions")
+                    f"clear of the other burgers and motions", kind="landing")
             tried.setdefault(who, []).append(spot)
             lands[who] = spot
             moved.add(who)
     raise CookConflictError(f"no landing spot for burgers {', '.join(sorted(tried))} "
-                            f"gives a flip that can be planned")
+                            f"gives a flip that can be planned", kind="landing")
 
 
 __all__ = ["MAX_ROUNDS", "CookConflictError", "Footprints", "clear_cook", "cook_meetings",

@@ -30,8 +30,25 @@ MAX_TURN = math.radians(30.0)  # rad: the atlas's widest turn (flipkit.config.ta
 MAX_TRIES = 4  # headings planned per burger beyond its first
 
 
+CONFLICTS = ("landing", "heading", "other")
+"""What a :class:`CookConflictError` ran out of: landing spots clear of the other burgers
+(``landing``), scoop headings that pass them (``heading``), or rounds or schedules
+(``other``)."""
+
+
 class CookConflictError(FlipkitError):
-    """A motion of the cook would meet another burger and no landing spot avoids it."""
+    """A motion of the cook would meet another burger and no landing spot avoids it.
+
+    Args:
+        message: One line naming the burger and what it meets.
+        kind: What ran out, one of :data:`CONFLICTS`.
+    """
+
+    def __init__(self, message: str, kind: str = "other"):
+        if kind not in CONFLICTS:
+            raise ValueError(f"conflict kind {kind!r}: one of {', '.join(CONFLICTS)}")
+        super().__init__(message)
+        self.kind = kind
 
 
 class Turns:
@@ -119,7 +136,8 @@ class Turns:
         widest = math.degrees(max(abs(d) for d in self.turns))
         raise CookConflictError(f"{why} at every scoop heading tried ({tried} deg; turns "
                                 f"within {widest:.0f} deg of radial, at most "
-                                f"{self.max_tries + 1} planned): drop them farther apart")
+                                f"{self.max_tries + 1} planned): drop them farther apart",
+                                kind="heading")
 
 
-__all__ = ["MAX_TRIES", "MAX_TURN", "TURN_STEP", "CookConflictError", "Turns"]
+__all__ = ["CONFLICTS", "MAX_TRIES", "MAX_TURN", "TURN_STEP", "CookConflictError", "Turns"]
