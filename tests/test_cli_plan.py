@@ -49,6 +49,8 @@ def test_translate_writes_a_plan_that_verify_accepts(tmp_path, capsys):
     ["flip", "--burger", "0.75", "0.0", "0.072", "--start-q", "0", "0", "0", "0", "0", "3.3"],
     ["flip", "--burger", "0.75", "0.0", "0.072", "--start-q", "0", "0", "0", "0", "0"],
     ["flip", "--burger", "0.75", "zero", "0.072"],
+    ["flip", "--burger", "0.75", "0.0", "0.072", "--burger-diameter", "0.05"],
+    ["flip", "--burger", "0.75", "0.0", "0.072", "--burger-diameter", "0.13"],
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv):
     path = tmp_path / "p.json"
@@ -166,3 +168,22 @@ def test_batch_warm_starts_from_the_package_atlas_unless_told_not_to(tmp_path, c
                           "--workers", "1", "--no-progress", *extra)
         assert rc == 2 and "stopped by the test" in err
     assert seen[0] is not None and len(seen[0]) > 0 and seen[1] is None
+
+
+def test_flip_for_the_burger_the_camera_sees_records_and_checks_its_diameter(tmp_path, capsys):
+    """--burger-diameter plans for that burger (cold: the package's atlas is for the 0.1 m
+    one): the plan file records the diameter and verify checks the plan with it."""
+    path = tmp_path / "big.json"
+    rc, out, _ = _run(capsys, "plan", "flip", "--burger", "0.69", "-0.16", "0.072",
+                      "--burger-diameter", "0.127", "--json", path)
+    assert rc == 0 and "warm start" not in out
+    plan = Plan.load(path)
+    assert plan.burger["diameter"] == pytest.approx(0.127)
+    assert plan.cell().burger.diameter == pytest.approx(0.127)
+    assert verify_plan(plan).ok
+    # the big burger's plan carries it differently from the nominal one's
+    nominal = tmp_path / "nominal.json"
+    assert _run(capsys, "plan", "flip", "--burger", "0.69", "-0.16", "0.072", "--json",
+                nominal)[0] == 0
+    a, b = (Plan.load(p).segment("flip").landing["burger_on_blade"] for p in (path, nominal))
+    assert not np.allclose(a, b, atol=1e-4)

@@ -22,6 +22,7 @@ from flipkit.simulation.modes import POSITION
 def test_known_parameters_are_ranges_of_the_study_and_the_blade_and_servo_rate():
     assert set(KNOWN_PARAMETERS) <= set(PHYSICAL_RANGES)
     assert "physics.servo_rate_hz" in KNOWN_PARAMETERS
+    assert "burger.diameter" in KNOWN_PARAMETERS  # the camera that locates a burger sees it
     for unknown in ("burger.mu", "physics.mu_grill", "physics.latency_s",
                     "physics.servo_gain_scale"):
         assert unknown not in KNOWN_PARAMETERS
@@ -34,6 +35,8 @@ def test_known_physics_sets_only_what_the_cell_knows():
     assert model.servo_rate_hz == 500.0
     assert model.latency_s == ph.latency_s and model.mu_grill == ph.mu_grill
     assert known_physics(ph, {}) is ph
+    # a known burger parameter is planned for (PLANNED_PARAMETERS), not a servo's
+    assert known_physics(ph, {"burger.diameter": 0.127}) is ph
     with pytest.raises(InvalidChoiceError, match="physical parameter"):
         known_physics(ph, {"physics.nonsense": 1.0})
 

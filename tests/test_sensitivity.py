@@ -75,7 +75,7 @@ def test_a_planned_parameter_runs_the_plans_made_for_its_value(flip_plan, flip_p
     from flipkit.experiments.trial_jobs import plan_text
     from flipkit.planning.planners.planner import plan_flip
 
-    assert PLANNED_PARAMETERS == ("physics.blade_thickness",)
+    assert PLANNED_PARAMETERS == ("burger.diameter", "physics.blade_thickness")
     thick = with_parameter(CellConfig(), "physics.blade_thickness", 0.002)
     other = plan_flip(tuple(flip_plan.burger["location"]), cell=thick)
     assert other.status == "solved"

@@ -22,7 +22,8 @@ import argparse
 
 from flipkit.behaviors.targets import check_table_spot
 from flipkit.cli.common import MAX_WORKERS, check_int, deferred
-from flipkit.cli.plan_inputs import batch_locations, burger, heading, numbers, r_land, yaw
+from flipkit.cli.plan_inputs import (batch_locations, burger, burger_diameter, heading, numbers,
+                                     r_land, yaw)
 from flipkit.config import CellConfig
 from flipkit.errors import UnreachableError
 from flipkit.fileio import check_output, check_output_dir
@@ -84,6 +85,10 @@ def register(subparsers) -> None:
                    help="scoop heading (degrees from the world's +x, within +-60): the go to "
                         "burger, scoop, pickup and flip run along it; default: radially outward "
                         "from the arm's base, which the package's atlas serves")
+    f.add_argument("--burger-diameter", default=None, metavar="M",
+                   help="the burger's diameter (m) as the camera sees it, in [0.089, 0.127]; "
+                        "default: the cell's 0.1 m burger, which the package's atlas serves "
+                        "(another diameter plans from cold starts)")
     atlas_arguments(f)
     common(f)
     f.set_defaults(run=run_flip)
@@ -104,6 +109,10 @@ def register(subparsers) -> None:
                    help="scoop heading (degrees from the world's +x, within +-60): the go to "
                         "burger, scoop, pickup run along it; default: radially outward "
                         "from the arm's base, which the package's atlas serves")
+    s.add_argument("--burger-diameter", default=None, metavar="M",
+                   help="the burger's diameter (m) as the camera sees it, in [0.089, 0.127]; "
+                        "default: the cell's 0.1 m burger, which the package's atlas serves "
+                        "(another diameter plans from cold starts)")
     atlas_arguments(s, " (go to burger, scoop and pickup)")
     common(s)
     s.set_defaults(run=run_serve)
@@ -172,6 +181,7 @@ def run_flip(args: argparse.Namespace) -> int:
     args.r_land = None if args.r_land is None else r_land(args.r_land)
     args.start_q = _start_q(args.start_q)
     args.heading = heading(args.heading)
+    args.burger_diameter = burger_diameter(args.burger_diameter)
     _atlas_file(args)
     return deferred("plan", "run_flip")(args)
 
@@ -188,6 +198,7 @@ def run_serve(args: argparse.Namespace) -> int:
         raise UnreachableError(f"--table-spot: {exc}") from None
     args.start_q = _start_q(args.start_q)
     args.heading = heading(args.heading)
+    args.burger_diameter = burger_diameter(args.burger_diameter)
     _atlas_file(args)
     return deferred("plan", "run_serve")(args)
 

@@ -13,6 +13,7 @@ import csv
 import math
 
 from flipkit.behaviors.targets import check_burger_height, check_heading
+from flipkit.config.physics import PHYSICAL_RANGES
 from flipkit.config.task import R_LAND_RANGE
 from flipkit.csv_header import header_columns
 from flipkit.decimal_text import decimal
@@ -67,6 +68,20 @@ def burger(values, cell) -> list[float]:
     loc = numbers("--burger", values, 3)
     check_burger_height(cell, loc[2], "--burger")
     return loc
+
+
+def burger_diameter(value) -> float | None:
+    """``--burger-diameter`` (m), the patty's diameter as the cell's camera sees it, within the
+    range of patties the cell is studied for (``PHYSICAL_RANGES["burger.diameter"]``);
+    ``None`` when not given (the cell's nominal burger)."""
+    if value is None:
+        return None
+    d = numbers("--burger-diameter", value)[0]
+    lo, hi, source = PHYSICAL_RANGES["burger.diameter"]
+    if not lo <= d <= hi:
+        raise ConfigError(f"--burger-diameter must be in [{lo:g}, {hi:g}] m ({source}), "
+                          f"got {value}")
+    return d
 
 
 def r_land(value) -> float:

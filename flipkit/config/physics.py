@@ -269,27 +269,31 @@ PHYSICAL_RANGES = {  # dotted CellConfig name -> (lo, hi, source); swept one at 
 sensitivity study sweeps one at a time (see :func:`with_parameter`)."""
 
 
-KNOWN_PARAMETERS = ("physics.blade_thickness", "physics.bevel_length", "physics.edge_thickness",
-                    "physics.servo_rate_hz", "physics.servo_lookahead_s")
+KNOWN_PARAMETERS = ("burger.diameter", "physics.blade_thickness", "physics.bevel_length",
+                    "physics.edge_thickness", "physics.servo_rate_hz", "physics.servo_lookahead_s")
 """The parameters of :data:`PHYSICAL_RANGES` that a cell knows: it chose its spatula (the
 blade's geometry) and its robot controller (the servo rate: a CB-series arm streams at
-125 Hz, an e-Series at 500 Hz; the ``servoj`` lookahead it sends). The others it cannot
-measure: the burger, the frictions, the contact damping, the servo's gains and latency. A
-plan is made for what the cell knows. The planner models the blade as its top face with a
-3 mm collision box (``spatula.thickness``, an envelope of the blade's thickness range); the
-blade's thickness enters a plan through the scoop model only (how high the blade can lift
-the patty's overhang, :data:`PLANNED_PARAMETERS`). The servo rate and the lookahead change
-the position commands (:func:`known_physics`)."""
+125 Hz, an e-Series at 500 Hz; the ``servoj`` lookahead it sends), and it sees the burger's
+diameter with the camera that locates the burger (a patty's outline gives its place and its
+size alike; ``flipkit plan flip --burger-diameter``). The others it cannot measure: the
+burger's thickness, mass and stiffness, the frictions, the contact damping, the servo's gains
+and latency. A plan is made for what the cell knows. The planner models the blade as its top
+face with a 3 mm collision box (``spatula.thickness``, an envelope of the blade's thickness
+range); the blade's thickness enters a plan through the scoop model only (how high the blade
+can lift the patty's overhang). The burger's diameter and the blade's thickness change the
+plans (:data:`PLANNED_PARAMETERS`); the servo rate and the lookahead change the position
+commands (:func:`known_physics`)."""
 
-PLANNED_PARAMETERS = ("physics.blade_thickness",)
-"""The known parameters that change a plan (the scoop model's overhang,
-:func:`flipkit.model.scoop.overhang_share`): a study that moves one plans again for each
-value (:func:`flipkit.experiments.sensitivity.run_sensitivity`'s ``replanned``)."""
+PLANNED_PARAMETERS = ("burger.diameter", "physics.blade_thickness")
+"""The known parameters that change a plan: the burger's diameter (its friction cone's
+footprint, the scoop's overlap, the landing) and the blade's thickness (the scoop model's
+overhang, :func:`flipkit.model.scoop.overhang_share`). A study that moves one plans again for
+each value (:func:`flipkit.experiments.sensitivity.run_sensitivity`'s ``replanned``)."""
 
 
 def known_physics(physics: PhysicsConfig, values: dict) -> PhysicsConfig:
     """The cell's model of its own physics, as the commands use it: ``physics`` with the
-    known parameters among ``values`` (``{dotted name: value}``, keys of
+    known ``physics.*`` parameters among ``values`` (``{dotted name: value}``, keys of
     :data:`PHYSICAL_RANGES`) set; every other entry is left at ``physics``'s value.
 
     Raises:
@@ -299,7 +303,7 @@ def known_physics(physics: PhysicsConfig, values: dict) -> PhysicsConfig:
         if name not in PHYSICAL_RANGES:
             raise InvalidChoiceError("physical parameter", name, PHYSICAL_RANGES)
     known = {name.split(".")[1]: float(v) for name, v in values.items()
-             if name in KNOWN_PARAMETERS}
+             if name in KNOWN_PARAMETERS and name.startswith("physics.")}
     return replace(physics, **known) if known else physics
 
 

@@ -14,7 +14,7 @@ import warnings
 from pathlib import Path
 
 from flipkit.behaviors.options import SegmentOptions
-from flipkit.config import CellConfig
+from flipkit.config import CellConfig, with_parameter
 from flipkit.errors import FlipkitError
 from flipkit.experiments.sweep import make_executor
 from flipkit.fileio import write_text
@@ -78,7 +78,7 @@ def run_translate(args: argparse.Namespace) -> int:
 def run_flip(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     _quiet()
-    cell, caches = CellConfig(), PlannerCaches()  # the start's check and the plan share them
+    cell, caches = _cell(args), PlannerCaches()  # the start's check and the plan share them
     options = SegmentOptions() if args.r_land is None else SegmentOptions(r_land=args.r_land)
     q_start = _start_q(args.start_q, caches.models(cell))
     atlas = _atlas(args, options, cell)
@@ -88,6 +88,15 @@ def run_flip(args: argparse.Namespace) -> int:
     if atlas is not None:
         print(f"  warm start: atlas of {len(atlas)} entries")
     return _report(plan, args.json)
+
+
+def _cell(args: argparse.Namespace) -> CellConfig:
+    """The cell, its burger of ``--burger-diameter`` when given (a plan is made for the burger
+    the camera sees; the plan file records its diameter, and verify checks it)."""
+    cell = CellConfig()
+    if getattr(args, "burger_diameter", None) is None:
+        return cell
+    return with_parameter(cell, "burger.diameter", args.burger_diameter)
 
 
 def _atlas(args: argparse.Namespace, options, cell):
@@ -104,7 +113,7 @@ def _atlas(args: argparse.Namespace, options, cell):
 def run_serve(args: argparse.Namespace) -> int:
     """Plan, write (solved or failed), summarise."""
     _quiet()
-    cell, caches = CellConfig(), PlannerCaches()  # the start's check and the plan share them
+    cell, caches = _cell(args), PlannerCaches()  # the start's check and the plan share them
     q_start = _start_q(args.start_q, caches.models(cell))
     atlas = _atlas(args, SegmentOptions(), cell)
     plan = plan_serve(args.burger, args.table_spot, q_start, cell=cell, solver=args.solver,
