@@ -106,11 +106,12 @@ class RandomCook:
         return {kind: kinds.count(kind) for kind in REFUSALS}
 
 
-def _reason(cook: PlannedCook) -> str:
+def _refusal(cook: PlannedCook) -> tuple[str, str]:
+    """The :data:`REFUSALS` kind and one line of a cook planned but not kept."""
     if not cook.timeline.ok:
         failed = [m.key for m in cook.timeline.motions if not m.ok]
-        return f"motions not planned: {', '.join(failed)}"
-    return f"windows broken: {cook.breach.message()}"
+        return "other", f"motions not planned: {', '.join(failed)}"
+    return "windows", f"windows broken: {cook.breach.message()}"
 
 
 def first_random_cook(n: int, seeds, plan: Callable[[list], PlannedCook],
@@ -138,7 +139,7 @@ def first_random_cook(n: int, seeds, plan: Callable[[list], PlannedCook],
             continue
         if cook.ok:
             return RandomCook(int(seed), cook, refused)
-        refused.append((int(seed), "other" if not cook.timeline.ok else "windows", _reason(cook)))
+        refused.append((int(seed), *_refusal(cook)))
     tried = "; ".join(f"seed {s}: {why}" for s, _, why in refused) or "no seed given"
     raise ConfigError(f"no random cook of {n} burgers planned within its windows ({tried})")
 

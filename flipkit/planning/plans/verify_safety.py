@@ -34,7 +34,7 @@ def check_safety(report, k: int, seg, robot, tol: float) -> None:
     times = np.append((seg.t[:-1, None] + np.diff(seg.t)[:, None] * frac).ravel(), seg.t[-1])
     q, qd = spline(times), spline(times, 1)
     tool = ToolMotion(robot)
-    rows = np.array([[tool.tcp_speed(a, b), tool.momentum(a, b)] for a, b in zip(q, qd)])
+    rows = np.array([tool.speed_and_momentum(a, b) for a, b in zip(q, qd)])
     limit = np.array([preset.tcp_speed, preset.momentum])
     nodes = np.minimum(np.arange(len(times)) // SUBSTEPS, seg.N)
     over = np.maximum(rows - limit, 0.0)
